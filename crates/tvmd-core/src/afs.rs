@@ -1,0 +1,166 @@
+//! Elliptic-cone approximation of the attainable force space (AFS), eqs. (7)-(8).
+
+use nalgebra::Vector3;
+
+use crate::error::ConfigError;
+use crate::real::{count, to_f64, Real};
+
+/// The AFS relaxation `s in (0, 1]`: gimbal limits are shrunk to `s sigma` when planning, which
+/// leaves attitude-control authority in reserve (paper, eq. 8).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Relaxation<T: Real>(T);
+
+impl<T: Real> Relaxation<T> {
+    /// Validates `s in (0, 1]`.
+    pub fn new(s: T) -> Result<Self, ConfigError> {
+        if !s.is_finite() {
+            return Err(ConfigError::NonFinite { field: "relaxation" });
+        }
+        if s <= T::zero() || s > T::one() {
+            return Err(ConfigError::Relaxation { value: to_f64(s) });
+        }
+        Ok(Self(s))
+    }
+
+    /// `s = 1`: the full gimbal limits (used by the force projection).
+    pub fn none() -> Self {
+        Self(T::one())
+    }
+
+    /// The value of `s`.
+    pub fn get(&self) -> T {
+        self.0
+    }
+}
+
+/// Semi-axes of the elliptic cross-section of the AFS at height `z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SemiAxes<T: Real> {
+    /// `c_x(z, s)`.
+    pub c_x: T,
+    /// `c_y(z, s)`.
+    pub c_y: T,
+    /// Whether a semi-axis comes from the `sigma >= pi/2` branch of eq. (8) (then the AFS is not
+    /// confined to `z > 0`).
+    pub unbounded_branch: bool,
+}
+
+/// The approximated AFS of a (possibly degraded) team:
+/// `u_f in AFS  <=>  u_f^T C(u_fz) u_f <= 1  and  ||u_f|| <= n sigma_Tf` (eq. 7),
+/// with `C = diag(1/c_x^2, 1/c_y^2, 0)` and `c_x, c_y` from eq. (8).
+///
+/// A force with `z <= 0` is outside unless a semi-axis comes from the `sigma >= pi/2` branch
+/// (SPEC reading; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
+/// paper writes `<`, so that the projection's output `t_Tf u` is a member.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttainableForceSpace<T: Real> {
+    n: usize,
+    n_x: usize,
+    sigma_x: T,
+    sigma_y: T,
+    max_thrust: T,
+}
+
+impl<T: Real> AttainableForceSpace<T> {
+    /// The AFS of `n` working agents of which `n_x` have even quarter turns.
+    pub fn new(
+        n: usize,
+        n_x: usize,
+        sigma_x: T,
+        sigma_y: T,
+        max_thrust: T,
+    ) -> Result<Self, ConfigError> {
+        if n == 0 {
+            return Err(ConfigError::NoAgents);
+        }
+        if n_x > n {
+            return Err(ConfigError::AgentCount { n, n_x });
+        }
+        crate::team::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
+        Ok(Self {
+            n,
+            n_x,
+            sigma_x,
+            sigma_y,
+            max_thrust,
+        })
+    }
+
+    /// `n`.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// `n_x`.
+    pub fn n_x(&self) -> usize {
+        self.n_x
+    }
+
+    /// `n sigma_Tf`, the largest attainable force magnitude.
+    pub fn max_force(&self) -> T {
+        count::<T>(self.n) * self.max_thrust
+    }
+
+    /// `g(n_k, sigma, z)` of eq. (8); the flag tells whether the `sigma >= pi/2` branch was used.
+    fn g(&self, n_k: usize, sigma: T, z: T) -> (T, bool) {
+        if sigma >= T::frac_pi_2() {
+            (count::<T>(n_k) * self.max_thrust, n_k > 0)
+        } else if n_k == 0 {
+            // (1 - delta(n_k)) vanishes.
+            (T::zero(), false)
+        } else {
+            (
+                count::<T>(n_k) / count::<T>(self.n) * z.abs() * sigma.tan(),
+                false,
+            )
+        }
+    }
+
+    /// `c_x(z, s) = g(n_x, s sigma_y, z) + g(n_y, s sigma_x, z)` and
+    /// `c_y(z, s) = g(n_x, s sigma_x, z) + g(n_y, s sigma_y, z)` (eq. 8).
+    pub fn semi_axes(&self, z: T, s: Relaxation<T>) -> SemiAxes<T> {
+        let n_y = self.n - self.n_x;
+        let (sx, sy) = (s.get() * self.sigma_x, s.get() * self.sigma_y);
+        let (a, ua) = self.g(self.n_x, sy, z);
+        let (b, ub) = self.g(n_y, sx, z);
+        let (c, uc) = self.g(self.n_x, sx, z);
+        let (d, ud) = self.g(n_y, sy, z);
+        SemiAxes {
+            c_x: a + b,
+            c_y: c + d,
+            unbounded_branch: ua || ub || uc || ud,
+        }
+    }
+
+    /// `u^T C(u_z) u = (u_x / c_x)^2 + (u_y / c_y)^2` (eq. 7). A zero semi-axis contributes 0 if
+    /// its component is 0 and `+inf` otherwise.
+    pub fn quadratic_form(&self, u: &Vector3<T>, s: Relaxation<T>) -> T {
+        let axes = self.semi_axes(u.z, s);
+        ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y)
+    }
+
+    /// Membership in the approximated AFS (eq. 7, with the readings documented on the type).
+    pub fn contains(&self, u: &Vector3<T>, s: Relaxation<T>) -> bool {
+        if !u.iter().all(|x| x.is_finite()) || u.norm() > self.max_force() {
+            return false;
+        }
+        let axes = self.semi_axes(u.z, s);
+        (u.z > T::zero() || axes.unbounded_branch)
+            && ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y) <= T::one()
+    }
+}
+
+fn ratio_squared<T: Real>(x: T, c: T) -> T {
+    if x == T::zero() {
+        T::zero()
+    } else if c == T::zero() {
+        infinity()
+    } else {
+        (x / c) * (x / c)
+    }
+}
+
+/// `+inf` for IEEE floats.
+pub(crate) fn infinity<T: Real>() -> T {
+    T::one() / T::zero()
+}

@@ -1,0 +1,129 @@
+//! The effectiveness model `M(Xi)` (eq. 4): what wrench the team produces from agent forces.
+//!
+//! Stored as one 6x3 block per agent, never as a heap matrix, so every product is `O(n)`.
+
+use nalgebra::{Matrix3, Matrix6, Matrix6x3, SymmetricEigen, Vector3, Vector6};
+
+use crate::error::ConfigError;
+use crate::real::{eps, lit, to_f64, Real};
+use crate::team::{FailureMask, TeamConfig};
+
+/// `R_z(m pi/2)`, exact for whole quarter turns.
+pub fn quarter_turn<T: Real>(quarter_turns: i32) -> Matrix3<T> {
+    let (o, i) = (T::zero(), T::one());
+    match quarter_turns.rem_euclid(4) {
+        0 => Matrix3::identity(),
+        1 => Matrix3::new(o, -i, o, i, o, o, o, o, i),
+        2 => Matrix3::new(-i, o, o, o, -i, o, o, o, i),
+        _ => Matrix3::new(o, i, o, -i, o, o, o, o, i),
+    }
+}
+
+/// `M_i = [[p_i]x R_z(psi_i); R_z(psi_i)]`, agent `i`'s block of eq. (4), rows `[torque; force]`.
+pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix6x3<T> {
+    let rz = quarter_turn::<T>(quarter_turns);
+    let mut block = Matrix6x3::zeros();
+    block
+        .fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(position.cross_matrix() * rz));
+    block.fixed_view_mut::<3, 3>(3, 0).copy_from(&rz);
+    block
+}
+
+/// `M(Xi)` of the working agents: `u = [u_tau; u_f] = sum_i M_i f_i` (eq. 4), with `f_i` in
+/// agent `i`'s frame. Failed agents have no block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Effectiveness<T: Real, const N: usize> {
+    blocks: [Option<Matrix6x3<T>>; N],
+}
+
+impl<T: Real, const N: usize> Effectiveness<T, N> {
+    /// Blocks of the team's working agents.
+    pub fn new(team: &TeamConfig<T, N>, failures: &FailureMask<N>) -> Self {
+        let mut blocks = [None; N];
+        for (i, agent) in team.working(failures) {
+            if let Some(slot) = blocks.get_mut(i) {
+                *slot = Some(agent_block(&agent.position, agent.quarter_turns));
+            }
+        }
+        Self { blocks }
+    }
+
+    /// Block of agent `i`, `None` if it failed or does not exist.
+    pub fn block(&self, agent: usize) -> Option<&Matrix6x3<T>> {
+        self.blocks.get(agent).and_then(Option::as_ref)
+    }
+
+    /// Blocks per slot of the capacity (`None` for failed or absent agents).
+    pub fn blocks(&self) -> &[Option<Matrix6x3<T>>; N] {
+        &self.blocks
+    }
+
+    /// Number of working agents.
+    pub fn working_count(&self) -> usize {
+        self.blocks.iter().flatten().count()
+    }
+
+    /// `u = M f` (eq. 4) for agent-frame forces; failed agents' forces are ignored.
+    pub fn wrench(&self, forces: &[Vector3<T>; N]) -> Vector6<T> {
+        self.blocks
+            .iter()
+            .zip(forces)
+            .filter_map(|(b, f)| b.as_ref().map(|b| b * f))
+            .fold(Vector6::zeros(), |acc, u| acc + u)
+    }
+
+    /// `M W^-1 M^T = sum_i M_i M_i^T / w_i` (with `w_i = 1`: `M M^T`), the 6x6 Gram matrix of the
+    /// pseudo-inverse. `weights[i] > 0` is agent `i`'s cost weight.
+    pub fn weighted_gram(&self, weights: Option<&[T; N]>) -> Matrix6<T> {
+        let mut gram = Matrix6::zeros();
+        for (i, block) in self.blocks.iter().enumerate() {
+            if let Some(b) = block {
+                let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+                gram += b * b.transpose() / w;
+            }
+        }
+        gram
+    }
+
+    /// `M M^T`.
+    pub fn gram(&self) -> Matrix6<T> {
+        self.weighted_gram(None)
+    }
+
+    /// Writes the dense `6 x 3n` matrix row-major into `out` (length `18 n` for `n` slots,
+    /// zero columns for failed agents). Returns `false` if `out` has the wrong length.
+    pub fn write_dense(&self, n: usize, out: &mut [T]) -> bool {
+        if out.len() != 18 * n || n > N {
+            return false;
+        }
+        for (row, out_row) in out.chunks_exact_mut(3 * n).enumerate() {
+            for (block, cols) in self.blocks.iter().zip(out_row.chunks_exact_mut(3)) {
+                for (col, x) in cols.iter_mut().enumerate() {
+                    *x = block
+                        .as_ref()
+                        .and_then(|b| b.get((row, col)).copied())
+                        .unwrap_or(T::zero());
+                }
+            }
+        }
+        true
+    }
+
+    /// Errors with [`ConfigError::RankDeficient`] unless `M` has rank 6, judged by the
+    /// eigenvalues of `M M^T` (smallest above `1e3 eps` times the largest).
+    pub fn check_rank(&self) -> Result<(), ConfigError> {
+        let eig = SymmetricEigen::try_new(self.gram(), eps(), 256)
+            .ok_or(ConfigError::RankDeficient { conditioning: 0.0 })?
+            .eigenvalues;
+        let (min, max) = (eig.min(), eig.max());
+        if max > T::zero() && min > max * eps::<T>() * lit(1e3) {
+            Ok(())
+        } else {
+            let ratio = if max > T::zero() { min / max } else { T::zero() };
+            Err(ConfigError::RankDeficient {
+                conditioning: to_f64(ratio).max(0.0),
+            })
+        }
+    }
+}

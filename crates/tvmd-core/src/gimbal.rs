@@ -1,0 +1,61 @@
+//! The agent's two-axis gimbal: thrust direction (eq. 1) and its inverse (paper, "Control
+//! Allocation").
+
+use nalgebra::Vector3;
+
+use crate::real::Real;
+
+/// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
+/// unit thrust direction in the agent frame.
+pub fn thrust_direction<T: Real>(eta_x: T, eta_y: T) -> Vector3<T> {
+    let (sx, cx) = eta_x.sin_cos();
+    let (sy, cy) = eta_y.sin_cos();
+    Vector3::new(cx * sy, -sx, cx * cy)
+}
+
+/// Gimbal angles and thrust of one agent: the command that produces an agent-frame force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GimbalCommand<T: Real> {
+    /// `T = ||f_i||` (N).
+    pub thrust: T,
+    /// Inner gimbal angle `eta_x` (rad).
+    pub eta_x: T,
+    /// Outer gimbal angle `eta_y` (rad).
+    pub eta_y: T,
+}
+
+impl<T: Real> GimbalCommand<T> {
+    /// Zero thrust, gimbal centred.
+    pub fn idle() -> Self {
+        Self {
+            thrust: T::zero(),
+            eta_x: T::zero(),
+            eta_y: T::zero(),
+        }
+    }
+
+    /// The inverse of [`Self::force`]: `T = ||f||`, `eta_x = asin(-f_y / T)`,
+    /// `eta_y = atan2(f_x / sgn(cos eta_x), f_z / sgn(cos eta_x))`.
+    ///
+    /// `asin` returns `|eta_x| <= pi/2`, so `cos eta_x >= 0` and the paper's sign is `+1`
+    /// (taken as `+1` at `cos eta_x = 0` too, where `eta_y` is arbitrary). A zero force gives
+    /// zero thrust with a centred gimbal.
+    pub fn from_force(force: &Vector3<T>) -> Self {
+        let thrust = force.norm();
+        if thrust == T::zero() || !thrust.is_finite() {
+            return Self::idle();
+        }
+        // Rounding can push |f_y|/T a hair above 1.
+        let sin_x = (-force.y / thrust).clamp(-T::one(), T::one());
+        Self {
+            thrust,
+            eta_x: sin_x.asin(),
+            eta_y: force.x.atan2(force.z),
+        }
+    }
+
+    /// `f = T a_hat(eta_x, eta_y)`, the agent-frame force.
+    pub fn force(&self) -> Vector3<T> {
+        thrust_direction(self.eta_x, self.eta_y) * self.thrust
+    }
+}

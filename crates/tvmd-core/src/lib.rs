@@ -1,0 +1,47 @@
+//! # tvmd-core
+//!
+//! Full-pose tracking control for over-actuated, thrust-vectoring modular team UAVs (TVMD):
+//! several agents, each a coaxial rotor on a two-axis gimbal, bolted into one rigid vehicle.
+//!
+//! Pipeline of one control period, each stage a pure function of explicit inputs:
+//!
+//! 1. [`team`]: the configuration `Xi`, limits, presets and failures.
+//! 2. [`effectiveness`]: `M(Xi)`, the wrench the agents produce (eq. 4).
+//! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8).
+//! 4. [`projection`]: the force projection `K_f` (eqs. 12-13).
+//! 5. [`planner`]: the bisection attitude planner (eqs. 9-11).
+//! 6. [`gimbal`]: thrust direction (eq. 1) and its inverse.
+//!
+//! `no_std`, no allocator, generic over [`Real`] (`f32` or `f64`), fixed capacity `N` agents.
+#![no_std]
+#![deny(missing_docs)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented
+)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod afs;
+pub mod effectiveness;
+pub mod error;
+pub mod gimbal;
+pub mod planner;
+pub mod projection;
+pub mod real;
+pub mod team;
+
+pub use afs::{AttainableForceSpace, Relaxation, SemiAxes};
+pub use effectiveness::Effectiveness;
+pub use error::{ConfigError, InputError};
+pub use gimbal::GimbalCommand;
+pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
+pub use projection::{project_force, ForceProjection};
+pub use real::Real;
+pub use team::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};

@@ -1,0 +1,201 @@
+//! The attitude planner (eqs. 9-11): the smallest tilt of the reference attitude `R_r` that
+//! makes the requested force attainable.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::error::{ConfigError, InputError};
+use crate::real::{eps, lit, Real};
+
+/// How the planner reached its output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlannerStatus {
+    /// `R_r^T f_r` was already in the AFS: `R_d = R_r`, `theta = 0`.
+    AlreadyFeasible,
+    /// Bisection found the smallest feasible tilt (within the tolerance).
+    Planned,
+    /// `f_r = 0`: there is no direction to tilt toward; `R_d = R_r`.
+    ZeroForce,
+    /// Not even `b_zd` along `f_r` is feasible (`||f_r|| > n sigma_Tf`): `R_d` aligns `b_zd`
+    /// with `f_r` as closely as the rotation allows (`theta = theta_max`).
+    Unreachable,
+}
+
+/// Output of [`AttitudePlanner::plan`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlannerOutput<T: Real> {
+    /// `R_d = [b_xd b_yd b_zd]`, the planned attitude.
+    pub r_d: Matrix3<T>,
+    /// `theta*`, the tilt from `b_zr` toward `f_r` (rad).
+    pub theta: T,
+    /// Bisection iterations used (0 unless [`PlannerStatus::Planned`]).
+    pub iterations: u32,
+    /// How the output was reached.
+    pub status: PlannerStatus,
+}
+
+/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in SPEC:
+/// it returns the last *feasible* bisection point, stops on a tolerance or an iteration cap, and
+/// tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudePlanner<T: Real> {
+    relaxation: Relaxation<T>,
+    tolerance: T,
+    max_iterations: u32,
+}
+
+impl<T: Real> AttitudePlanner<T> {
+    /// A planner with relaxation `s`, tolerance `max(1e-10, 8 eps)` rad and at most 64 iterations.
+    pub fn new(relaxation: Relaxation<T>) -> Self {
+        Self {
+            relaxation,
+            tolerance: lit::<T>(1e-10).max(eps::<T>() * lit(8.0)),
+            max_iterations: 64,
+        }
+    }
+
+    /// Sets the bisection tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
+    pub fn with_tolerance(mut self, tolerance: T, max_iterations: u32) -> Result<Self, ConfigError> {
+        if !tolerance.is_finite() || tolerance <= T::zero() {
+            return Err(ConfigError::Parameter {
+                name: "planner.tolerance",
+            });
+        }
+        if max_iterations == 0 {
+            return Err(ConfigError::Parameter {
+                name: "planner.max_iterations",
+            });
+        }
+        self.tolerance = tolerance;
+        self.max_iterations = max_iterations;
+        Ok(self)
+    }
+
+    /// The relaxation `s`.
+    pub fn relaxation(&self) -> Relaxation<T> {
+        self.relaxation
+    }
+
+    /// The bisection tolerance (rad).
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
+    /// Plans `R_d` for the reference attitude `r_r` and the inertial force request `f_r`
+    /// (eq. 9: `f_r = t_Tf R u_fr`). Errors only on non-finite input.
+    pub fn plan(
+        &self,
+        afs: &AttainableForceSpace<T>,
+        r_r: &Matrix3<T>,
+        f_r: &Vector3<T>,
+    ) -> Result<PlannerOutput<T>, InputError> {
+        if !r_r.iter().all(|x| x.is_finite()) {
+            return Err(InputError::NonFinite {
+                field: "planner.r_r",
+            });
+        }
+        if !f_r.iter().all(|x| x.is_finite()) {
+            return Err(InputError::NonFinite {
+                field: "planner.f_r",
+            });
+        }
+        let unchanged = |status| PlannerOutput {
+            r_d: *r_r,
+            theta: T::zero(),
+            iterations: 0,
+            status,
+        };
+        let feasible = |r: &Matrix3<T>| afs.contains(&(r.transpose() * f_r), self.relaxation);
+        let norm = f_r.norm();
+        if norm == T::zero() {
+            return Ok(unchanged(PlannerStatus::ZeroForce));
+        }
+        if feasible(r_r) {
+            return Ok(unchanged(PlannerStatus::AlreadyFeasible));
+        }
+        let tilt = Tilt::new(r_r, f_r, norm);
+        let end = tilt.attitude(tilt.theta_max);
+        if !feasible(&end) {
+            return Ok(PlannerOutput {
+                r_d: end,
+                theta: tilt.theta_max,
+                iterations: 0,
+                status: PlannerStatus::Unreachable,
+            });
+        }
+        // Invariant: `lo` infeasible, `hi` feasible; `hi` is returned.
+        let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
+        let mut iterations = 0;
+        while hi - lo > self.tolerance && iterations < self.max_iterations {
+            iterations += 1;
+            let mid = (lo + hi) * lit(0.5);
+            let r_mid = tilt.attitude(mid);
+            if feasible(&r_mid) {
+                hi = mid;
+                r_hi = r_mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok(PlannerOutput {
+            r_d: r_hi,
+            theta: hi,
+            iterations,
+            status: PlannerStatus::Planned,
+        })
+    }
+}
+
+/// The one-parameter family `R_d(theta)` of eqs. (10)-(11).
+struct Tilt<T: Real> {
+    b_xr: Vector3<T>,
+    b_yr: Vector3<T>,
+    b_zr: Vector3<T>,
+    /// `k x b_zr`, the direction `b_zd` moves toward.
+    k_cross_bz: Vector3<T>,
+    theta_max: T,
+}
+
+impl<T: Real> Tilt<T> {
+    fn new(r_r: &Matrix3<T>, f_r: &Vector3<T>, norm: T) -> Self {
+        let (b_xr, b_yr, b_zr) = (
+            r_r.column(0).into_owned(),
+            r_r.column(1).into_owned(),
+            r_r.column(2).into_owned(),
+        );
+        let cross = b_zr.cross(f_r);
+        let cross_norm = cross.norm();
+        // f_r (anti)parallel to b_zr: no unique axis; roll about b_xr (documented choice).
+        let k = if cross_norm > norm * eps::<T>() * lit(8.0) {
+            cross / cross_norm
+        } else {
+            b_xr
+        };
+        let cos_max = (b_zr.dot(f_r) / norm).clamp(-T::one(), T::one());
+        Self {
+            k_cross_bz: k.cross(&b_zr),
+            b_xr,
+            b_yr,
+            b_zr,
+            theta_max: cos_max.acos(),
+        }
+    }
+
+    /// `b_zd = rot(b_zr, k, theta)` (Rodrigues; `k . b_zr = 0`), `b_yd = b_zd x b_xr / ||.||`,
+    /// `b_xd = b_yd x b_zd` (eq. 11). When `b_zd` is parallel to `b_xr`, `b_xd` is instead taken
+    /// from `b_yr x b_zd`.
+    fn attitude(&self, theta: T) -> Matrix3<T> {
+        let (s, c) = theta.sin_cos();
+        let b_zd = (self.b_zr * c + self.k_cross_bz * s).normalize();
+        let y = b_zd.cross(&self.b_xr);
+        let y_norm = y.norm();
+        let (b_xd, b_yd) = if y_norm > eps::<T>().sqrt() {
+            let b_yd = y / y_norm;
+            (b_yd.cross(&b_zd), b_yd)
+        } else {
+            let b_xd = self.b_yr.cross(&b_zd).normalize();
+            (b_xd, b_zd.cross(&b_xd))
+        };
+        Matrix3::from_columns(&[b_xd, b_yd, b_zd])
+    }
+}

@@ -1,0 +1,64 @@
+//! Force projection `K_f` (eqs. 12-13): scales a requested force into the approximated AFS.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::real::Real;
+
+/// The projected force and the factors of `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForceProjection<T: Real> {
+    /// `K_f u_fr`.
+    pub force: Vector3<T>,
+    /// `t_Tf = min(1, n sigma_Tf / ||u_fr||)` (`1` for a zero force).
+    pub t_tf: T,
+    /// `t_eta = min(1, sqrt(1 / (u'^T C(u'_z) u')))` at `s = 1`, `u' = t_Tf u_fr`
+    /// (`1` when the quadratic form is 0, `0` when it is infinite).
+    pub t_eta: T,
+}
+
+impl<T: Real> ForceProjection<T> {
+    /// `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
+    pub fn gain(&self) -> Matrix3<T> {
+        let xy = self.t_eta * self.t_tf;
+        Matrix3::from_diagonal(&Vector3::new(xy, xy, self.t_tf))
+    }
+}
+
+/// Projects `u_fr` (team frame) into `afs`: first onto the thrust ball, then the horizontal
+/// part onto the ellipse at the resulting height (eqs. 12-13, `s = 1`).
+///
+/// A non-finite `u_fr` projects to zero with both factors 0, so the output is never NaN.
+pub fn project_force<T: Real>(
+    afs: &AttainableForceSpace<T>,
+    u_fr: &Vector3<T>,
+) -> ForceProjection<T> {
+    if !u_fr.iter().all(|x| x.is_finite()) {
+        return ForceProjection {
+            force: Vector3::zeros(),
+            t_tf: T::zero(),
+            t_eta: T::zero(),
+        };
+    }
+    let norm = u_fr.norm();
+    let limit = afs.max_force();
+    let t_tf = if norm > limit { limit / norm } else { T::one() };
+    let scaled = u_fr * t_tf;
+    let q = afs.quadratic_form(&scaled, Relaxation::none());
+    let t_eta = if q <= T::one() {
+        T::one()
+    } else if q.is_finite() {
+        (T::one() / q).sqrt()
+    } else {
+        T::zero()
+    };
+    let projection = ForceProjection {
+        force: Vector3::zeros(),
+        t_tf,
+        t_eta,
+    };
+    ForceProjection {
+        force: projection.gain() * u_fr,
+        ..projection
+    }
+}

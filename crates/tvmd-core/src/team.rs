@@ -1,0 +1,532 @@
+//! The team configuration `Xi` (paper, "Modeling"): agents, limits, navigator, and the derived
+//! team mass `m_C`, inertia `J_C`, `n_x` / `n_y` and the Con/Inc arrangement.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::afs::AttainableForceSpace;
+use crate::effectiveness::Effectiveness;
+use crate::error::{ConfigError, GimbalAxis, MassOf};
+use crate::real::{eps, lit, Real};
+
+/// One agent of the team: its frame in the team CoM frame `{C}`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AgentSpec<T: Real> {
+    /// `p_i`: the agent's gimbal centre in `{C}` (m).
+    pub position: Vector3<T>,
+    /// `m_i`: the agent's yaw as a whole number of quarter turns, `psi_i = m_i pi/2`.
+    /// Stored as an integer so `R_z(psi_i)` is exact.
+    pub quarter_turns: i32,
+    /// `m_i` of the dynamics (kg), treated as a point mass at `p_i`.
+    pub mass: T,
+    /// Optional inertia of the agent about its own centre, in `{C}` axes (extension of the
+    /// paper's point-mass model; zero by default).
+    pub inertia: Matrix3<T>,
+}
+
+impl<T: Real> AgentSpec<T> {
+    /// A point-mass agent at `position` with yaw `quarter_turns * pi/2`.
+    pub fn new(position: Vector3<T>, quarter_turns: i32, mass: T) -> Self {
+        Self {
+            position,
+            quarter_turns,
+            mass,
+            inertia: Matrix3::zeros(),
+        }
+    }
+
+    /// Whether the agent's `x` gimbal axis is aligned with the team's `x` axis (`m_i` even).
+    pub fn is_x_aligned(&self) -> bool {
+        self.quarter_turns.rem_euclid(2) == 0
+    }
+
+    fn placeholder() -> Self {
+        Self::new(Vector3::zeros(), 0, T::zero())
+    }
+}
+
+/// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
+/// `T = rho d^4 c_l omega^2` (eq. 5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AgentLimits<T: Real> {
+    /// `sigma_x`: limit of `|eta_x|` (rad), in `(0, pi/2]`.
+    pub sigma_x: T,
+    /// `sigma_y`: limit of `|eta_y|` (rad), in `(0, pi/2]`.
+    pub sigma_y: T,
+    /// `sigma_Tf`: maximum thrust of one agent (N).
+    pub max_thrust: T,
+    /// Idle thrust (N), the smallest thrust the allocator commands; `0` by default.
+    pub min_thrust: T,
+    /// `rho d^4 c_l`: thrust per squared rotor speed (N s^2 / rad^2).
+    pub thrust_coefficient: T,
+}
+
+impl<T: Real> AgentLimits<T> {
+    /// Limits from the gimbal limits and the maximum thrust. Rotor speeds are then normalized:
+    /// `omega = 1` at maximum thrust.
+    pub fn new(sigma_x: T, sigma_y: T, max_thrust: T) -> Result<Self, ConfigError> {
+        let limits = Self {
+            sigma_x,
+            sigma_y,
+            max_thrust,
+            min_thrust: T::zero(),
+            thrust_coefficient: max_thrust,
+        };
+        limits.validate()?;
+        Ok(limits)
+    }
+
+    /// Limits from the rotor constants of eq. (5): air density `rho`, rotor diameter `d`,
+    /// lift coefficient `c_l` and maximum rotor speed `sigma_omega`; `sigma_Tf = T(sigma_omega)`.
+    pub fn from_rotor(
+        sigma_x: T,
+        sigma_y: T,
+        rho: T,
+        d: T,
+        c_l: T,
+        sigma_omega: T,
+    ) -> Result<Self, ConfigError> {
+        for (value, field) in [
+            (rho, "limits.rho"),
+            (d, "limits.d"),
+            (c_l, "limits.c_l"),
+            (sigma_omega, "limits.sigma_omega"),
+        ] {
+            if !value.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if value <= T::zero() {
+                return Err(ConfigError::NonPositiveThrust {
+                    value: crate::real::to_f64(value),
+                });
+            }
+        }
+        let k = rho * d * d * d * d * c_l;
+        let limits = Self {
+            sigma_x,
+            sigma_y,
+            max_thrust: k * sigma_omega * sigma_omega,
+            min_thrust: T::zero(),
+            thrust_coefficient: k,
+        };
+        limits.validate()?;
+        Ok(limits)
+    }
+
+    /// The same limits with an idle thrust `min_thrust` in `[0, sigma_Tf)`.
+    pub fn with_min_thrust(mut self, min_thrust: T) -> Result<Self, ConfigError> {
+        self.min_thrust = min_thrust;
+        self.validate()?;
+        Ok(self)
+    }
+
+    /// Checks every field; [`TeamConfig::new`] calls it.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let half_pi = T::frac_pi_2();
+        for (value, axis, field) in [
+            (self.sigma_x, GimbalAxis::X, "limits.sigma_x"),
+            (self.sigma_y, GimbalAxis::Y, "limits.sigma_y"),
+        ] {
+            if !value.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if value <= T::zero() || value > half_pi {
+                return Err(ConfigError::GimbalLimit {
+                    axis,
+                    value: crate::real::to_f64(value),
+                });
+            }
+        }
+        for (value, field) in [
+            (self.max_thrust, "limits.max_thrust"),
+            (self.thrust_coefficient, "limits.thrust_coefficient"),
+            (self.min_thrust, "limits.min_thrust"),
+        ] {
+            if !value.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+        }
+        for value in [self.max_thrust, self.thrust_coefficient] {
+            if value <= T::zero() {
+                return Err(ConfigError::NonPositiveThrust {
+                    value: crate::real::to_f64(value),
+                });
+            }
+        }
+        if self.min_thrust < T::zero() || self.min_thrust >= self.max_thrust {
+            return Err(ConfigError::IdleThrust {
+                value: crate::real::to_f64(self.min_thrust),
+            });
+        }
+        Ok(())
+    }
+
+    /// Rotor speed for a thrust (eq. 5 inverted); negative thrust maps to 0.
+    pub fn speed_for_thrust(&self, thrust: T) -> T {
+        (thrust.max(T::zero()) / self.thrust_coefficient).sqrt()
+    }
+
+    /// Thrust for a rotor speed (eq. 5).
+    pub fn thrust_for_speed(&self, omega: T) -> T {
+        self.thrust_coefficient * omega * omega
+    }
+
+    /// `sigma_omega`, the rotor speed at maximum thrust.
+    pub fn max_speed(&self) -> T {
+        self.speed_for_thrust(self.max_thrust)
+    }
+}
+
+/// The navigator module at the team CoM (the paper's "1 navigator").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Navigator<T: Real> {
+    /// `m_0` (kg), `>= 0`.
+    pub mass: T,
+    /// `J_0`, inertia about the team CoM (kg m^2), symmetric positive semi-definite.
+    pub inertia: Matrix3<T>,
+}
+
+impl<T: Real> Default for Navigator<T> {
+    /// No navigator mass (the paper's simulation).
+    fn default() -> Self {
+        Self {
+            mass: T::zero(),
+            inertia: Matrix3::zeros(),
+        }
+    }
+}
+
+/// Whether every agent's gimbal axes are aligned with the team's (paper's "Con") or not ("Inc").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arrangement {
+    /// Consistent: every `m_i` even (`n_y = 0`).
+    Con,
+    /// Inconsistent: some `m_i` odd.
+    Inc,
+}
+
+/// Which agents have failed. A failed agent leaves `n`, `n_x` / `n_y` and `M` (paper's degraded
+/// team); it is commanded to zero thrust.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FailureMask<const N: usize> {
+    failed: [bool; N],
+}
+
+impl<const N: usize> Default for FailureMask<N> {
+    fn default() -> Self {
+        Self::none()
+    }
+}
+
+impl<const N: usize> FailureMask<N> {
+    /// No agent failed.
+    pub const fn none() -> Self {
+        Self { failed: [false; N] }
+    }
+
+    /// Marks agent `i` failed (or working again with `failed = false`).
+    pub fn set(&mut self, agent: usize, failed: bool) -> Result<(), ConfigError> {
+        let slot = self
+            .failed
+            .get_mut(agent)
+            .ok_or(ConfigError::FailureIndex { agent })?;
+        *slot = failed;
+        Ok(())
+    }
+
+    /// A mask with the given agents failed.
+    pub fn with_failed(agents: &[usize]) -> Result<Self, ConfigError> {
+        let mut mask = Self::none();
+        for &i in agents {
+            mask.set(i, true)?;
+        }
+        Ok(mask)
+    }
+
+    /// Whether agent `i` is marked failed (`false` beyond the capacity).
+    pub fn is_failed(&self, agent: usize) -> bool {
+        self.failed.get(agent).copied().unwrap_or(false)
+    }
+
+    /// The flags, one per slot of the capacity.
+    pub fn as_array(&self) -> &[bool; N] {
+        &self.failed
+    }
+}
+
+/// The team configuration `Xi = {(p_i, psi_i)}` with limits, masses and navigator, validated.
+///
+/// Fixed-capacity storage: up to `N` agents, no allocation. Mass `m_C = m_0 + sum m_i` and
+/// inertia `J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)` are derived once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TeamConfig<T: Real, const N: usize> {
+    agents: [AgentSpec<T>; N],
+    len: usize,
+    limits: AgentLimits<T>,
+    navigator: Navigator<T>,
+    mass: T,
+    inertia: Matrix3<T>,
+}
+
+impl<T: Real, const N: usize> TeamConfig<T, N> {
+    /// Validates and builds a team.
+    ///
+    /// Errors: [`ConfigError::NoAgents`], [`ConfigError::TooManyAgents`],
+    /// [`ConfigError::NonFinite`], [`ConfigError::GimbalLimit`], [`ConfigError::NonPositiveMass`],
+    /// [`ConfigError::NonPositiveThrust`], [`ConfigError::IdleThrust`],
+    /// [`ConfigError::NavigatorInertia`], [`ConfigError::RankDeficient`].
+    pub fn new(
+        agents: &[AgentSpec<T>],
+        limits: AgentLimits<T>,
+        navigator: Navigator<T>,
+    ) -> Result<Self, ConfigError> {
+        if agents.is_empty() {
+            return Err(ConfigError::NoAgents);
+        }
+        if agents.len() > N {
+            return Err(ConfigError::TooManyAgents {
+                count: agents.len(),
+                capacity: N,
+            });
+        }
+        limits.validate()?;
+        validate_navigator(&navigator)?;
+        let mut storage = [AgentSpec::placeholder(); N];
+        let mut mass = navigator.mass;
+        let mut inertia = navigator.inertia;
+        for (i, (slot, agent)) in storage.iter_mut().zip(agents).enumerate() {
+            if !agent.position.iter().all(|x| x.is_finite()) {
+                return Err(ConfigError::NonFinite {
+                    field: "agent.position",
+                });
+            }
+            if !agent.mass.is_finite() {
+                return Err(ConfigError::NonFinite {
+                    field: "agent.mass",
+                });
+            }
+            if !agent.inertia.iter().all(|x| x.is_finite()) {
+                return Err(ConfigError::NonFinite {
+                    field: "agent.inertia",
+                });
+            }
+            if agent.mass <= T::zero() {
+                return Err(ConfigError::NonPositiveMass {
+                    of: MassOf::Agent(i),
+                    value: crate::real::to_f64(agent.mass),
+                });
+            }
+            let p = agent.position.cross_matrix();
+            mass += agent.mass;
+            inertia += agent.inertia - p * p * agent.mass;
+            *slot = *agent;
+        }
+        let team = Self {
+            agents: storage,
+            len: agents.len(),
+            limits,
+            navigator,
+            mass,
+            inertia,
+        };
+        team.effectiveness(&FailureMask::none()).check_rank()?;
+        Ok(team)
+    }
+
+    /// The agents (length `n`).
+    pub fn agents(&self) -> &[AgentSpec<T>] {
+        self.agents.get(..self.len).unwrap_or(&[])
+    }
+
+    /// `n`, the number of agents.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Always `false`: a validated team has at least one agent.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Agent limits.
+    pub fn limits(&self) -> &AgentLimits<T> {
+        &self.limits
+    }
+
+    /// Navigator.
+    pub fn navigator(&self) -> &Navigator<T> {
+        &self.navigator
+    }
+
+    /// `m_C`, the team mass (kg).
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+
+    /// `J_C`, the team inertia about its CoM (kg m^2).
+    pub fn inertia(&self) -> Matrix3<T> {
+        self.inertia
+    }
+
+    /// `n_x`: working agents with even `m_i`.
+    pub fn n_x(&self, failures: &FailureMask<N>) -> usize {
+        self.working(failures).filter(|(_, a)| a.is_x_aligned()).count()
+    }
+
+    /// `n_y = n - n_x` over working agents.
+    pub fn n_y(&self, failures: &FailureMask<N>) -> usize {
+        self.working(failures).filter(|(_, a)| !a.is_x_aligned()).count()
+    }
+
+    /// Con if every agent's axes align with the team's, else Inc.
+    pub fn arrangement(&self) -> Arrangement {
+        if self.agents().iter().all(AgentSpec::is_x_aligned) {
+            Arrangement::Con
+        } else {
+            Arrangement::Inc
+        }
+    }
+
+    /// Indices and specs of the agents not marked failed.
+    pub fn working<'a>(
+        &'a self,
+        failures: &'a FailureMask<N>,
+    ) -> impl Iterator<Item = (usize, &'a AgentSpec<T>)> + 'a {
+        self.agents()
+            .iter()
+            .enumerate()
+            .filter(move |(i, _)| !failures.is_failed(*i))
+    }
+
+    /// The effectiveness model `M(Xi)` of the working agents (eq. 4).
+    pub fn effectiveness(&self, failures: &FailureMask<N>) -> Effectiveness<T, N> {
+        Effectiveness::new(self, failures)
+    }
+
+    /// The attainable-force-space approximation of the working agents (eqs. 7-8).
+    /// Errors with [`ConfigError::NoAgents`] when every agent failed.
+    pub fn afs(&self, failures: &FailureMask<N>) -> Result<AttainableForceSpace<T>, ConfigError> {
+        let n = self.working(failures).count();
+        AttainableForceSpace::new(
+            n,
+            self.n_x(failures),
+            self.limits.sigma_x,
+            self.limits.sigma_y,
+            self.limits.max_thrust,
+        )
+    }
+
+    /// Checks that a degraded team can still produce every wrench (rank-6 `M`).
+    pub fn validate_failures(&self, failures: &FailureMask<N>) -> Result<(), ConfigError> {
+        if let Some(agent) = (self.len..N).find(|&i| failures.is_failed(i)) {
+            return Err(ConfigError::FailureIndex { agent });
+        }
+        if self.working(failures).next().is_none() {
+            return Err(ConfigError::NoAgents);
+        }
+        self.effectiveness(failures).check_rank()
+    }
+}
+
+fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigError> {
+    if !navigator.mass.is_finite() {
+        return Err(ConfigError::NonFinite {
+            field: "navigator.mass",
+        });
+    }
+    if !navigator.inertia.iter().all(|x| x.is_finite()) {
+        return Err(ConfigError::NonFinite {
+            field: "navigator.inertia",
+        });
+    }
+    if navigator.mass < T::zero() {
+        return Err(ConfigError::NonPositiveMass {
+            of: MassOf::Navigator,
+            value: crate::real::to_f64(navigator.mass),
+        });
+    }
+    let j = navigator.inertia;
+    let scale = j.amax().max(T::one());
+    let tol = scale * eps::<T>() * lit(64.0);
+    if (j - j.transpose()).amax() > tol {
+        return Err(ConfigError::NavigatorInertia);
+    }
+    let min_eig = SymmetricEigen::try_new(j, eps(), 256)
+        .map(|e| e.eigenvalues.min())
+        .ok_or(ConfigError::NavigatorInertia)?;
+    if min_eig < -tol {
+        return Err(ConfigError::NavigatorInertia);
+    }
+    Ok(())
+}
+
+/// Team presets: the paper's A4 teams and ring layouts for tests and the simulator.
+pub mod presets {
+    use super::*;
+
+    /// Half side of the paper's square: `a = 0.5 sqrt(2)/2` m.
+    pub const PAPER_HALF_SIDE: f64 = 0.353_553_390_593_273_8;
+    /// Agent mass of the paper's simulation (kg).
+    pub const PAPER_AGENT_MASS: f64 = 0.7;
+    /// Gravity used throughout the paper (m/s^2).
+    pub const GRAVITY: f64 = 9.81;
+
+    /// The paper's agent limits: `sigma_x = pi/6`, `sigma_y = pi/4`, `sigma_Tf = 2 m_i g`.
+    pub fn paper_limits<T: Real>() -> AgentLimits<T> {
+        AgentLimits {
+            sigma_x: T::pi() / lit(6.0),
+            sigma_y: T::frac_pi_4(),
+            max_thrust: lit(2.0 * PAPER_AGENT_MASS * GRAVITY),
+            min_thrust: T::zero(),
+            thrust_coefficient: lit(2.0 * PAPER_AGENT_MASS * GRAVITY),
+        }
+    }
+
+    /// A square of four agents at `(+a,+a), (+a,-a), (-a,-a), (-a,+a)` with the given quarter turns.
+    pub fn square<T: Real, const N: usize>(
+        quarter_turns: [i32; 4],
+        limits: AgentLimits<T>,
+    ) -> Result<TeamConfig<T, N>, ConfigError> {
+        let a: T = lit(PAPER_HALF_SIDE);
+        let corners = [(a, a), (a, -a), (-a, -a), (-a, a)];
+        let mut agents = [AgentSpec::placeholder(); 4];
+        for ((agent, (x, y)), m) in agents.iter_mut().zip(corners).zip(quarter_turns) {
+            *agent = AgentSpec::new(Vector3::new(x, y, T::zero()), m, lit(PAPER_AGENT_MASS));
+        }
+        TeamConfig::new(&agents, limits, Navigator::default())
+    }
+
+    /// The paper's simulated team "A4 inc, 1 navigator": `psi = [pi/2, pi/2, 0, 0]`,
+    /// `m_i = 0.7` kg, navigator mass 0, [`paper_limits`].
+    pub fn a4_inc<T: Real, const N: usize>() -> Result<TeamConfig<T, N>, ConfigError> {
+        square([1, 1, 0, 0], paper_limits())
+    }
+
+    /// As [`a4_inc`] with every agent aligned (`psi = 0`): the consistent A4 team.
+    pub fn a4_con<T: Real, const N: usize>() -> Result<TeamConfig<T, N>, ConfigError> {
+        square([0, 0, 0, 0], paper_limits())
+    }
+
+    /// `n` agents of the paper's mass on a circle of `radius` in the `x-y` plane; every second
+    /// agent turned a quarter turn when `inconsistent` (A3..A10-like layouts).
+    pub fn ring<T: Real, const N: usize>(
+        n: usize,
+        radius: T,
+        inconsistent: bool,
+        limits: AgentLimits<T>,
+    ) -> Result<TeamConfig<T, N>, ConfigError> {
+        if n > N {
+            return Err(ConfigError::TooManyAgents { count: n, capacity: N });
+        }
+        let mut agents = [AgentSpec::placeholder(); N];
+        for (i, agent) in agents.iter_mut().take(n).enumerate() {
+            let phase = T::two_pi() * crate::real::count::<T>(i) / crate::real::count::<T>(n);
+            let m = if inconsistent { (i % 2) as i32 } else { 0 };
+            *agent = AgentSpec::new(
+                Vector3::new(radius * phase.cos(), radius * phase.sin(), T::zero()),
+                m,
+                lit(PAPER_AGENT_MASS),
+            );
+        }
+        TeamConfig::new(agents.get(..n).unwrap_or(&[]), limits, Navigator::default())
+    }
+}
