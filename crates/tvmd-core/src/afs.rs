@@ -14,7 +14,9 @@ impl<T: Real> Relaxation<T> {
     /// Validates `s in (0, 1]`.
     pub fn new(s: T) -> Result<Self, ConfigError> {
         if !s.is_finite() {
-            return Err(ConfigError::NonFinite { field: "relaxation" });
+            return Err(ConfigError::NonFinite {
+                field: "relaxation",
+            });
         }
         if s <= T::zero() || s > T::one() {
             return Err(ConfigError::Relaxation { value: to_f64(s) });

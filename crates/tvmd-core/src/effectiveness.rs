@@ -120,7 +120,11 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
         if max > T::zero() && min > max * eps::<T>() * lit(1e3) {
             Ok(())
         } else {
-            let ratio = if max > T::zero() { min / max } else { T::zero() };
+            let ratio = if max > T::zero() {
+                min / max
+            } else {
+                T::zero()
+            };
             Err(ConfigError::RankDeficient {
                 conditioning: to_f64(ratio).max(0.0),
             })

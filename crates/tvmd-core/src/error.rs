@@ -161,7 +161,9 @@ pub enum InputError {
 impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            Self::NonFinite { field } => write!(f, "input `{field}` is not finite (NaN or infinite)"),
+            Self::NonFinite { field } => {
+                write!(f, "input `{field}` is not finite (NaN or infinite)")
+            }
             Self::NotRotation { field } => write!(f, "input `{field}` is not a rotation matrix"),
         }
     }

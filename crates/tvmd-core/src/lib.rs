@@ -28,6 +28,9 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+/// The nalgebra version the API uses, re-exported so users match it.
+pub use nalgebra;
+
 pub mod afs;
 pub mod effectiveness;
 pub mod error;

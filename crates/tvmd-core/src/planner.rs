@@ -55,7 +55,11 @@ impl<T: Real> AttitudePlanner<T> {
     }
 
     /// Sets the bisection tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
-    pub fn with_tolerance(mut self, tolerance: T, max_iterations: u32) -> Result<Self, ConfigError> {
+    pub fn with_tolerance(
+        mut self,
+        tolerance: T,
+        max_iterations: u32,
+    ) -> Result<Self, ConfigError> {
         if !tolerance.is_finite() || tolerance <= T::zero() {
             return Err(ConfigError::Parameter {
                 name: "planner.tolerance",
@@ -144,6 +148,17 @@ impl<T: Real> AttitudePlanner<T> {
             status: PlannerStatus::Planned,
         })
     }
+}
+
+/// `R_d(theta)` of eqs. (10)-(11): `R_r` tilted by `theta` toward `f_r`, the family the planner
+/// searches (exposed for diagnostics and tests). `f_r` must be finite and non-zero; otherwise
+/// `R_r` is returned.
+pub fn tilted_attitude<T: Real>(r_r: &Matrix3<T>, f_r: &Vector3<T>, theta: T) -> Matrix3<T> {
+    let norm = f_r.norm();
+    if norm == T::zero() || !norm.is_finite() || !theta.is_finite() {
+        return *r_r;
+    }
+    Tilt::new(r_r, f_r, norm).attitude(theta)
 }
 
 /// The one-parameter family `R_d(theta)` of eqs. (10)-(11).

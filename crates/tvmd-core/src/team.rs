@@ -369,12 +369,16 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
 
     /// `n_x`: working agents with even `m_i`.
     pub fn n_x(&self, failures: &FailureMask<N>) -> usize {
-        self.working(failures).filter(|(_, a)| a.is_x_aligned()).count()
+        self.working(failures)
+            .filter(|(_, a)| a.is_x_aligned())
+            .count()
     }
 
     /// `n_y = n - n_x` over working agents.
     pub fn n_y(&self, failures: &FailureMask<N>) -> usize {
-        self.working(failures).filter(|(_, a)| !a.is_x_aligned()).count()
+        self.working(failures)
+            .filter(|(_, a)| !a.is_x_aligned())
+            .count()
     }
 
     /// Con if every agent's axes align with the team's, else Inc.
@@ -515,7 +519,10 @@ pub mod presets {
         limits: AgentLimits<T>,
     ) -> Result<TeamConfig<T, N>, ConfigError> {
         if n > N {
-            return Err(ConfigError::TooManyAgents { count: n, capacity: N });
+            return Err(ConfigError::TooManyAgents {
+                count: n,
+                capacity: N,
+            });
         }
         let mut agents = [AgentSpec::placeholder(); N];
         for (i, agent) in agents.iter_mut().take(n).enumerate() {

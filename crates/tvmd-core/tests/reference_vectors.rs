@@ -8,8 +8,7 @@ use nalgebra::{Matrix3, Vector3};
 use tvmd_core::effectiveness::agent_block;
 use tvmd_core::real::Real;
 use tvmd_core::{
-    project_force, AttainableForceSpace, AttitudePlanner, GimbalCommand, PlannerStatus,
-    Relaxation,
+    project_force, AttainableForceSpace, AttitudePlanner, GimbalCommand, PlannerStatus, Relaxation,
 };
 
 fn t<T: Real>(x: f64) -> T {
@@ -33,7 +32,10 @@ fn m3<T: Real>(r: &[Vec<f64>]) -> Matrix3<T> {
 }
 
 fn n_x_of(quarter_turns: &[i32]) -> usize {
-    quarter_turns.iter().filter(|m| m.rem_euclid(2) == 0).count()
+    quarter_turns
+        .iter()
+        .filter(|m| m.rem_euclid(2) == 0)
+        .count()
 }
 
 /// Runs every group for `T`; returns the number of cases checked.
@@ -48,7 +50,12 @@ fn check_all<T: Real>(rel: f64, theta_tol: f64) -> usize {
             eta_y: t(f(c, "eta_y")),
         };
         let want = vec3(&c["force"]);
-        assert_close(&out3(&cmd.force()), &want, rel, &format!("gimbal[{i}].force"));
+        assert_close(
+            &out3(&cmd.force()),
+            &want,
+            rel,
+            &format!("gimbal[{i}].force"),
+        );
         let inv = GimbalCommand::from_force(&v3::<T>(want));
         assert_close(
             &[back(inv.thrust), back(inv.eta_x), back(inv.eta_y)],
@@ -79,7 +86,12 @@ fn check_all<T: Real>(rel: f64, theta_tol: f64) -> usize {
             wrench += block * v3::<T>([forces[3 * k], forces[3 * k + 1], forces[3 * k + 2]]);
         }
         let got: Vec<f64> = wrench.iter().map(|x| back(*x)).collect();
-        assert_close(&got, &list(&c["wrench"]), rel, &format!("effectiveness[{i}].wrench"));
+        assert_close(
+            &got,
+            &list(&c["wrench"]),
+            rel,
+            &format!("effectiveness[{i}].wrench"),
+        );
         checked += 1;
     }
 
@@ -153,7 +165,12 @@ fn check_all<T: Real>(rel: f64, theta_tol: f64) -> usize {
             .map(|(r, col)| back(out.r_d[(r, col)]))
             .collect();
         // R_d moves with theta at unit rate, so it gets the angle's tolerance.
-        assert_close(&got_r, &want_r, theta_tol.max(rel), &format!("planner[{i}].R_d"));
+        assert_close(
+            &got_r,
+            &want_r,
+            theta_tol.max(rel),
+            &format!("planner[{i}].R_d"),
+        );
         checked += 1;
     }
     checked

@@ -27,16 +27,24 @@ pub fn cases<'a>(v: &'a Value, key: &str) -> &'a Vec<Value> {
 }
 
 pub fn f(v: &Value, key: &str) -> f64 {
-    v[key].as_f64().unwrap_or_else(|| panic!("missing number {key}"))
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("missing number {key}"))
 }
 
 pub fn u(v: &Value, key: &str) -> usize {
-    v[key].as_u64().unwrap_or_else(|| panic!("missing count {key}")) as usize
+    v[key]
+        .as_u64()
+        .unwrap_or_else(|| panic!("missing count {key}")) as usize
 }
 
 pub fn vec3(v: &Value) -> [f64; 3] {
     let a = v.as_array().expect("array");
-    [a[0].as_f64().unwrap(), a[1].as_f64().unwrap(), a[2].as_f64().unwrap()]
+    [
+        a[0].as_f64().unwrap(),
+        a[1].as_f64().unwrap(),
+        a[2].as_f64().unwrap(),
+    ]
 }
 
 pub fn list(v: &Value) -> Vec<f64> {

@@ -1,0 +1,292 @@
+//! Every configuration error is reachable, typed and explained.
+
+use nalgebra::{Matrix3, Vector3};
+use tvmd_core::error::{GimbalAxis, MassOf};
+use tvmd_core::team::presets;
+use tvmd_core::{
+    AgentLimits, AgentSpec, AttainableForceSpace, AttitudePlanner, ConfigError, FailureMask,
+    Navigator, Relaxation, TeamConfig,
+};
+
+fn square_agents() -> Vec<AgentSpec<f64>> {
+    let a = presets::PAPER_HALF_SIDE;
+    [(a, a, 1), (a, -a, 1), (-a, -a, 0), (-a, a, 0)]
+        .iter()
+        .map(|&(x, y, m)| AgentSpec::new(Vector3::new(x, y, 0.0), m, 0.7))
+        .collect()
+}
+
+fn limits() -> AgentLimits<f64> {
+    presets::paper_limits()
+}
+
+fn build(agents: &[AgentSpec<f64>]) -> Result<TeamConfig<f64, 8>, ConfigError> {
+    TeamConfig::new(agents, limits(), Navigator::default())
+}
+
+fn assert_message(e: ConfigError, needle: &str) {
+    let text = e.to_string();
+    assert!(text.contains(needle), "`{text}` should mention `{needle}`");
+    let _: &dyn std::error::Error = &e;
+}
+
+#[test]
+fn valid_team_builds_with_derived_quantities() {
+    let team = build(&square_agents()).unwrap();
+    assert_eq!(team.len(), 4);
+    assert!((team.mass() - 2.8).abs() < 1e-12);
+    let none = FailureMask::none();
+    assert_eq!((team.n_x(&none), team.n_y(&none)), (2, 2));
+    // J_C = -sum m_i [p_i]x^2: diag(m a^2 4, m a^2 4, 2 m a^2 4) for the square.
+    let a2 = presets::PAPER_HALF_SIDE.powi(2);
+    let j = team.inertia();
+    assert!((j[(0, 0)] - 4.0 * 0.7 * a2).abs() < 1e-12);
+    assert!((j[(2, 2)] - 8.0 * 0.7 * a2).abs() < 1e-12);
+    assert_eq!(team.arrangement(), tvmd_core::Arrangement::Inc);
+    assert_eq!(
+        presets::a4_con::<f64, 4>().unwrap().arrangement(),
+        tvmd_core::Arrangement::Con
+    );
+}
+
+#[test]
+fn no_agents() {
+    let e = build(&[]).unwrap_err();
+    assert_eq!(e, ConfigError::NoAgents);
+    assert_message(e, "no");
+    let team = build(&square_agents()).unwrap();
+    let all = FailureMask::with_failed(&[0, 1, 2, 3]).unwrap();
+    assert_eq!(team.validate_failures(&all), Err(ConfigError::NoAgents));
+    assert_eq!(team.afs(&all), Err(ConfigError::NoAgents));
+}
+
+#[test]
+fn too_many_agents() {
+    let agents = square_agents();
+    let e = TeamConfig::<f64, 3>::new(&agents, limits(), Navigator::default()).unwrap_err();
+    assert_eq!(
+        e,
+        ConfigError::TooManyAgents {
+            count: 4,
+            capacity: 3
+        }
+    );
+    assert_message(e, "capacity of 3");
+    assert!(presets::ring::<f64, 4>(5, 1.0, true, limits()).is_err());
+}
+
+#[test]
+fn non_finite_numbers() {
+    let mut agents = square_agents();
+    agents[2].position.y = f64::NAN;
+    assert_eq!(
+        build(&agents),
+        Err(ConfigError::NonFinite {
+            field: "agent.position"
+        })
+    );
+    let mut agents = square_agents();
+    agents[1].mass = f64::INFINITY;
+    assert_eq!(
+        build(&agents),
+        Err(ConfigError::NonFinite {
+            field: "agent.mass"
+        })
+    );
+    let mut agents = square_agents();
+    agents[0].inertia[(1, 1)] = f64::NAN;
+    assert_eq!(
+        build(&agents),
+        Err(ConfigError::NonFinite {
+            field: "agent.inertia"
+        })
+    );
+    let e = AgentLimits::new(f64::NAN, 0.5, 10.0).unwrap_err();
+    assert_eq!(
+        e,
+        ConfigError::NonFinite {
+            field: "limits.sigma_x"
+        }
+    );
+    assert_message(e, "limits.sigma_x");
+    let e = AgentLimits::new(0.5, 0.5, f64::INFINITY).unwrap_err();
+    assert_eq!(
+        e,
+        ConfigError::NonFinite {
+            field: "limits.max_thrust"
+        }
+    );
+    let nav = Navigator {
+        mass: f64::NAN,
+        inertia: Matrix3::zeros(),
+    };
+    assert_eq!(
+        TeamConfig::<f64, 8>::new(&square_agents(), limits(), nav),
+        Err(ConfigError::NonFinite {
+            field: "navigator.mass"
+        })
+    );
+    assert_eq!(
+        Relaxation::new(f64::NAN),
+        Err(ConfigError::NonFinite {
+            field: "relaxation"
+        })
+    );
+}
+
+#[test]
+fn gimbal_limits_outside_range() {
+    for (sx, sy, axis, value) in [
+        (0.0, 0.5, GimbalAxis::X, 0.0),
+        (-0.1, 0.5, GimbalAxis::X, -0.1),
+        (0.5, 1.6, GimbalAxis::Y, 1.6),
+    ] {
+        let e = AgentLimits::new(sx, sy, 10.0).unwrap_err();
+        assert_eq!(e, ConfigError::GimbalLimit { axis, value });
+        assert_message(e, "(0, pi/2]");
+    }
+    assert!(AgentLimits::new(std::f64::consts::FRAC_PI_2, 0.1, 10.0).is_ok());
+}
+
+#[test]
+fn non_positive_masses() {
+    let mut agents = square_agents();
+    agents[3].mass = 0.0;
+    let e = build(&agents).unwrap_err();
+    assert_eq!(
+        e,
+        ConfigError::NonPositiveMass {
+            of: MassOf::Agent(3),
+            value: 0.0
+        }
+    );
+    assert_message(e, "agent 3");
+    let nav = Navigator {
+        mass: -1.0,
+        inertia: Matrix3::zeros(),
+    };
+    let e = TeamConfig::<f64, 8>::new(&square_agents(), limits(), nav).unwrap_err();
+    assert_eq!(
+        e,
+        ConfigError::NonPositiveMass {
+            of: MassOf::Navigator,
+            value: -1.0
+        }
+    );
+    assert_message(e, "navigator");
+}
+
+#[test]
+fn non_positive_thrust() {
+    assert_eq!(
+        AgentLimits::new(0.5, 0.5, 0.0),
+        Err(ConfigError::NonPositiveThrust { value: 0.0 })
+    );
+    assert_eq!(
+        AgentLimits::from_rotor(0.5, 0.5, 1.2, -0.2, 0.1, 1000.0),
+        Err(ConfigError::NonPositiveThrust { value: -0.2 })
+    );
+    let e = limits().with_min_thrust(100.0).unwrap_err();
+    assert_eq!(e, ConfigError::IdleThrust { value: 100.0 });
+    assert_message(e, "idle");
+}
+
+#[test]
+fn rotor_model_round_trip() {
+    let l = AgentLimits::from_rotor(0.5, 0.7, 1.225, 0.2, 0.1, 900.0).unwrap();
+    let k = 1.225 * 0.2f64.powi(4) * 0.1;
+    assert!((l.max_thrust - k * 900.0 * 900.0).abs() < 1e-9);
+    assert!((l.max_speed() - 900.0).abs() < 1e-9);
+    assert!((l.thrust_for_speed(l.speed_for_thrust(3.0)) - 3.0).abs() < 1e-12);
+    // Without rotor constants, speed is normalized to 1 at maximum thrust.
+    assert!((limits().max_speed() - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn navigator_inertia_must_be_psd() {
+    let asym = Navigator {
+        mass: 1.0,
+        inertia: Matrix3::new(1.0, 0.5, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+    };
+    assert_eq!(
+        TeamConfig::<f64, 8>::new(&square_agents(), limits(), asym),
+        Err(ConfigError::NavigatorInertia)
+    );
+    let indefinite = Navigator {
+        mass: 1.0,
+        inertia: Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0)),
+    };
+    assert_eq!(
+        TeamConfig::<f64, 8>::new(&square_agents(), limits(), indefinite),
+        Err(ConfigError::NavigatorInertia)
+    );
+}
+
+#[test]
+fn rank_deficient_teams() {
+    // One agent produces only 3 wrench directions.
+    let e = build(&square_agents()[..1]).unwrap_err();
+    assert!(matches!(e, ConfigError::RankDeficient { .. }), "{e:?}");
+    assert_message(e, "rank 6");
+    // Two agents at the same point cannot make torque about the line through them.
+    let p = Vector3::new(0.3, 0.0, 0.0);
+    let e = build(&[AgentSpec::new(p, 0, 0.7), AgentSpec::new(p, 1, 0.7)]).unwrap_err();
+    assert!(matches!(e, ConfigError::RankDeficient { .. }), "{e:?}");
+    // Losing three of four agents leaves rank 3.
+    let team = build(&square_agents()).unwrap();
+    let mask = FailureMask::with_failed(&[0, 1, 2]).unwrap();
+    assert!(matches!(
+        team.validate_failures(&mask),
+        Err(ConfigError::RankDeficient { .. })
+    ));
+    // Losing one keeps rank 6.
+    assert_eq!(
+        team.validate_failures(&FailureMask::with_failed(&[1]).unwrap()),
+        Ok(())
+    );
+}
+
+#[test]
+fn afs_and_planner_parameters() {
+    assert_eq!(
+        AttainableForceSpace::new(3, 4, 0.5, 0.5, 10.0),
+        Err(ConfigError::AgentCount { n: 3, n_x: 4 })
+    );
+    assert_eq!(
+        AttainableForceSpace::new(0, 0, 0.5, 0.5, 10.0),
+        Err(ConfigError::NoAgents)
+    );
+    for s in [0.0, -0.5, 1.0 + 1e-12] {
+        assert_eq!(
+            Relaxation::new(s),
+            Err(ConfigError::Relaxation { value: s })
+        );
+    }
+    assert!(Relaxation::new(1.0).is_ok());
+    let planner = AttitudePlanner::new(Relaxation::new(0.5).unwrap());
+    assert_eq!(
+        planner.with_tolerance(0.0, 10),
+        Err(ConfigError::Parameter {
+            name: "planner.tolerance"
+        })
+    );
+    assert_eq!(
+        planner.with_tolerance(1e-6, 0),
+        Err(ConfigError::Parameter {
+            name: "planner.max_iterations"
+        })
+    );
+}
+
+#[test]
+fn failure_mask_indices() {
+    let e = FailureMask::<4>::with_failed(&[4]).unwrap_err();
+    assert_eq!(e, ConfigError::FailureIndex { agent: 4 });
+    assert_message(e, "agent 4");
+    // A mask slot beyond the team's agents (but within capacity) is rejected too.
+    let team = build(&square_agents()).unwrap();
+    assert_eq!(
+        team.validate_failures(&FailureMask::with_failed(&[6]).unwrap()),
+        Err(ConfigError::FailureIndex { agent: 6 })
+    );
+}

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Every test of the project, on a fresh machine with rustup, Python 3.11 and pip.
+# Installs what it needs itself (the thumbv7em target, a Python venv with numpy/pytest/maturin).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n==> %s\n' "$*"; }
+
+step "toolchain components"
+rustup component add rustfmt clippy >/dev/null 2>&1 || true
+rustup target add thumbv7em-none-eabihf
+
+step "cargo fmt --check"
+cargo fmt --all -- --check
+
+step "cargo clippy -D warnings"
+cargo clippy --workspace --all-targets -- -D warnings
+
+step "cargo test (workspace)"
+cargo test --workspace
+
+step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
+cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
+
+step "Python tests"
+python3 -m venv .venv
+.venv/bin/python -m pip install --quiet --upgrade pip
+.venv/bin/python -m pip install --quiet -r crates/tvmd-py/requirements-test.txt
+.venv/bin/python -m pytest -q crates/tvmd-py/tests
+
+step "all tests passed"
