@@ -31,7 +31,9 @@ extern crate std;
 /// The nalgebra version the API uses, re-exported so users match it.
 pub use nalgebra;
 
+pub mod admissible;
 pub mod afs;
+pub mod allocation;
 pub mod effectiveness;
 pub mod error;
 pub mod gimbal;

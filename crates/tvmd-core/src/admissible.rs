@@ -1,0 +1,144 @@
+//! The admissible control space `E_f` of one agent (eq. 6): gimbal limits on the exact map,
+//! the thrust range, and optional gimbal rate limits from the previous command.
+
+use nalgebra::Vector3;
+
+use crate::error::ConfigError;
+use crate::gimbal::GimbalCommand;
+use crate::real::Real;
+use crate::team::AgentLimits;
+
+/// A closed interval `[lo, hi]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval<T: Real> {
+    /// Lower end.
+    pub lo: T,
+    /// Upper end (`>= lo`).
+    pub hi: T,
+}
+
+impl<T: Real> Interval<T> {
+    /// `[-limit, limit]`.
+    pub fn symmetric(limit: T) -> Self {
+        Self {
+            lo: -limit,
+            hi: limit,
+        }
+    }
+
+    /// Whether `x` lies within the interval widened by `tol`.
+    pub fn contains(&self, x: T, tol: T) -> bool {
+        x >= self.lo - tol && x <= self.hi + tol
+    }
+
+    /// The nearest point of the interval.
+    pub fn clamp(&self, x: T) -> T {
+        x.max(self.lo).min(self.hi)
+    }
+
+    /// How far `x` lies outside, 0 inside.
+    pub fn excess(&self, x: T) -> T {
+        (self.lo - x).max(x - self.hi).max(T::zero())
+    }
+
+    /// Intersection with `[centre - radius, centre + radius]`; if they do not meet, the end of
+    /// `self` nearest to the window (so the result is never empty and stays inside `self`).
+    fn window(&self, centre: T, radius: T) -> Self {
+        let lo = self.clamp(centre - radius);
+        let hi = self.clamp(centre + radius);
+        Self { lo, hi: hi.max(lo) }
+    }
+}
+
+/// Gimbal rate limits (rad/s) of the rate-constrained allocation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateLimits<T: Real> {
+    /// Largest `|d eta_x / dt|`.
+    pub eta_x: T,
+    /// Largest `|d eta_y / dt|`.
+    pub eta_y: T,
+}
+
+impl<T: Real> RateLimits<T> {
+    /// Validated rate limits (positive, finite).
+    pub fn new(eta_x: T, eta_y: T) -> Result<Self, ConfigError> {
+        for value in [eta_x, eta_y] {
+            if !value.is_finite() || value <= T::zero() {
+                return Err(ConfigError::Parameter {
+                    name: "rate_limits",
+                });
+            }
+        }
+        Ok(Self { eta_x, eta_y })
+    }
+}
+
+/// One agent's admissible set: `eta_x in eta_x`, `eta_y in eta_y`, `T in thrust`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdmissibleSet<T: Real> {
+    /// Range of `eta_x` (rad).
+    pub eta_x: Interval<T>,
+    /// Range of `eta_y` (rad).
+    pub eta_y: Interval<T>,
+    /// Range of the thrust (N).
+    pub thrust: Interval<T>,
+}
+
+impl<T: Real> AdmissibleSet<T> {
+    /// `E_f` of eq. (6): `|eta_x| <= sigma_x`, `|eta_y| <= sigma_y`, `T in [T_idle, sigma_Tf]`.
+    pub fn from_limits(limits: &AgentLimits<T>) -> Self {
+        Self {
+            eta_x: Interval::symmetric(limits.sigma_x),
+            eta_y: Interval::symmetric(limits.sigma_y),
+            thrust: Interval {
+                lo: limits.min_thrust,
+                hi: limits.max_thrust,
+            },
+        }
+    }
+
+    /// Narrows the gimbal ranges to `|eta - eta_prev| <= rate * dt` (the rate-constrained variant).
+    pub fn with_rate_limit(
+        &self,
+        previous: &GimbalCommand<T>,
+        rates: &RateLimits<T>,
+        dt: T,
+    ) -> Self {
+        Self {
+            eta_x: self.eta_x.window(previous.eta_x, rates.eta_x * dt),
+            eta_y: self.eta_y.window(previous.eta_y, rates.eta_y * dt),
+            thrust: self.thrust,
+        }
+    }
+
+    /// Whether a command lies in the set, each bound widened by `tol` (relative to the thrust
+    /// range for the thrust).
+    pub fn contains(&self, cmd: &GimbalCommand<T>, tol: T) -> bool {
+        self.eta_x.contains(cmd.eta_x, tol)
+            && self.eta_y.contains(cmd.eta_y, tol)
+            && self.thrust.contains(cmd.thrust, tol * self.thrust.hi)
+    }
+
+    /// Normalized distance outside the set (0 inside): the largest of the angle excesses over
+    /// their range widths and the thrust excess over the thrust range.
+    pub fn violation(&self, cmd: &GimbalCommand<T>) -> T {
+        let width = |i: &Interval<T>| (i.hi - i.lo).max(T::default_epsilon());
+        (self.eta_x.excess(cmd.eta_x) / width(&self.eta_x))
+            .max(self.eta_y.excess(cmd.eta_y) / width(&self.eta_y))
+            .max(self.thrust.excess(cmd.thrust) / width(&self.thrust))
+    }
+
+    /// The command clamped into the set, axis by axis on the exact gimbal map.
+    pub fn clamp(&self, cmd: &GimbalCommand<T>) -> GimbalCommand<T> {
+        GimbalCommand {
+            thrust: self.thrust.clamp(cmd.thrust),
+            eta_x: self.eta_x.clamp(cmd.eta_x),
+            eta_y: self.eta_y.clamp(cmd.eta_y),
+        }
+    }
+
+    /// The agent-frame force `f` saturated into the set (through [`Self::clamp`]).
+    pub fn saturate(&self, force: &Vector3<T>) -> Vector3<T> {
+        self.clamp(&GimbalCommand::from_force(force)).force()
+    }
+}

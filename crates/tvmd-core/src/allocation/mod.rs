@@ -1,0 +1,160 @@
+//! Control allocation: inverting `u_d = M f` (eq. 4) into admissible agent forces.
+//!
+//! As in PX4's control_allocator, the effectiveness model ([`Effectiveness`], what the team can
+//! do) is separate from the algorithms that invert it; every algorithm implements [`Allocator`].
+//! Every allocator returns forces inside each agent's [`AdmissibleSet`], so the command inversion
+//! downstream never has to clamp more than round-off.
+
+mod pseudo_inverse;
+mod redistributed;
+
+pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
+pub use redistributed::RedistributedPseudoInverse;
+
+use nalgebra::{Cholesky, Matrix6, SymmetricEigen, Vector3, Vector6};
+
+use crate::admissible::AdmissibleSet;
+use crate::effectiveness::Effectiveness;
+use crate::real::{eps, lit, Real};
+
+/// What an allocator is asked to do.
+#[derive(Clone, Copy, Debug)]
+pub struct AllocationRequest<'a, T: Real, const N: usize> {
+    /// `M(Xi)` of the working agents.
+    pub effectiveness: &'a Effectiveness<T, N>,
+    /// Each agent's admissible set (ignored for failed agents).
+    pub sets: &'a [AdmissibleSet<T>; N],
+    /// `u_d = [u_tau; u_f]`, the desired wrench in the team frame.
+    pub wrench: Vector6<T>,
+}
+
+/// The result of one allocation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allocation<T: Real, const N: usize> {
+    /// Agent-frame forces `f_i`, each inside its admissible set; zero for failed agents.
+    pub forces: [Vector3<T>; N],
+    /// `u = M f`, the wrench the forces produce.
+    pub wrench: Vector6<T>,
+    /// `e_f = ||u_fd - u_f||`, the paper's allocation error (force part).
+    pub e_f: T,
+    /// `||u_d - M f||` over the whole wrench.
+    pub wrench_error: T,
+    /// Solve rounds used (pseudo-inverse: 1; redistribution: up to `n`).
+    pub rounds: u32,
+    /// Agents whose force was saturated onto the boundary of their admissible set.
+    pub saturated: [bool; N],
+    /// The allocator could not solve and fell back to another method (see its docs).
+    pub fallback: bool,
+}
+
+impl<T: Real, const N: usize> Allocation<T, N> {
+    /// Completes an allocation from admissible forces: wrench and errors.
+    pub fn from_forces(
+        request: &AllocationRequest<'_, T, N>,
+        forces: [Vector3<T>; N],
+        rounds: u32,
+        saturated: [bool; N],
+    ) -> Self {
+        let wrench = request.effectiveness.wrench(&forces);
+        let error = request.wrench - wrench;
+        Self {
+            forces,
+            wrench,
+            e_f: error.fixed_rows::<3>(3).norm(),
+            wrench_error: error.norm(),
+            rounds,
+            saturated,
+            fallback: false,
+        }
+    }
+
+    /// Number of saturated agents.
+    pub fn saturated_count(&self) -> usize {
+        self.saturated.iter().filter(|s| **s).count()
+    }
+}
+
+/// An allocation algorithm. `&mut self` lets an allocator keep warm-start data between periods.
+pub trait Allocator<T: Real, const N: usize> {
+    /// Allocates `request.wrench` over the working agents.
+    fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N>;
+
+    /// A short name for logs ("pseudo-inverse", ...).
+    fn name(&self) -> &'static str;
+}
+
+/// Minimum-norm solution of `A lambda = r` for the symmetric positive semi-definite 6x6 Gram
+/// matrix `A`: Cholesky when definite, else an eigen-decomposition pseudo-inverse (a degraded
+/// free set in the redistribution can lose rank).
+pub(crate) fn solve_gram<T: Real>(gram: &Matrix6<T>, rhs: &Vector6<T>) -> Vector6<T> {
+    if let Some(chol) = Cholesky::new(*gram) {
+        let lambda = chol.solve(rhs);
+        if lambda.iter().all(|x| x.is_finite()) {
+            return lambda;
+        }
+    }
+    match SymmetricEigen::try_new(*gram, eps(), 256) {
+        Some(eig) => {
+            let cutoff = eig.eigenvalues.amax() * eps::<T>() * lit(1e3);
+            let projected = eig.eigenvectors.transpose() * rhs;
+            let scaled =
+                projected.zip_map(
+                    &eig.eigenvalues,
+                    |p, e| {
+                        if e > cutoff {
+                            p / e
+                        } else {
+                            T::zero()
+                        }
+                    },
+                );
+            eig.eigenvectors * scaled
+        }
+        None => Vector6::zeros(),
+    }
+}
+
+/// The weighted pseudo-inverse over the agents selected by `free`:
+/// `f_i = w_i^-1 M_i^T (sum_j w_j^-1 M_j M_j^T)^-1 r`, `O(n)` in agents.
+pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
+    effectiveness: &Effectiveness<T, N>,
+    free: &[bool; N],
+    weights: Option<&[T; N]>,
+    rhs: &Vector6<T>,
+    out: &mut [Vector3<T>; N],
+) {
+    let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+    let mut gram = Matrix6::zeros();
+    for (i, (block, _)) in effectiveness
+        .blocks()
+        .iter()
+        .zip(free)
+        .enumerate()
+        .filter(|(_, (_, f))| **f)
+    {
+        if let Some(b) = block {
+            gram += b * b.transpose() / weight(i);
+        }
+    }
+    let lambda = solve_gram(&gram, rhs);
+    for (i, ((block, f), slot)) in effectiveness
+        .blocks()
+        .iter()
+        .zip(free)
+        .zip(out.iter_mut())
+        .enumerate()
+    {
+        if let (Some(b), true) = (block, *f) {
+            *slot = b.tr_mul(&lambda) / weight(i);
+        }
+    }
+}
+
+/// Working agents as a mask.
+pub(crate) fn working_mask<T: Real, const N: usize>(e: &Effectiveness<T, N>) -> [bool; N] {
+    let mut mask = [false; N];
+    for (m, b) in mask.iter_mut().zip(e.blocks()) {
+        *m = b.is_some();
+    }
+    mask
+}

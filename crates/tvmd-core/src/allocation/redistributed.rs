@@ -1,0 +1,78 @@
+//! Redistributed pseudo-inverse allocation (Jin 2005).
+
+use nalgebra::Vector3;
+
+use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
+use crate::gimbal::GimbalCommand;
+use crate::real::Real;
+
+/// The redistributed pseudo-inverse (Jin 2005; SPEC "Allocation"): solve the pseudo-inverse
+/// over the free agents; if some leave their admissible set, saturate the one that leaves it
+/// furthest (largest normalized excess, see [`crate::admissible::AdmissibleSet::violation`]),
+/// fix it, and redistribute the remaining wrench over the others. At most `n` rounds; agents
+/// still outside after the last round are clamped. Failed agents never take part.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RedistributedPseudoInverse;
+
+impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
+    fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
+        let e = request.effectiveness;
+        let mut free = working_mask(e);
+        let mut forces = [Vector3::zeros(); N];
+        let mut saturated = [false; N];
+        let mut rounds: u32 = 0;
+        let n = e.working_count();
+        while (rounds as usize) < n {
+            rounds += 1;
+            let mut fixed_wrench = request.wrench;
+            for ((block, f), is_free) in e.blocks().iter().zip(&forces).zip(&free) {
+                if let (Some(b), false) = (block, *is_free) {
+                    fixed_wrench -= b * f;
+                }
+            }
+            pseudo_inverse_forces(e, &free, None, &fixed_wrench, &mut forces);
+            let worst = forces
+                .iter()
+                .zip(request.sets)
+                .zip(&free)
+                .enumerate()
+                .filter(|(_, (_, is_free))| **is_free)
+                .map(|(i, ((f, set), _))| (i, set.violation(&GimbalCommand::from_force(f))))
+                .filter(|(_, v)| *v > T::zero())
+                .fold(None, |best: Option<(usize, T)>, (i, v)| match best {
+                    Some((_, bv)) if bv >= v => best,
+                    _ => Some((i, v)),
+                });
+            let Some((j, _)) = worst else {
+                return Allocation::from_forces(request, forces, rounds, saturated);
+            };
+            if let (Some(f), Some(set), Some(is_free), Some(sat)) = (
+                forces.get_mut(j),
+                request.sets.get(j),
+                free.get_mut(j),
+                saturated.get_mut(j),
+            ) {
+                *f = set.saturate(f);
+                *is_free = false;
+                *sat = true;
+            }
+        }
+        // Out of rounds (every agent fixed, or the last ones still outside): clamp the rest.
+        for (((f, set), is_free), sat) in forces
+            .iter_mut()
+            .zip(request.sets)
+            .zip(&free)
+            .zip(saturated.iter_mut())
+        {
+            if *is_free && set.violation(&GimbalCommand::from_force(f)) > T::zero() {
+                *f = set.saturate(f);
+                *sat = true;
+            }
+        }
+        Allocation::from_forces(request, forces, rounds, saturated)
+    }
+
+    fn name(&self) -> &'static str {
+        "redistributed-pseudo-inverse"
+    }
+}
