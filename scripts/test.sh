@@ -22,6 +22,10 @@ cargo test --workspace
 step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
 cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
 
+step "panic-free link check: f32 control cycle on thumbv7em with an undefined panic handler"
+# Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).
+cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf
+
 step "Python tests"
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip

@@ -2,9 +2,10 @@
 //!
 //! Stored as one 6x3 block per agent, never as a heap matrix, so every product is `O(n)`.
 
-use nalgebra::{Matrix3, Matrix6, Matrix6x3, SymmetricEigen, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 
 use crate::error::ConfigError;
+use crate::linalg::{max_diagonal, Ldlt};
 use crate::real::{eps, lit, to_f64, Real};
 use crate::team::{FailureMask, TeamConfig};
 
@@ -111,22 +112,20 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
     }
 
     /// Errors with [`ConfigError::RankDeficient`] unless `M` has rank 6, judged by the
-    /// eigenvalues of `M M^T` (smallest above `1e3 eps` times the largest).
+    /// `L D L^T` pivots of `M M^T`: the smallest must exceed `1e3 eps` times the largest
+    /// diagonal entry (the reported conditioning is that ratio).
     pub fn check_rank(&self) -> Result<(), ConfigError> {
-        let eig = SymmetricEigen::try_new(self.gram(), eps(), 256)
-            .ok_or(ConfigError::RankDeficient { conditioning: 0.0 })?
-            .eigenvalues;
-        let (min, max) = (eig.min(), eig.max());
-        if max > T::zero() && min > max * eps::<T>() * lit(1e3) {
+        let gram = self.gram();
+        let scale = max_diagonal(&gram);
+        let conditioning = Ldlt::new(&gram, T::zero())
+            .map(|f| f.pivots().iter().fold(scale, |m, d| m.min(*d)) / scale)
+            .filter(|c| c.is_finite())
+            .unwrap_or(T::zero());
+        if scale > T::zero() && conditioning > eps::<T>() * lit(1e3) {
             Ok(())
         } else {
-            let ratio = if max > T::zero() {
-                min / max
-            } else {
-                T::zero()
-            };
             Err(ConfigError::RankDeficient {
-                conditioning: to_f64(ratio).max(0.0),
+                conditioning: to_f64(conditioning).max(0.0),
             })
         }
     }

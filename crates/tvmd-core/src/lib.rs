@@ -10,7 +10,12 @@
 //! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8).
 //! 4. [`projection`]: the force projection `K_f` (eqs. 12-13).
 //! 5. [`planner`]: the bisection attitude planner (eqs. 9-11).
-//! 6. [`gimbal`]: thrust direction (eq. 1) and its inverse.
+//! 6. [`law`]: the geometric full-pose control law (eq. 12) and Lyapunov values.
+//! 7. [`allocation`]: allocators behind one [`Allocator`] trait, over [`admissible`] sets.
+//! 8. [`command`]: inversion to gimbal angles and rotor speeds inside `E_f` (eq. 6), via
+//!    [`gimbal`] (eq. 1).
+//!
+//! [`Controller`] composes them into one `step` per control period.
 //!
 //! `no_std`, no allocator, generic over [`Real`] (`f32` or `f64`), fixed capacity `N` agents.
 #![no_std]
@@ -34,18 +39,30 @@ pub use nalgebra;
 pub mod admissible;
 pub mod afs;
 pub mod allocation;
+pub mod command;
+pub mod controller;
 pub mod effectiveness;
 pub mod error;
 pub mod gimbal;
+pub mod law;
+mod linalg;
 pub mod planner;
 pub mod projection;
 pub mod real;
 pub mod team;
 
+pub use admissible::{AdmissibleSet, RateLimits};
 pub use afs::{AttainableForceSpace, Relaxation, SemiAxes};
+pub use allocation::{
+    Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
+    RedistributedPseudoInverse, WeightedPseudoInverse,
+};
+pub use command::AgentCommand;
+pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, InputError};
 pub use gimbal::GimbalCommand;
+pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 pub use projection::{project_force, ForceProjection};
 pub use real::Real;

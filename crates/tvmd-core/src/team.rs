@@ -1,7 +1,7 @@
 //! The team configuration `Xi` (paper, "Modeling"): agents, limits, navigator, and the derived
 //! team mass `m_C`, inertia `J_C`, `n_x` / `n_y` and the Con/Inc arrangement.
 
-use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::AttainableForceSpace;
 use crate::effectiveness::Effectiveness;
@@ -454,10 +454,26 @@ fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigErr
     if (j - j.transpose()).amax() > tol {
         return Err(ConfigError::NavigatorInertia);
     }
-    let min_eig = SymmetricEigen::try_new(j, eps(), 256)
-        .map(|e| e.eigenvalues.min())
-        .ok_or(ConfigError::NavigatorInertia)?;
-    if min_eig < -tol {
+    // Positive semi-definite iff every principal minor is >= 0 (3x3: Sylvester's criterion
+    // on all of them, not only the leading ones).
+    let minor2 = |a: usize, b: usize| {
+        let (x, y, z) = (
+            j.get((a, a)).copied().unwrap_or(T::zero()),
+            j.get((b, b)).copied().unwrap_or(T::zero()),
+            j.get((a, b)).copied().unwrap_or(T::zero()),
+        );
+        x * y - z * z
+    };
+    let minors = [
+        j.m11,
+        j.m22,
+        j.m33,
+        minor2(0, 1),
+        minor2(0, 2),
+        minor2(1, 2),
+        j.determinant(),
+    ];
+    if minors.iter().any(|m| *m < -tol * scale * scale) {
         return Err(ConfigError::NavigatorInertia);
     }
     Ok(())

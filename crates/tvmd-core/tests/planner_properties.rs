@@ -1,6 +1,8 @@
 //! Planner properties over random teams, attitudes and forces, and the paper's hover
 //! saturation law.
 
+use std::f64::consts::FRAC_PI_2;
+
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use proptest::prelude::*;
 use tvmd_core::planner::tilted_attitude;
@@ -102,17 +104,12 @@ fn team_strategy() -> impl Strategy<Value = TeamConfig<f64, 16>> {
         3usize..=10,
         0.2f64..1.5,
         any::<bool>(),
-        0.1f64..=1.5708,
-        0.1f64..=1.5708,
+        0.1f64..=FRAC_PI_2,
+        0.1f64..=FRAC_PI_2,
         2.0f64..30.0,
     )
         .prop_map(|(n, radius, inc, sx, sy, thrust)| {
-            let limits = AgentLimits::new(
-                sx.min(std::f64::consts::FRAC_PI_2),
-                sy.min(std::f64::consts::FRAC_PI_2),
-                thrust,
-            )
-            .unwrap();
+            let limits = AgentLimits::new(sx, sy, thrust).unwrap();
             presets::ring::<f64, 16>(n, radius, inc, limits).unwrap()
         })
 }

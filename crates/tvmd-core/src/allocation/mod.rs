@@ -5,17 +5,24 @@
 //! Every allocator returns forces inside each agent's [`AdmissibleSet`], so the command inversion
 //! downstream never has to clamp more than round-off.
 
+mod any;
+#[cfg(feature = "clarabel")]
+mod clarabel;
 mod pseudo_inverse;
 mod redistributed;
 
+pub use any::AnyAllocator;
+#[cfg(feature = "clarabel")]
+pub use clarabel::{ClarabelAllocator, ClarabelStatus, FallbackReason, SolveReport};
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
 pub use redistributed::RedistributedPseudoInverse;
 
-use nalgebra::{Cholesky, Matrix6, SymmetricEigen, Vector3, Vector6};
+use nalgebra::{Matrix6, Vector3, Vector6};
 
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
-use crate::real::{eps, lit, Real};
+use crate::linalg::solve_gram;
+use crate::real::Real;
 
 /// What an allocator is asked to do.
 #[derive(Clone, Copy, Debug)]
@@ -81,37 +88,6 @@ pub trait Allocator<T: Real, const N: usize> {
 
     /// A short name for logs ("pseudo-inverse", ...).
     fn name(&self) -> &'static str;
-}
-
-/// Minimum-norm solution of `A lambda = r` for the symmetric positive semi-definite 6x6 Gram
-/// matrix `A`: Cholesky when definite, else an eigen-decomposition pseudo-inverse (a degraded
-/// free set in the redistribution can lose rank).
-pub(crate) fn solve_gram<T: Real>(gram: &Matrix6<T>, rhs: &Vector6<T>) -> Vector6<T> {
-    if let Some(chol) = Cholesky::new(*gram) {
-        let lambda = chol.solve(rhs);
-        if lambda.iter().all(|x| x.is_finite()) {
-            return lambda;
-        }
-    }
-    match SymmetricEigen::try_new(*gram, eps(), 256) {
-        Some(eig) => {
-            let cutoff = eig.eigenvalues.amax() * eps::<T>() * lit(1e3);
-            let projected = eig.eigenvectors.transpose() * rhs;
-            let scaled =
-                projected.zip_map(
-                    &eig.eigenvalues,
-                    |p, e| {
-                        if e > cutoff {
-                            p / e
-                        } else {
-                            T::zero()
-                        }
-                    },
-                );
-            eig.eigenvectors * scaled
-        }
-        None => Vector6::zeros(),
-    }
 }
 
 /// The weighted pseudo-inverse over the agents selected by `free`:

@@ -1,0 +1,96 @@
+//! Small dense solvers for the 6x6 Gram matrices, written out so the control cycle has no
+//! panic path (nalgebra's decompositions keep bounds assertions that survive optimization; the
+//! thumbv7em link check in `embedded/cycle-check` proves this module has none).
+// Triangular solves read clearest with index loops over the fixed 6x6 arrays.
+#![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::real::{eps, lit, Real};
+
+/// `A = L D L^T` of a symmetric 6x6 matrix, without pivoting. `None` unless every pivot is
+/// above `tol` (so `A` is numerically positive definite).
+pub(crate) struct Ldlt<T: Real> {
+    l: [[T; 6]; 6],
+    d: [T; 6],
+}
+
+impl<T: Real> Ldlt<T> {
+    pub(crate) fn new(a: &Matrix6<T>, tol: T) -> Option<Self> {
+        let mut l = [[T::zero(); 6]; 6];
+        let mut d = [T::zero(); 6];
+        for j in 0..6 {
+            let mut dj = a[(j, j)];
+            for k in 0..j {
+                dj -= l[j][k] * l[j][k] * d[k];
+            }
+            // Written so NaN pivots fail too.
+            if dj.partial_cmp(&tol) != Some(core::cmp::Ordering::Greater) {
+                return None;
+            }
+            d[j] = dj;
+            l[j][j] = T::one();
+            for i in (j + 1)..6 {
+                let mut s = a[(i, j)];
+                for k in 0..j {
+                    s -= l[i][k] * l[j][k] * d[k];
+                }
+                l[i][j] = s / dj;
+            }
+        }
+        Some(Self { l, d })
+    }
+
+    /// The pivots `D`.
+    pub(crate) fn pivots(&self) -> &[T; 6] {
+        &self.d
+    }
+
+    pub(crate) fn solve(&self, b: &Vector6<T>) -> Vector6<T> {
+        let mut y = [T::zero(); 6];
+        for i in 0..6 {
+            let mut s = b[i];
+            for k in 0..i {
+                s -= self.l[i][k] * y[k];
+            }
+            y[i] = s;
+        }
+        for (yi, di) in y.iter_mut().zip(&self.d) {
+            *yi /= *di;
+        }
+        let mut x = Vector6::zeros();
+        for i in (0..6).rev() {
+            let mut s = y[i];
+            for k in (i + 1)..6 {
+                s -= self.l[k][i] * x[k];
+            }
+            x[i] = s;
+        }
+        x
+    }
+}
+
+/// Largest diagonal entry (the scale of a Gram matrix).
+pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
+    a.diagonal().iter().fold(T::zero(), |m, x| m.max(*x))
+}
+
+/// Solves `A lambda = r` for a symmetric positive semi-definite `A`: exactly when `A` is
+/// definite, else with Tikhonov damping `A + delta I`, `delta = sqrt(eps) max diag(A)`
+/// (damped least squares: a rank-deficient free set in the redistribution still gets the
+/// nearest wrench it can make). Zero when `A = 0` or the input is not finite.
+pub(crate) fn solve_gram<T: Real>(a: &Matrix6<T>, r: &Vector6<T>) -> Vector6<T> {
+    let scale = max_diagonal(a);
+    if scale <= T::zero() || !scale.is_finite() {
+        return Vector6::zeros();
+    }
+    let tol = scale * eps::<T>() * lit(1e3);
+    if let Some(f) = Ldlt::new(a, tol) {
+        return f.solve(r);
+    }
+    let damped = a + Matrix6::identity() * (scale * eps::<T>().sqrt());
+    match Ldlt::new(&damped, T::zero()) {
+        Some(f) => f.solve(r),
+        None => Vector6::zeros(),
+    }
+}
