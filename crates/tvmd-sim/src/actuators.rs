@@ -1,0 +1,393 @@
+//! Agent commands, thrust direction (eq. 1), actuator models and failures.
+//!
+//! Each agent has two gimbal angles `eta_x`, `eta_y` and a thrust `T`. Its force in the team
+//! (body) frame is `T R_z(m_i pi/2) a_hat(eta_x, eta_y)` with the exact quarter-turn matrix.
+//!
+//! Models (per agent, stepped at the physics rate):
+//! - ideal (default): the command passes through unchanged;
+//! - servo: each gimbal angle follows its command as a second-order system
+//!   `eta_dd = w_n^2 (eta_cmd - eta) - 2 zeta w_n eta_d` with `|eta_d| <= rate_limit`;
+//! - rotor lag: first order `T_d = (T_cmd - T) / tau`;
+//! - optional saturation of the *commands* to the gimbal and thrust limits.
+//!
+//! Failures take effect from a given time: the thrust drops to zero at once and/or the gimbal
+//! sticks at the angles it has at that moment.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::math::quarter_turn;
+
+/// Command (or actual state) of one agent.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AgentCommand {
+    /// Gimbal angle about the agent's x axis (rad).
+    pub eta_x: f64,
+    /// Gimbal angle about the agent's y axis (rad).
+    pub eta_y: f64,
+    /// Thrust magnitude (N).
+    pub thrust: f64,
+}
+
+impl AgentCommand {
+    /// True if every field is finite.
+    pub fn is_finite(&self) -> bool {
+        self.eta_x.is_finite() && self.eta_y.is_finite() && self.thrust.is_finite()
+    }
+}
+
+/// Thrust direction in the agent frame (eq. 1):
+/// `a_hat = [cos(eta_x) sin(eta_y), -sin(eta_x), cos(eta_x) cos(eta_y)]`.
+pub fn thrust_direction(eta_x: f64, eta_y: f64) -> Vector3<f64> {
+    let (sx, cx) = eta_x.sin_cos();
+    let (sy, cy) = eta_y.sin_cos();
+    Vector3::new(cx * sy, -sx, cx * cy)
+}
+
+/// The agent's force in the team (body) frame: `T R_z(m_i pi/2) a_hat(eta_x, eta_y)`.
+pub fn agent_force_body(cmd: &AgentCommand, quarter_turns: i32) -> Vector3<f64> {
+    quarter_turn(quarter_turns) * (cmd.thrust * thrust_direction(cmd.eta_x, cmd.eta_y))
+}
+
+/// Second-order, rate-limited gimbal servo.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ServoModel {
+    /// Natural frequency `w_n` (rad/s).
+    pub natural_frequency: f64,
+    /// Damping ratio `zeta`.
+    pub damping_ratio: f64,
+    /// Maximum gimbal rate (rad/s).
+    pub rate_limit: f64,
+}
+
+/// First-order rotor (thrust) lag.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorLag {
+    /// Time constant `tau` (s).
+    pub time_constant: f64,
+}
+
+/// Per-agent command limits used when saturation is enabled.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorLimits {
+    /// `|eta_x| <= sigma_x` (rad).
+    pub sigma_x: f64,
+    /// `|eta_y| <= sigma_y` (rad).
+    pub sigma_y: f64,
+    /// `0 <= T <= max_thrust` (N).
+    pub max_thrust: f64,
+}
+
+/// Actuator model of every agent. The default is ideal (commands pass through).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ActuatorModel {
+    /// Gimbal servo model; `None` = ideal gimbal.
+    pub servo: Option<ServoModel>,
+    /// Rotor lag; `None` = ideal thrust.
+    pub rotor_lag: Option<RotorLag>,
+    /// Saturate commands to these limits before the models; `None` = no saturation.
+    pub limits: Option<ActuatorLimits>,
+}
+
+impl ActuatorModel {
+    /// True if commands pass through unchanged.
+    pub fn is_ideal(&self) -> bool {
+        self.servo.is_none() && self.rotor_lag.is_none() && self.limits.is_none()
+    }
+}
+
+/// What fails in an agent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FailureKind {
+    /// The rotor stops: thrust zero from the failure time on.
+    NoThrust,
+    /// The gimbal sticks at its angles at the failure time; thrust keeps following commands.
+    StuckGimbal,
+    /// Both.
+    NoThrustStuckGimbal,
+}
+
+impl FailureKind {
+    /// True if the thrust is lost.
+    pub fn loses_thrust(self) -> bool {
+        matches!(self, Self::NoThrust | Self::NoThrustStuckGimbal)
+    }
+
+    /// True if the gimbal sticks.
+    pub fn sticks_gimbal(self) -> bool {
+        matches!(self, Self::StuckGimbal | Self::NoThrustStuckGimbal)
+    }
+}
+
+/// State of one agent's actuators.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AgentActuator {
+    /// Actual gimbal angles and thrust.
+    pub actual: AgentCommand,
+    /// Gimbal rates (rad/s) `[eta_x_dot, eta_y_dot]` (servo model only).
+    pub rates: [f64; 2],
+    /// The thrust is lost.
+    pub thrust_failed: bool,
+    /// The gimbal is stuck at `actual`'s angles.
+    pub gimbal_stuck: bool,
+}
+
+fn servo_axis(angle: &mut f64, rate: &mut f64, cmd: f64, m: &ServoModel, dt: f64) {
+    let wn = m.natural_frequency;
+    let acc = wn * wn * (cmd - *angle) - 2.0 * m.damping_ratio * wn * *rate;
+    // Semi-implicit Euler: the rate first (then limited), the angle with the new rate.
+    *rate = (*rate + dt * acc).clamp(-m.rate_limit, m.rate_limit);
+    *angle += dt * *rate;
+}
+
+impl AgentActuator {
+    /// Advances this agent's actuators by `dt` towards `cmd` and returns the actual output.
+    pub fn step(&mut self, cmd: &AgentCommand, model: &ActuatorModel, dt: f64) -> AgentCommand {
+        let mut c = *cmd;
+        if let Some(l) = &model.limits {
+            c.eta_x = c.eta_x.clamp(-l.sigma_x, l.sigma_x);
+            c.eta_y = c.eta_y.clamp(-l.sigma_y, l.sigma_y);
+            c.thrust = c.thrust.clamp(0.0, l.max_thrust);
+        }
+        if !self.gimbal_stuck {
+            match &model.servo {
+                None => {
+                    self.actual.eta_x = c.eta_x;
+                    self.actual.eta_y = c.eta_y;
+                }
+                Some(m) => {
+                    let [rx, ry] = &mut self.rates;
+                    servo_axis(&mut self.actual.eta_x, rx, c.eta_x, m, dt);
+                    servo_axis(&mut self.actual.eta_y, ry, c.eta_y, m, dt);
+                }
+            }
+        }
+        if self.thrust_failed {
+            self.actual.thrust = 0.0;
+        } else {
+            match &model.rotor_lag {
+                None => self.actual.thrust = c.thrust,
+                Some(l) => {
+                    // Exact discretisation of the first-order lag over dt.
+                    let a = (-dt / l.time_constant).exp();
+                    self.actual.thrust = a * self.actual.thrust + (1.0 - a) * c.thrust;
+                }
+            }
+        }
+        self.actual
+    }
+
+    /// Applies a failure now.
+    pub fn fail(&mut self, kind: FailureKind) {
+        if kind.loses_thrust() {
+            self.thrust_failed = true;
+            self.actual.thrust = 0.0;
+        }
+        if kind.sticks_gimbal() {
+            self.gimbal_stuck = true;
+            self.rates = [0.0; 2];
+        }
+    }
+
+    /// True if any failure is active.
+    pub fn failed(&self) -> bool {
+        self.thrust_failed || self.gimbal_stuck
+    }
+}
+
+/// The actuators of all agents.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActuatorBank {
+    /// The model shared by all agents.
+    pub model: ActuatorModel,
+    /// Per-agent state.
+    pub agents: Vec<AgentActuator>,
+}
+
+impl ActuatorBank {
+    /// `n` agents at rest (zero angles, zero thrust).
+    pub fn new(model: ActuatorModel, n: usize) -> Self {
+        Self {
+            model,
+            agents: vec![AgentActuator::default(); n],
+        }
+    }
+
+    /// Advances all agents by `dt`; `commands.len()` must equal the number of agents
+    /// (extra commands are ignored, missing ones count as zero).
+    pub fn step(&mut self, commands: &[AgentCommand], dt: f64) -> Vec<AgentCommand> {
+        self.agents
+            .iter_mut()
+            .enumerate()
+            .map(|(i, a)| {
+                let c = commands.get(i).copied().unwrap_or_default();
+                a.step(&c, &self.model, dt)
+            })
+            .collect()
+    }
+
+    /// Actual outputs of all agents.
+    pub fn actual(&self) -> Vec<AgentCommand> {
+        self.agents.iter().map(|a| a.actual).collect()
+    }
+
+    /// Applies a failure to agent `i` (ignored if out of range).
+    pub fn fail(&mut self, i: usize, kind: FailureKind) {
+        if let Some(a) = self.agents.get_mut(i) {
+            a.fail(kind);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn direction_is_unit_and_matches_eq1() {
+        let d = thrust_direction(0.3, -0.7);
+        assert!((d.norm() - 1.0).abs() < 1e-15);
+        assert!(
+            (d - Vector3::new(
+                0.3f64.cos() * (-0.7f64).sin(),
+                -(0.3f64.sin()),
+                0.3f64.cos() * 0.7f64.cos()
+            ))
+            .norm()
+                < 1e-15
+        );
+        assert_eq!(thrust_direction(0.0, 0.0), Vector3::z());
+    }
+
+    #[test]
+    fn quarter_turn_rotates_the_force() {
+        let c = AgentCommand {
+            eta_x: 0.0,
+            eta_y: FRAC_PI_2,
+            thrust: 2.0,
+        };
+        // a_hat = +x in the agent frame; one quarter turn maps it to +y.
+        let f = agent_force_body(&c, 1);
+        assert!((f - Vector3::new(0.0, 2.0, 0.0)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn servo_converges_and_respects_rate_limit() {
+        let model = ActuatorModel {
+            servo: Some(ServoModel {
+                natural_frequency: 30.0,
+                damping_ratio: 0.8,
+                rate_limit: 2.0,
+            }),
+            ..Default::default()
+        };
+        let mut a = AgentActuator::default();
+        let cmd = AgentCommand {
+            eta_x: 0.5,
+            eta_y: -0.2,
+            thrust: 5.0,
+        };
+        let mut prev = a.actual;
+        for _ in 0..2000 {
+            let out = a.step(&cmd, &model, 1e-3);
+            assert!((out.eta_x - prev.eta_x).abs() <= 2.0 * 1e-3 + 1e-15);
+            prev = out;
+        }
+        assert!((a.actual.eta_x - 0.5).abs() < 1e-6 && (a.actual.eta_y + 0.2).abs() < 1e-6);
+        assert_eq!(a.actual.thrust, 5.0);
+    }
+
+    #[test]
+    fn rotor_lag_is_first_order() {
+        let model = ActuatorModel {
+            rotor_lag: Some(RotorLag {
+                time_constant: 0.05,
+            }),
+            ..Default::default()
+        };
+        let mut a = AgentActuator::default();
+        let cmd = AgentCommand {
+            thrust: 10.0,
+            ..Default::default()
+        };
+        for _ in 0..50 {
+            a.step(&cmd, &model, 1e-3);
+        }
+        // After one time constant: 1 - 1/e of the step.
+        assert!((a.actual.thrust - 10.0 * (1.0 - (-1.0f64).exp())).abs() < 1e-9);
+    }
+
+    #[test]
+    fn failures_stop_thrust_and_freeze_gimbal() {
+        let model = ActuatorModel::default();
+        let mut bank = ActuatorBank::new(model, 2);
+        let cmd = [AgentCommand {
+            eta_x: 0.1,
+            eta_y: 0.2,
+            thrust: 3.0,
+        }; 2];
+        bank.step(&cmd, 1e-3);
+        bank.fail(0, FailureKind::NoThrust);
+        bank.fail(1, FailureKind::StuckGimbal);
+        let out = bank.step(
+            &[AgentCommand {
+                eta_x: -0.3,
+                eta_y: 0.0,
+                thrust: 4.0,
+            }; 2],
+            1e-3,
+        );
+        assert_eq!(
+            out[0],
+            AgentCommand {
+                eta_x: -0.3,
+                eta_y: 0.0,
+                thrust: 0.0
+            }
+        );
+        assert_eq!(
+            out[1],
+            AgentCommand {
+                eta_x: 0.1,
+                eta_y: 0.2,
+                thrust: 4.0
+            }
+        );
+    }
+
+    #[test]
+    fn limits_saturate_commands() {
+        let model = ActuatorModel {
+            limits: Some(ActuatorLimits {
+                sigma_x: 0.5,
+                sigma_y: 0.6,
+                max_thrust: 10.0,
+            }),
+            ..Default::default()
+        };
+        let mut a = AgentActuator::default();
+        let out = a.step(
+            &AgentCommand {
+                eta_x: 1.0,
+                eta_y: -1.0,
+                thrust: 20.0,
+            },
+            &model,
+            1e-3,
+        );
+        assert_eq!(
+            out,
+            AgentCommand {
+                eta_x: 0.5,
+                eta_y: -0.6,
+                thrust: 10.0
+            }
+        );
+    }
+}

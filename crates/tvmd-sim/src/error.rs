@@ -1,0 +1,72 @@
+//! Error type of the simulator.
+
+/// Boxed error returned by a [`crate::sim::FlightController`].
+pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// Errors of the simulator.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The team description is not usable (for example its centre of mass is not at the origin).
+    #[error("invalid team: {0}")]
+    InvalidTeam(String),
+    /// A scenario field holds a value that parses but is not acceptable.
+    #[error("invalid scenario field `{field}`: {reason}")]
+    InvalidScenario {
+        /// Dotted path of the offending field (e.g. `failures[0].agent`).
+        field: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A scenario file could not be parsed; the message names the offending key.
+    #[error("cannot parse scenario{}: {message}", .path.as_ref().map(|p| format!(" `{p}`")).unwrap_or_default())]
+    ScenarioParse {
+        /// File the scenario was read from, if any.
+        path: Option<String>,
+        /// The parser's message (it names the field and shows the offending line).
+        message: String,
+    },
+    /// No built-in scenario has this name.
+    #[error("unknown built-in scenario `{name}` (known: {known})")]
+    UnknownScenario {
+        /// The requested name.
+        name: String,
+        /// Comma-separated list of the known names.
+        known: String,
+    },
+    /// The controller returned an error.
+    #[error("controller failed at t = {t:.3} s: {source}")]
+    Controller {
+        /// Simulation time of the failing call.
+        t: f64,
+        /// The controller's error.
+        source: BoxedError,
+    },
+    /// The controller returned commands that cannot be applied.
+    #[error("invalid controller output at t = {t:.3} s: {reason}")]
+    InvalidCommand {
+        /// Simulation time of the call.
+        t: f64,
+        /// What is wrong with the output.
+        reason: String,
+    },
+    /// The simulated state became non-finite.
+    #[error("simulation diverged at t = {t:.3} s: {what}")]
+    Diverged {
+        /// Simulation time.
+        t: f64,
+        /// Which quantity became non-finite.
+        what: String,
+    },
+    /// An I/O error (reading a scenario, writing a log).
+    #[error("I/O error: {0}")]
+    Io(#[from] std::io::Error),
+    /// An MCAP error while writing a log.
+    #[error("MCAP error: {0}")]
+    Mcap(#[from] mcap::McapError),
+    /// A JSON serialization error while writing a log.
+    #[error("JSON error: {0}")]
+    Json(#[from] serde_json::Error),
+    /// The log was already finished.
+    #[error("the MCAP log is already finished")]
+    LogFinished,
+}

@@ -1,0 +1,40 @@
+//! Rigid-body simulator for thrust-vectoring modular team UAVs (TVMD).
+//!
+//! The team is simulated as **one** rapier3d-f64 rigid body built from colliders: every agent
+//! is a small ball collider at its position `p_i` carrying the agent's mass as a point mass,
+//! and the navigator module is a ball at the centre carrying `m_0` and `J_0`. The body's mass
+//! and inertia therefore equal the model's `m_C = m_0 + sum m_i` and
+//! `J_C = J_0 - sum m_i [p_i]x [p_i]x` (see [`physics::TeamBody`]). A fixed ground cuboid with
+//! contact lets runs start on the ground and land.
+//!
+//! Modules:
+//! - [`physics`]: team body, rapier world, state access ([`physics::PhysicsWorld`]).
+//! - [`rk4`]: an independent RK4 integration of the paper's dynamics (eqs. 2-3), used as a
+//!   check on rapier.
+//! - [`actuators`]: agent commands, thrust direction (eq. 1), servo / rotor-lag models and
+//!   failures.
+//! - [`mod@reference`]: the paper's reference trajectory (stages A/B/C) and a hover reference.
+//! - [`scenario`]: TOML scenarios (serde) and the built-in scenarios.
+//! - [`log`]: MCAP logs (JSON messages, Foxglove `FrameTransform` / `SceneUpdate`).
+//! - [`sim`]: the digital control loop; controllers plug in through
+//!   [`sim::FlightController`].
+//!
+//! Conventions: SI units, z up, gravity `g = 9.81 m/s^2` along `-z`; body-frame twist
+//! `xi = [Omega; v]` with `x_dot = R v`.
+
+#![warn(missing_docs)]
+
+pub mod actuators;
+mod error;
+pub mod log;
+pub mod math;
+pub mod physics;
+pub mod reference;
+pub mod rk4;
+pub mod scenario;
+pub mod sim;
+
+pub use error::{BoxedError, SimError};
+
+/// Standard gravity used throughout the simulator (m/s^2).
+pub const GRAVITY: f64 = 9.81;

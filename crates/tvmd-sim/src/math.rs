@@ -1,0 +1,91 @@
+//! Small math helpers shared by the simulator (nalgebra types).
+
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+
+/// The skew-symmetric cross-product matrix `[v]x`, such that `[v]x w = v x w`.
+pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// The exact rotation `R_z(m pi/2)` about the body z axis by `m` quarter turns.
+///
+/// Entries are exactly 0 or +-1 (no trigonometric round-off); `m` may be any integer
+/// (it is reduced modulo 4, negative values included).
+pub fn quarter_turn(m: i32) -> Matrix3<f64> {
+    match m.rem_euclid(4) {
+        0 => Matrix3::identity(),
+        1 => Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+        2 => Matrix3::new(-1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0),
+        _ => Matrix3::new(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+    }
+}
+
+/// Rotation about the world x axis by `angle` (roll).
+pub fn rot_x(angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+
+/// Roll, pitch and yaw (ZYX convention, `R = R_z(yaw) R_y(pitch) R_x(roll)`) of a rotation matrix.
+pub fn roll_pitch_yaw(r: &Matrix3<f64>) -> [f64; 3] {
+    let (roll, pitch, yaw) = Rotation3::from_matrix_unchecked(*r).euler_angles();
+    [roll, pitch, yaw]
+}
+
+/// Unit quaternion of a rotation matrix (the matrix is re-orthonormalised first).
+pub fn quaternion_of(r: &Matrix3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_matrix(r)
+}
+
+/// Converts a nalgebra matrix to a row-major array.
+pub fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [
+        [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
+        [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
+        [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
+    ]
+}
+
+/// Converts a row-major array to a nalgebra matrix.
+pub fn from_rows(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::new(
+        rows[0][0], rows[0][1], rows[0][2], rows[1][0], rows[1][1], rows[1][2], rows[2][0],
+        rows[2][1], rows[2][2],
+    )
+}
+
+/// Angle of the rotation `R_a^T R_b` (geodesic distance on SO(3)), in radians.
+pub fn rotation_distance(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+    let c = ((a.transpose() * b).trace() - 1.0) / 2.0;
+    c.clamp(-1.0, 1.0).acos()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quarter_turns_match_trigonometry() {
+        for m in -5..=5 {
+            let a = m as f64 * std::f64::consts::FRAC_PI_2;
+            let r = Rotation3::from_axis_angle(&Vector3::z_axis(), a);
+            assert!(
+                (quarter_turn(m) - r.matrix()).abs().max() < 1e-15,
+                "m = {m}"
+            );
+        }
+    }
+
+    #[test]
+    fn skew_is_cross_product() {
+        let v = Vector3::new(0.3, -1.2, 2.0);
+        let w = Vector3::new(-0.7, 0.4, 1.1);
+        assert!((skew(&v) * w - v.cross(&w)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn roll_pitch_yaw_of_roll() {
+        let rpy = roll_pitch_yaw(&rot_x(0.4));
+        assert!((rpy[0] - 0.4).abs() < 1e-12 && rpy[1].abs() < 1e-12 && rpy[2].abs() < 1e-12);
+    }
+}
