@@ -103,52 +103,95 @@ impl<T: Real> AttainableForceSpace<T> {
         count::<T>(self.n) * self.max_thrust
     }
 
-    /// `g(n_k, sigma, z)` of eq. (8); the flag tells whether the `sigma >= pi/2` branch was used.
-    fn g(&self, n_k: usize, sigma: T, z: T) -> (T, bool) {
+    /// `g(n_k, sigma, z) = offset + slope |z|` of eq. (8): `n_k sigma_Tf` (offset) if
+    /// `sigma >= pi/2`, else `(n_k/n)(1 - delta(n_k)) tan(sigma)` (slope). The flag tells whether
+    /// the `sigma >= pi/2` branch contributed.
+    fn g(&self, n_k: usize, sigma: T) -> (T, T, bool) {
         if sigma >= T::frac_pi_2() {
-            (count::<T>(n_k) * self.max_thrust, n_k > 0)
+            (count::<T>(n_k) * self.max_thrust, T::zero(), n_k > 0)
         } else if n_k == 0 {
             // (1 - delta(n_k)) vanishes.
-            (T::zero(), false)
+            (T::zero(), T::zero(), false)
         } else {
             (
-                count::<T>(n_k) / count::<T>(self.n) * z.abs() * sigma.tan(),
+                T::zero(),
+                count::<T>(n_k) / count::<T>(self.n) * sigma.tan(),
                 false,
             )
         }
     }
 
-    /// `c_x(z, s) = g(n_x, s sigma_y, z) + g(n_y, s sigma_x, z)` and
-    /// `c_y(z, s) = g(n_x, s sigma_x, z) + g(n_y, s sigma_y, z)` (eq. 8).
-    pub fn semi_axes(&self, z: T, s: Relaxation<T>) -> SemiAxes<T> {
+    /// The cone of eq. (8) for relaxation `s`: `c_x(z, s) = g(n_x, s sigma_y, z) + g(n_y, s sigma_x, z)`,
+    /// `c_y(z, s) = g(n_x, s sigma_x, z) + g(n_y, s sigma_y, z)`, with the `tan` terms evaluated
+    /// once (the planner tests many `z` at one `s`).
+    pub fn cone(&self, s: Relaxation<T>) -> EllipticCone<T> {
         let n_y = self.n - self.n_x;
         let (sx, sy) = (s.get() * self.sigma_x, s.get() * self.sigma_y);
-        let (a, ua) = self.g(self.n_x, sy, z);
-        let (b, ub) = self.g(n_y, sx, z);
-        let (c, uc) = self.g(self.n_x, sx, z);
-        let (d, ud) = self.g(n_y, sy, z);
-        SemiAxes {
-            c_x: a + b,
-            c_y: c + d,
-            unbounded_branch: ua || ub || uc || ud,
+        let (ax, bx, ux) = self.g(self.n_x, sy);
+        let (ay, by, uy) = self.g(n_y, sx);
+        let (cx, dx, vx) = self.g(self.n_x, sx);
+        let (cy, dy, vy) = self.g(n_y, sy);
+        EllipticCone {
+            offset_x: ax + ay,
+            slope_x: bx + by,
+            offset_y: cx + cy,
+            slope_y: dx + dy,
+            unbounded_branch: ux || uy || vx || vy,
+            max_force: self.max_force(),
         }
+    }
+
+    /// `c_x(z, s)`, `c_y(z, s)` of eq. (8).
+    pub fn semi_axes(&self, z: T, s: Relaxation<T>) -> SemiAxes<T> {
+        self.cone(s).semi_axes(z)
     }
 
     /// `u^T C(u_z) u = (u_x / c_x)^2 + (u_y / c_y)^2` (eq. 7). A zero semi-axis contributes 0 if
     /// its component is 0 and `+inf` otherwise.
     pub fn quadratic_form(&self, u: &Vector3<T>, s: Relaxation<T>) -> T {
-        let axes = self.semi_axes(u.z, s);
-        ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y)
+        self.cone(s).quadratic_form(u)
     }
 
     /// Membership in the approximated AFS (eq. 7, with the readings documented on the type).
     pub fn contains(&self, u: &Vector3<T>, s: Relaxation<T>) -> bool {
-        if !u.iter().all(|x| x.is_finite()) || u.norm() > self.max_force() {
-            return false;
+        self.cone(s).contains(u)
+    }
+}
+
+/// The AFS at one relaxation: semi-axes affine in `|z|` (eq. 8) and the thrust bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EllipticCone<T: Real> {
+    offset_x: T,
+    slope_x: T,
+    offset_y: T,
+    slope_y: T,
+    unbounded_branch: bool,
+    max_force: T,
+}
+
+impl<T: Real> EllipticCone<T> {
+    /// `c_x(z)`, `c_y(z)`.
+    pub fn semi_axes(&self, z: T) -> SemiAxes<T> {
+        SemiAxes {
+            c_x: self.offset_x + self.slope_x * z.abs(),
+            c_y: self.offset_y + self.slope_y * z.abs(),
+            unbounded_branch: self.unbounded_branch,
         }
-        let axes = self.semi_axes(u.z, s);
-        (u.z > T::zero() || axes.unbounded_branch)
-            && ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y) <= T::one()
+    }
+
+    /// `u^T C(u_z) u` (eq. 7).
+    pub fn quadratic_form(&self, u: &Vector3<T>) -> T {
+        let axes = self.semi_axes(u.z);
+        ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y)
+    }
+
+    /// Membership: `||u|| <= n sigma_Tf`, `u^T C u <= 1`, and `z > 0` unless a semi-axis comes
+    /// from the `sigma >= pi/2` branch.
+    pub fn contains(&self, u: &Vector3<T>) -> bool {
+        u.iter().all(|x| x.is_finite())
+            && u.norm() <= self.max_force
+            && (u.z > T::zero() || self.unbounded_branch)
+            && self.quadratic_form(u) <= T::one()
     }
 }
 

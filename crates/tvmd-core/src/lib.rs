@@ -52,7 +52,7 @@ pub mod real;
 pub mod team;
 
 pub use admissible::{AdmissibleSet, RateLimits};
-pub use afs::{AttainableForceSpace, Relaxation, SemiAxes};
+pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,

@@ -109,7 +109,8 @@ impl<T: Real> AttitudePlanner<T> {
             iterations: 0,
             status,
         };
-        let feasible = |r: &Matrix3<T>| afs.contains(&(r.transpose() * f_r), self.relaxation);
+        let cone = afs.cone(self.relaxation);
+        let feasible = |r: &Matrix3<T>| cone.contains(&(r.transpose() * f_r));
         let norm = f_r.norm();
         if norm == T::zero() {
             return Ok(unchanged(PlannerStatus::ZeroForce));
