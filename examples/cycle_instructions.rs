@@ -13,8 +13,10 @@ use tvmd::core::{
 };
 
 type Cycle<T> = Controller<T, 4, RedistributedPseudoInverse>;
+/// A controller with its inputs.
+type Setup<T> = (Cycle<T>, RigidState<T>, Reference<T>);
 
-fn setup<T: Real>() -> Result<(Cycle<T>, RigidState<T>, Reference<T>), tvmd::core::ConfigError> {
+fn setup<T: Real>() -> Result<Setup<T>, tvmd::core::ConfigError> {
     let lit = |x: f64| -> T { tvmd::core::nalgebra::convert(x) };
     let controller = Controller::new(
         presets::a4_inc::<T, 4>()?,
