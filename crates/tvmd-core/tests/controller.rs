@@ -324,3 +324,60 @@ fn redistribution_reduces_the_wrench_error_on_average() {
     assert!(sum_rpi < sum_pi);
     assert!(wins * 2 > saturated);
 }
+
+/// Seeded sweep over random teams (A3..A10 rings, Con and Inc), states and references:
+/// asserts the cycle's invariants and prints the measured ranges (quoted in the docs).
+#[test]
+fn cycle_ranges_over_random_inputs() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+    let config = Config {
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let mut runner =
+        TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &[11; 32]));
+    let strategy = (
+        3usize..=10,
+        any::<bool>(),
+        prop::array::uniform3(-2.0f64..2.0),
+        prop::array::uniform3(-1.0f64..1.0),
+        prop::array::uniform3(-2.0f64..2.0),
+        prop::array::uniform3(-1.2f64..1.2),
+    );
+    let (mut max_e_f_rel, mut max_eta_x, mut max_eta_y, mut min_t, mut max_t_rel) =
+        (0.0f64, 0.0f64, 0.0f64, f64::MAX, 0.0f64);
+    let mut saturated_cycles = 0;
+    let cases = 3000;
+    for _ in 0..cases {
+        let (n, inc, dx, euler, omega, euler_r) = strategy.new_tree(&mut runner).unwrap().current();
+        let team = random_request_team(n, inc, 0.5);
+        let mut c = controller(team, rpi());
+        let mut state = RigidState::at_rest(Vector3::from(dx));
+        state.attitude = *Rotation3::from_euler_angles(euler[0], euler[1], euler[2]).matrix();
+        state.angular_velocity = Vector3::from(omega);
+        let mut reference = Reference::hover(Vector3::zeros());
+        reference.attitude =
+            *Rotation3::from_euler_angles(euler_r[0], euler_r[1], euler_r[2]).matrix();
+        let out = c.step(&state, &reference).unwrap();
+        let limits = team.limits();
+        let weight = team.mass() * 9.81;
+        max_e_f_rel = max_e_f_rel.max(out.allocation.e_f / weight);
+        saturated_cycles += usize::from(out.allocation.saturated_count() > 0);
+        for cmd in &out.commands[..n] {
+            assert!(cmd.eta_x.abs() <= limits.sigma_x && cmd.eta_y.abs() <= limits.sigma_y);
+            assert!(cmd.thrust >= 0.0 && cmd.thrust <= limits.max_thrust);
+            max_eta_x = max_eta_x.max(cmd.eta_x.abs() / limits.sigma_x);
+            max_eta_y = max_eta_y.max(cmd.eta_y.abs() / limits.sigma_y);
+            min_t = min_t.min(cmd.thrust);
+            max_t_rel = max_t_rel.max(cmd.thrust / limits.max_thrust);
+        }
+    }
+    println!(
+        "{cases} random cycles: max e_f/(m_C g) = {max_e_f_rel:.3e}, saturated in {saturated_cycles}; \
+         max |eta_x|/sigma_x = {max_eta_x:.4}, max |eta_y|/sigma_y = {max_eta_y:.4}, \
+         thrust in [{min_t:.4}, {:.4} sigma_Tf]",
+        max_t_rel
+    );
+    assert!(max_eta_x <= 1.0 && max_eta_y <= 1.0 && max_t_rel <= 1.0);
+}
