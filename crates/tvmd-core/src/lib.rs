@@ -57,6 +57,8 @@ pub use allocation::{
     Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
+#[cfg(feature = "clarabel")]
+pub use allocation::ClarabelAllocator;
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;
