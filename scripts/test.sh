@@ -13,11 +13,18 @@ rustup target add thumbv7em-none-eabihf
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
-step "cargo clippy -D warnings"
+step "cargo clippy -D warnings (default features, then with clarabel)"
 cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy -p tvmd-core -p tvmd --all-targets --features tvmd-core/clarabel,tvmd/clarabel -- -D warnings
 
 step "cargo test (workspace)"
 cargo test --workspace
+
+step "cargo test --features clarabel (core with the constrained allocator)"
+cargo test -p tvmd-core --features clarabel
+
+step "benchmarks compile (cargo bench --no-run)"
+cargo bench --workspace --no-run
 
 step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
 cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
