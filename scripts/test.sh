@@ -6,6 +6,9 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s\n' "$*"; }
 
+# tvmd-py is a Python extension: never link it against libpython in plain cargo builds.
+export PYO3_BUILD_EXTENSION_MODULE=1
+
 step "toolchain components"
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 rustup target add thumbv7em-none-eabihf
@@ -33,10 +36,13 @@ step "panic-free link check: f32 control cycle on thumbv7em with an undefined pa
 # Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).
 cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf
 
-step "Python tests"
+step "Python wheel (maturin, abi3) and pytest"
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet -r crates/tvmd-py/requirements-test.txt
+rm -rf target/wheels
+.venv/bin/maturin build --release -m crates/tvmd-py/Cargo.toml -o target/wheels
+.venv/bin/python -m pip install --quiet --force-reinstall --no-deps target/wheels/tvmd-*.whl
 .venv/bin/python -m pytest -q crates/tvmd-py/tests
 
 step "all tests passed"

@@ -11,9 +11,7 @@ else in the ``shared`` directory beside the repository checkout.
 
 from __future__ import annotations
 
-import json
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -23,30 +21,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import reference_impl as ri  # noqa: E402
-
-RTOL = 1e-9  # relative tolerance of the vectors (README of the vectors)
-ATOL = 1e-12  # absolute floor for entries that are 0 up to round-off (e.g. -8e-17 in M)
-PLANNER_TOL = 1e-6  # bisection: theta in rad, R_d entries
-
-
-def _shared_dir() -> Path:
-    env = os.environ.get("TVMD_SHARED")
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[3].parent / "shared"
-
-
-VECTORS_PATH = _shared_dir() / "reference" / "core_vectors.json"
-VECTORS = json.loads(VECTORS_PATH.read_text()) if VECTORS_PATH.is_file() else None
-
-needs_vectors = pytest.mark.skipif(VECTORS is None, reason=f"test vectors not found at {VECTORS_PATH}")
-
-
-def _cases(key):
-    """Parameters (one per case) of a vector family; a single skipped one without vectors."""
-    if VECTORS is None:
-        return [pytest.param(None, id=key, marks=pytest.mark.skip(reason=f"no test vectors at {VECTORS_PATH}"))]
-    return [pytest.param(c, id=f"{key}-{i}") for i, c in enumerate(VECTORS[key])]
+from vectors import ATOL, PLANNER_TOL, RTOL, VECTORS  # noqa: E402,F401
+from vectors import cases as _cases  # noqa: E402
+from vectors import needs_vectors  # noqa: E402
 
 
 def _close(actual, expected, rtol=RTOL, atol=ATOL):
