@@ -188,10 +188,28 @@ impl<T: Real> EllipticCone<T> {
     /// Membership: `||u|| <= n sigma_Tf`, `u^T C u <= 1`, and `z > 0` unless a semi-axis comes
     /// from the `sigma >= pi/2` branch.
     pub fn contains(&self, u: &Vector3<T>) -> bool {
-        u.iter().all(|x| x.is_finite())
-            && u.norm() <= self.max_force
-            && (u.z > T::zero() || self.unbounded_branch)
-            && self.quadratic_form(u) <= T::one()
+        u.iter().all(|x| x.is_finite()) && u.norm() <= self.max_force && self.admits(u)
+    }
+
+    /// Membership without the thrust bound (the planner checks `||u||` once per plan, as it is
+    /// invariant under rotation). Division-free: `x^2 c_y^2 + y^2 c_x^2 <= c_x^2 c_y^2`, with
+    /// the zero-semi-axis rule of [`Self::quadratic_form`].
+    pub fn admits(&self, u: &Vector3<T>) -> bool {
+        if !(u.z > T::zero() || self.unbounded_branch) {
+            return false;
+        }
+        let axes = self.semi_axes(u.z);
+        let (x2, y2) = (u.x * u.x, u.y * u.y);
+        let (cx2, cy2) = (axes.c_x * axes.c_x, axes.c_y * axes.c_y);
+        if cx2 == T::zero() || cy2 == T::zero() {
+            return self.quadratic_form(u) <= T::one();
+        }
+        x2 * cy2 + y2 * cx2 <= cx2 * cy2
+    }
+
+    /// `n sigma_Tf`.
+    pub fn max_force(&self) -> T {
+        self.max_force
     }
 }
 

@@ -4,14 +4,14 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::admissible::{AdmissibleSet, RateLimits};
-use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::allocation::{Allocation, AllocationRequest, Allocator};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, InputError};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
-use crate::projection::{project_force, ForceProjection};
+use crate::projection::{project_force_in, ForceProjection};
 use crate::real::{lit, Real};
 use crate::team::{FailureMask, TeamConfig};
 
@@ -116,6 +116,9 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     allocator: A,
     failures: FailureMask<N>,
     afs: AttainableForceSpace<T>,
+    /// `afs` at `s = 1` (projection) and at the planner's `s`, kept between periods.
+    full_cone: EllipticCone<T>,
+    planner_cone: EllipticCone<T>,
     effectiveness: Effectiveness<T, N>,
     admissible: AdmissibleSet<T>,
     previous: [AgentCommand<T>; N],
@@ -130,14 +133,17 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     ) -> Result<Self, ConfigError> {
         settings.validate()?;
         let failures = FailureMask::none();
+        let afs = team.afs(&failures)?;
         Ok(Self {
+            full_cone: afs.cone(Relaxation::none()),
+            planner_cone: afs.cone(settings.relaxation),
+            afs,
             plant: Plant {
                 mass: team.mass(),
                 inertia: team.inertia(),
                 gravity: settings.gravity,
             },
             planner: AttitudePlanner::new(settings.relaxation),
-            afs: team.afs(&failures)?,
             effectiveness: team.effectiveness(&failures),
             admissible: AdmissibleSet::from_limits(team.limits()),
             team,
@@ -153,6 +159,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     pub fn set_failures(&mut self, failures: FailureMask<N>) -> Result<(), ConfigError> {
         self.team.validate_failures(&failures)?;
         self.afs = self.team.afs(&failures)?;
+        self.full_cone = self.afs.cone(Relaxation::none());
+        self.planner_cone = self.afs.cone(self.settings.relaxation);
         self.effectiveness = self.team.effectiveness(&failures);
         self.failures = failures;
         Ok(())
@@ -161,6 +169,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Replaces the planner (e.g. another tolerance); its relaxation becomes the controller's.
     pub fn set_planner(&mut self, planner: AttitudePlanner<T>) {
         self.settings.relaxation = planner.relaxation();
+        self.planner_cone = self.afs.cone(planner.relaxation());
         self.planner = planner;
     }
 
@@ -236,11 +245,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         reference.validate().map_err(reject)?;
         let gains = &self.settings.gains;
         let u_fr = force_request(&self.plant, gains, state, reference);
-        let projection = project_force(&self.afs, &u_fr);
+        let projection = project_force_in(&self.full_cone, &u_fr);
         let f_r = state.attitude * u_fr * projection.t_tf;
         let planner = self
             .planner
-            .plan(&self.afs, &reference.attitude, &f_r)
+            .plan_in(&self.planner_cone, &reference.attitude, &f_r)
             .map_err(reject)?;
         let law = control_wrench(
             &self.plant,

@@ -53,12 +53,12 @@ pub mod team;
 
 pub use admissible::{AdmissibleSet, RateLimits};
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
+#[cfg(feature = "clarabel")]
+pub use allocation::ClarabelAllocator;
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
-#[cfg(feature = "clarabel")]
-pub use allocation::ClarabelAllocator;
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;
@@ -66,6 +66,6 @@ pub use error::{ConfigError, InputError};
 pub use gimbal::GimbalCommand;
 pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
-pub use projection::{project_force, ForceProjection};
+pub use projection::{project_force, project_force_in, ForceProjection};
 pub use real::Real;
 pub use team::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};

@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::error::{ConfigError, InputError};
 use crate::real::{eps, lit, Real};
 
@@ -93,6 +93,17 @@ impl<T: Real> AttitudePlanner<T> {
         r_r: &Matrix3<T>,
         f_r: &Vector3<T>,
     ) -> Result<PlannerOutput<T>, InputError> {
+        self.plan_in(&afs.cone(self.relaxation), r_r, f_r)
+    }
+
+    /// As [`Self::plan`] with the AFS already evaluated at the planner's relaxation
+    /// (`afs.cone(planner.relaxation())`), which a controller keeps between periods.
+    pub fn plan_in(
+        &self,
+        cone: &EllipticCone<T>,
+        r_r: &Matrix3<T>,
+        f_r: &Vector3<T>,
+    ) -> Result<PlannerOutput<T>, InputError> {
         if !r_r.iter().all(|x| x.is_finite()) {
             return Err(InputError::NonFinite {
                 field: "planner.r_r",
@@ -109,9 +120,10 @@ impl<T: Real> AttitudePlanner<T> {
             iterations: 0,
             status,
         };
-        let cone = afs.cone(self.relaxation);
-        let feasible = |r: &Matrix3<T>| cone.contains(&(r.transpose() * f_r));
+        // ||R^T f_r|| = ||f_r||: the thrust bound is checked once, the cross-section per attitude.
         let norm = f_r.norm();
+        let within_thrust = norm <= cone.max_force();
+        let feasible = |r: &Matrix3<T>| within_thrust && cone.admits(&(r.transpose() * f_r));
         if norm == T::zero() {
             return Ok(unchanged(PlannerStatus::ZeroForce));
         }
@@ -128,18 +140,31 @@ impl<T: Real> AttitudePlanner<T> {
                 status: PlannerStatus::Unreachable,
             });
         }
-        // Invariant: `lo` infeasible, `hi` feasible; `hi` is returned.
+        // Invariant: `lo` infeasible, `hi` feasible; `hi` is returned. `b_zd(theta)` moves on a
+        // great circle, so the midpoint direction is the normalized sum of the end directions:
+        // no trigonometry inside the loop.
         let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
+        let (mut z_lo, mut z_hi) = (tilt.b_zr, end.column(2).into_owned());
         let mut iterations = 0;
         while hi - lo > self.tolerance && iterations < self.max_iterations {
             iterations += 1;
             let mid = (lo + hi) * lit(0.5);
-            let r_mid = tilt.attitude(mid);
+            let sum = z_lo + z_hi;
+            let norm = sum.norm();
+            // |sum| = 2 cos((hi - lo) / 2) vanishes only for a half-turn bracket.
+            let z_mid = if norm > lit(0.5) {
+                sum * (T::one() / norm)
+            } else {
+                tilt.direction(mid)
+            };
+            let r_mid = tilt.frame(z_mid);
             if feasible(&r_mid) {
                 hi = mid;
+                z_hi = z_mid;
                 r_hi = r_mid;
             } else {
                 lo = mid;
+                z_lo = z_mid;
             }
         }
         Ok(PlannerOutput {
@@ -201,12 +226,21 @@ impl<T: Real> Tilt<T> {
     /// `b_xd = b_yd x b_zd` (eq. 11). When `b_zd` is parallel to `b_xr`, `b_xd` is instead taken
     /// from `b_yr x b_zd`.
     fn attitude(&self, theta: T) -> Matrix3<T> {
+        self.frame(self.direction(theta))
+    }
+
+    /// `b_zd(theta) = rot(b_zr, k, theta)`.
+    fn direction(&self, theta: T) -> Vector3<T> {
         let (s, c) = theta.sin_cos();
-        let b_zd = (self.b_zr * c + self.k_cross_bz * s).normalize();
+        (self.b_zr * c + self.k_cross_bz * s).normalize()
+    }
+
+    /// `R_d = [b_xd b_yd b_zd]` completed from `b_zd` as in [`Self::attitude`].
+    fn frame(&self, b_zd: Vector3<T>) -> Matrix3<T> {
         let y = b_zd.cross(&self.b_xr);
         let y_norm = y.norm();
         let (b_xd, b_yd) = if y_norm > eps::<T>().sqrt() {
-            let b_yd = y / y_norm;
+            let b_yd = y * (T::one() / y_norm);
             (b_yd.cross(&b_zd), b_yd)
         } else {
             let b_xd = self.b_yr.cross(&b_zd).normalize();

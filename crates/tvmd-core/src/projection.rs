@@ -2,7 +2,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::real::Real;
 
 /// The projected force and the factors of `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
@@ -33,6 +33,11 @@ pub fn project_force<T: Real>(
     afs: &AttainableForceSpace<T>,
     u_fr: &Vector3<T>,
 ) -> ForceProjection<T> {
+    project_force_in(&afs.cone(Relaxation::none()), u_fr)
+}
+
+/// As [`project_force`] with the AFS already evaluated at `s = 1` (`afs.cone(Relaxation::none())`).
+pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> ForceProjection<T> {
     if !u_fr.iter().all(|x| x.is_finite()) {
         return ForceProjection {
             force: Vector3::zeros(),
@@ -41,10 +46,10 @@ pub fn project_force<T: Real>(
         };
     }
     let norm = u_fr.norm();
-    let limit = afs.max_force();
+    let limit = cone.max_force();
     let t_tf = if norm > limit { limit / norm } else { T::one() };
     let scaled = u_fr * t_tf;
-    let q = afs.quadratic_form(&scaled, Relaxation::none());
+    let q = cone.quadratic_form(&scaled);
     let t_eta = if q <= T::one() {
         T::one()
     } else if q.is_finite() {
