@@ -66,6 +66,12 @@ pub enum SimError {
     /// A JSON serialization error while writing a log.
     #[error("JSON error: {0}")]
     Json(#[from] serde_json::Error),
+    /// A figure could not be drawn or written.
+    #[error("plot error: {0}")]
+    Plot(String),
+    /// An MCAP log could not be read back (missing channel, malformed message).
+    #[error("cannot read log: {0}")]
+    LogRead(String),
     /// The log was already finished.
     #[error("the MCAP log is already finished")]
     LogFinished,

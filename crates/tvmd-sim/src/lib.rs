@@ -18,6 +18,11 @@
 //! - [`log`]: MCAP logs (JSON messages, Foxglove `FrameTransform` / `SceneUpdate`).
 //! - [`sim`]: the digital control loop; controllers plug in through
 //!   [`sim::FlightController`].
+//! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller.
+//! - [`runner`]: run a scenario with the tvmd controller and an optional MCAP log.
+//! - [`metrics`]: the paper's reproduction metrics computed from a run's samples.
+//! - [`plot`]: PNG figures (state profile, Lyapunov candidates, relaxation study) from samples
+//!   or from an MCAP log.
 //!
 //! Conventions: SI units, z up, gravity `g = 9.81 m/s^2` along `-z`; body-frame twist
 //! `xi = [Omega; v]` with `x_dot = R v`.
@@ -25,12 +30,16 @@
 #![warn(missing_docs)]
 
 pub mod actuators;
+pub mod control;
 mod error;
 pub mod log;
 pub mod math;
+pub mod metrics;
 pub mod physics;
+pub mod plot;
 pub mod reference;
 pub mod rk4;
+pub mod runner;
 pub mod scenario;
 pub mod sim;
 

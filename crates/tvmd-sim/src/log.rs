@@ -7,12 +7,14 @@
 //! | `/state` | `tvmd.State` | true state of the team |
 //! | `/reference` | `tvmd.Reference` | reference trajectory |
 //! | `/planner` | `tvmd.Planner` | attitude planner diagnostics |
-//! | `/control` | `tvmd.Control` | control-law diagnostics |
+//! | `/control` | `tvmd.Control` | control-law diagnostics (and skipped cycles in `extra`) |
 //! | `/allocation` | `tvmd.Allocation` | allocation diagnostics (`e_f`) |
 //! | `/actuators` | `tvmd.Actuators` | commanded and actual agent commands, failures |
 //! | `/lyapunov` | `tvmd.Lyapunov` | `V_x`, `V_R` |
 //! | `/tf` | `foxglove.FrameTransform` | pose of frame `team` in frame `world` |
 //! | `/scene` | `foxglove.SceneUpdate` | one entity per agent (cube at `p_i`, thrust arrow) |
+//!
+//! A metadata record [`METADATA_SCENARIO`] may hold the scenario of the run.
 //!
 //! Every message carries the simulation time `t` (s), and its MCAP log/publish time is `t`
 //! in nanoseconds. The file is finalised by [`McapLog::finish`] and, if that was not called
@@ -31,6 +33,10 @@ use serde_json::{json, Value};
 use crate::actuators::AgentCommand;
 use crate::physics::TeamBody;
 use crate::SimError;
+
+/// Name of the metadata record holding the scenario of a run: keys `name`, `relaxation`,
+/// `allocator` and `toml` (the whole scenario as TOML).
+pub const METADATA_SCENARIO: &str = "tvmd.scenario";
 
 /// The message kinds of a simulation log (one channel each).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -114,17 +120,23 @@ impl LogKind {
             ),
             Self::Planner => (
                 json!({"t": num, "r_d": m3, "planned_roll_pitch_yaw": v3, "theta": num,
-                       "t_tf": num, "t_eta": num, "reference_feasible": {"type": "boolean"}}),
+                       "t_tf": num, "t_eta": num, "reference_feasible": {"type": "boolean"},
+                       "planned_roll": num, "status": {"type": "string"},
+                       "iterations": {"type": "integer"}}),
                 vec!["t"],
             ),
             Self::Control => (
                 json!({"t": num, "u_r": v6, "u_d": v6, "e_x": v3, "e_v": v3, "e_r": v3,
-                       "e_omega": v3, "extra": {}}),
+                       "e_omega": v3, "t_tf": num, "t_eta": num, "extra": {}}),
                 vec!["t"],
             ),
             Self::Allocation => (
                 json!({"t": num, "wrench": v6, "e_f": num,
-                       "saturated": {"type": "array", "items": {"type": "boolean"}}}),
+                       "saturated": {"type": "array", "items": {"type": "boolean"}},
+                       "wrench_error": num, "rounds": {"type": "integer"},
+                       "fallback": {"type": "boolean"},
+                       "forces": {"type": "array", "items": v3},
+                       "rotor_speeds": {"type": "array", "items": num}}),
                 vec!["t", "e_f"],
             ),
             Self::Actuators => (
@@ -310,11 +322,32 @@ impl From<UnitQuaternion<f64>> for Quat {
     }
 }
 
-#[derive(Serialize)]
-struct Stamped<'a, T: Serialize> {
-    t: f64,
-    #[serde(flatten)]
-    msg: &'a T,
+/// Adds `"t": t` in front of a serialized JSON object unless it starts with a `t` field (the
+/// message types of this module do); wraps anything else as `{"t": t, "value": ...}`.
+fn stamp(t: f64, body: Vec<u8>) -> Result<Vec<u8>, SimError> {
+    if body.starts_with(b"{\"t\":") {
+        return Ok(body);
+    }
+    let t_json = serde_json::to_vec(&t)?;
+    let mut out = Vec::with_capacity(body.len() + t_json.len() + 16);
+    match body.strip_prefix(b"{") {
+        Some(rest) => {
+            out.extend_from_slice(b"{\"t\":");
+            out.extend_from_slice(&t_json);
+            if rest != b"}" {
+                out.push(b',');
+            }
+            out.extend_from_slice(rest);
+        }
+        None => {
+            out.extend_from_slice(b"{\"t\":");
+            out.extend_from_slice(&t_json);
+            out.extend_from_slice(b",\"value\":");
+            out.extend_from_slice(&body);
+            out.push(b'}');
+        }
+    }
+    Ok(out)
 }
 
 fn nanos(t: f64) -> u64 {
@@ -387,6 +420,21 @@ impl McapLog {
         })
     }
 
+    /// Writes an MCAP metadata record `name` with string key/value pairs (for example the
+    /// scenario, see [`METADATA_SCENARIO`]).
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        values: BTreeMap<String, String>,
+    ) -> Result<(), SimError> {
+        let w = self.writer.as_mut().ok_or(SimError::LogFinished)?;
+        w.write_metadata(&mcap::records::Metadata {
+            name: name.to_string(),
+            metadata: values,
+        })?;
+        Ok(())
+    }
+
     /// Number of messages written so far.
     pub fn message_count(&self) -> u64 {
         self.messages
@@ -409,9 +457,10 @@ impl McapLog {
         Ok(())
     }
 
-    /// Writes `msg` (any serde type; a field `t` is added) on the channel of `kind`.
+    /// Writes `msg` (any serde type; a field `t` is added unless it has one) on the channel of
+    /// `kind`.
     pub fn write<T: Serialize>(&mut self, kind: LogKind, t: f64, msg: &T) -> Result<(), SimError> {
-        let data = serde_json::to_vec(&Stamped { t, msg })?;
+        let data = stamp(t, serde_json::to_vec(msg)?)?;
         let channel = self.channels[&kind];
         self.write_raw(channel, t, &data)
     }
@@ -523,6 +572,25 @@ impl Drop for McapLog {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_carry_one_t() {
+        let parse = |b: Vec<u8>| serde_json::from_slice::<Value>(&b).unwrap();
+        assert_eq!(
+            parse(stamp(0.5, br#"{"a":1}"#.to_vec()).unwrap()),
+            json!({"t": 0.5, "a": 1})
+        );
+        assert_eq!(
+            parse(stamp(0.5, b"{}".to_vec()).unwrap()),
+            json!({"t": 0.5})
+        );
+        let own = br#"{"t":0.25,"a":1}"#.to_vec();
+        assert_eq!(stamp(0.5, own.clone()).unwrap(), own);
+        assert_eq!(
+            parse(stamp(0.5, b"[1,2]".to_vec()).unwrap()),
+            json!({"t": 0.5, "value": [1, 2]})
+        );
+    }
 
     #[test]
     fn schemas_are_objects_with_titles() {

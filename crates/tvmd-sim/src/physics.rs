@@ -88,6 +88,27 @@ impl TeamBody {
         }
     }
 
+    /// `n` agents of mass `mass` evenly on a circle of `radius` in the `x-y` plane, agent `i`
+    /// at angle `2 pi i / n`; every second agent turned a quarter turn when `inconsistent`
+    /// (the layout of `tvmd_core::team::presets::ring`). Massless navigator.
+    pub fn ring(n: usize, radius: f64, mass: f64, inconsistent: bool) -> Self {
+        Self {
+            agents: (0..n)
+                .map(|i| {
+                    let phase = std::f64::consts::TAU * i as f64 / n as f64;
+                    AgentBody {
+                        position: [radius * phase.cos(), radius * phase.sin(), 0.0],
+                        mass,
+                        quarter_turns: if inconsistent { (i % 2) as i32 } else { 0 },
+                    }
+                })
+                .collect(),
+            navigator_mass: 0.0,
+            navigator_inertia: [[0.0; 3]; 3],
+            collider_radius: DEFAULT_COLLIDER_RADIUS,
+        }
+    }
+
     /// Half side of the paper's A4 square: `a = 0.5 sqrt(2)/2` m.
     pub fn paper_arm() -> f64 {
         0.5 * std::f64::consts::SQRT_2 / 2.0

@@ -11,7 +11,8 @@
 //! controller_period = 0.01
 //! initial_position = [0.5, -0.5, 0.0]
 //! relaxation = 0.5
-//! allocator = "redistributed-pseudo-inverse"
+//! allocator = "redistributed-pseudo-inverse"   # "pseudo-inverse", "clarabel", ...
+//! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
 //!
 //! [physics]
 //! dt = 0.001
@@ -70,6 +71,15 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "a4-con",
     "a4-inc",
     "agent-failure",
+    "a6-agent-failure",
+];
+
+/// Allocator names a scenario may give (`"clarabel"` needs the `clarabel` feature at run time).
+pub const ALLOCATOR_NAMES: &[&str] = &[
+    "redistributed-pseudo-inverse",
+    "pseudo-inverse",
+    "weighted-pseudo-inverse",
+    "clarabel",
 ];
 
 /// The team: a preset or explicit agents.
@@ -301,8 +311,15 @@ pub struct Scenario {
     pub initial_position: [f64; 3],
     /// Planner relaxation `s` in `(0, 1]`; 0.5.
     pub relaxation: f64,
-    /// Allocator name, interpreted by the controller; `"redistributed-pseudo-inverse"`.
+    /// Allocator name, interpreted by the controller; `"redistributed-pseudo-inverse"`
+    /// (also `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and
+    /// `"clarabel"` with the `clarabel` feature).
     pub allocator: String,
+    /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
+    /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
+    /// plant's: give both to model a servo the controller knows about.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_rate_limits: Option<[f64; 2]>,
     /// Physics settings (step, gravity, ground, friction).
     pub physics: PhysicsConfig,
     /// The team.
@@ -333,6 +350,7 @@ impl Default for Scenario {
             initial_position: [0.5, -0.5, 0.0],
             relaxation: 0.5,
             allocator: "redistributed-pseudo-inverse".into(),
+            controller_rate_limits: None,
             physics: PhysicsConfig::default(),
             team: TeamSpec::default(),
             limits: Limits::default(),
@@ -475,6 +493,26 @@ impl Scenario {
                      (controller informed); descent at 12 s",
                 )
             }
+            "a6-agent-failure" => {
+                s.initial_position = [0.0, 0.0, 0.0];
+                s.reference = ReferenceConfig::PaperTilt(PaperTilt {
+                    roll_peak: 0.0,
+                    ..PaperTilt::default()
+                });
+                s.team.agents = Some(TeamBody::ring(6, 0.5, 0.7, true).agents);
+                s.failures = vec![Failure {
+                    agent: 0,
+                    time: 5.0,
+                    kind: FailureKind::NoThrust,
+                    controller_informed: true,
+                }];
+                with(
+                    s,
+                    "A6-Inc ring (radius 0.5 m, alternate quarter turns) ascends and hovers at \
+                     1.5 m; agent 0 loses its thrust at t = 5 s (controller informed); descent \
+                     at 12 s",
+                )
+            }
             other => {
                 return Err(SimError::UnknownScenario {
                     name: other.to_string(),
@@ -549,6 +587,20 @@ impl Scenario {
         }
         if let Some(t) = self.limits.max_thrust {
             check_pos("limits.max_thrust", t)?;
+        }
+        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str()) {
+            return Err(invalid(
+                "allocator",
+                format!(
+                    "unknown allocator `{}` (known: {})",
+                    self.allocator,
+                    ALLOCATOR_NAMES.join(", ")
+                ),
+            ));
+        }
+        if let Some([x, y]) = self.controller_rate_limits {
+            check_pos("controller_rate_limits[0]", x)?;
+            check_pos("controller_rate_limits[1]", y)?;
         }
         check_nonneg("gains.k_x", &self.gains.k_x)?;
         check_nonneg("gains.k_r", &self.gains.k_r)?;

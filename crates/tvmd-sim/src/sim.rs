@@ -43,6 +43,15 @@ pub struct PlannerDiagnostics {
     pub t_eta: f64,
     /// Whether `R_r` itself was feasible.
     pub reference_feasible: bool,
+    /// Planned roll `atan2(R_d[2,1], R_d[2,2])` (rad).
+    #[serde(default)]
+    pub planned_roll: f64,
+    /// How the planner reached `R_d` (e.g. `already-feasible`, `planned`).
+    #[serde(default)]
+    pub status: String,
+    /// Bisection iterations used.
+    #[serde(default)]
+    pub iterations: u32,
 }
 
 /// Control-law diagnostics (logged on `/control`).
@@ -60,6 +69,12 @@ pub struct ControlDiagnostics {
     pub e_r: [f64; 3],
     /// `e_Omega` (rad/s).
     pub e_omega: [f64; 3],
+    /// Thrust scaling `t_Tf` of the force projection.
+    #[serde(default)]
+    pub t_tf: f64,
+    /// Gimbal scaling `t_eta` of the force projection.
+    #[serde(default)]
+    pub t_eta: f64,
     /// Anything else the controller wants logged.
     #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
     pub extra: serde_json::Value,
@@ -74,6 +89,22 @@ pub struct AllocationDiagnostics {
     pub e_f: f64,
     /// Per agent: whether the allocator saturated it.
     pub saturated: Vec<bool>,
+    /// `||u_d - M f||` over the whole wrench.
+    #[serde(default)]
+    pub wrench_error: f64,
+    /// Solve rounds (pseudo-inverse 1, redistribution up to `n`, Clarabel: iterations).
+    #[serde(default)]
+    pub rounds: u32,
+    /// The allocator fell back to another method.
+    #[serde(default)]
+    pub fallback: bool,
+    /// Allocated agent-frame forces `f_i` (N).
+    #[serde(default)]
+    pub forces: Vec<[f64; 3]>,
+    /// Rotor speeds of the commands (normalised to 1 at maximum thrust unless rotor constants
+    /// are given).
+    #[serde(default)]
+    pub rotor_speeds: Vec<f64>,
 }
 
 /// Lyapunov candidates (logged on `/lyapunov`).
@@ -96,6 +127,12 @@ pub struct Diagnostics {
     pub allocation: Option<AllocationDiagnostics>,
     /// Lyapunov candidates.
     pub lyapunov: Option<LyapunovDiagnostics>,
+    /// The controller skipped this cycle and held its previous commands, for this reason.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_error: Option<String>,
+    /// A note on the failure mask (e.g. the controller could not use the reported failures).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure_note: Option<String>,
 }
 
 /// What a controller returns at each tick.
@@ -151,18 +188,28 @@ pub struct Sample {
     pub reference_position: [f64; 3],
     /// Roll, pitch, yaw of `R` (rad).
     pub roll_pitch_yaw: [f64; 3],
+    /// Roll, pitch, yaw of `R_r` (rad).
+    pub reference_roll_pitch_yaw: [f64; 3],
     /// `phi_r` (rad).
     pub reference_roll: f64,
     /// Roll of the planned `R_d` (rad), if the controller reported it.
     pub planned_roll: Option<f64>,
+    /// Roll, pitch, yaw of the planned `R_d` (rad), if reported.
+    pub planned_roll_pitch_yaw: Option<[f64; 3]>,
+    /// Angle between `R` and the planned `R_d` (rad), if `R_d` was reported.
+    pub attitude_error: Option<f64>,
     /// Planner angle `theta*` (rad), if reported.
     pub theta: Option<f64>,
     /// Allocation error `e_f` (N), if reported.
     pub e_f: Option<f64>,
+    /// Number of agents the allocator saturated, if reported.
+    pub saturated_agents: Option<usize>,
     /// `V_x`, if reported.
     pub v_x: Option<f64>,
     /// `V_R`, if reported.
     pub v_r: Option<f64>,
+    /// The controller skipped this cycle (held its previous commands).
+    pub cycle_error: bool,
     /// Commands returned at this tick.
     pub commands: Vec<AgentCommand>,
     /// Actual actuator outputs at this tick (before the new commands act).
@@ -170,6 +217,31 @@ pub struct Sample {
     /// True failure flags.
     pub failed: Vec<bool>,
 }
+
+impl Sample {
+    /// `||x - x_r||` (m).
+    pub fn position_error(&self) -> f64 {
+        norm3(&sub3(&self.position, &self.reference_position))
+    }
+
+    /// Horizontal position error `||(x - x_r)_{x,y}||` (m).
+    pub fn horizontal_error(&self) -> f64 {
+        let d = sub3(&self.position, &self.reference_position);
+        d[0].hypot(d[1])
+    }
+}
+
+fn sub3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm3(a: &[f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Time after which [`RunSummary::max_position_error_after_4s`] is taken (s): the end of
+/// the paper's ascent plus its hover (stage A).
+pub const SETTLING_TIME: f64 = 4.0;
 
 /// Summary of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -188,18 +260,50 @@ pub struct RunSummary {
     pub final_roll_pitch_yaw: [f64; 3],
     /// Largest `||x - x_r||` over the samples (m).
     pub max_position_error: f64,
+    /// Largest `||x - x_r||` over the samples at `t >= SETTLING_TIME` (4 s) (m).
+    pub max_position_error_after_4s: f64,
     /// `||x - x_r||` at the last sample (m).
     pub final_position_error: f64,
+    /// Horizontal error `||(x - x_r)_{x,y}||` at the sample nearest to `t = 4 s` (m).
+    pub horizontal_error_at_4s: Option<f64>,
+    /// Horizontal error at the sample nearest to `t = 12 s` (m).
+    pub horizontal_error_at_12s: Option<f64>,
     /// Largest tilt angle (angle between body z and world z) over the samples (rad).
     pub max_tilt: f64,
+    /// Largest actual roll `|phi|` (rad).
+    pub max_roll: f64,
     /// Largest planned roll `|phi_d|`, if reported (rad).
     pub max_planned_roll: Option<f64>,
     /// Largest allocation error `e_f`, if reported (N).
     pub max_e_f: Option<f64>,
+    /// Time of the largest `e_f` (s).
+    pub max_e_f_time: Option<f64>,
+    /// Largest `e_f / (m_C g)`, if reported.
+    pub max_e_f_over_weight: Option<f64>,
+    /// `V_x` at the last sample, if reported.
+    pub final_v_x: Option<f64>,
+    /// `V_R` at the last sample, if reported.
+    pub final_v_r: Option<f64>,
+    /// Smallest commanded thrust of a working agent (N).
+    pub min_thrust: Option<f64>,
+    /// Largest commanded thrust (N).
+    pub max_thrust: Option<f64>,
+    /// Largest commanded `|eta_x|` (rad).
+    pub max_abs_eta_x: f64,
+    /// Largest commanded `|eta_y|` (rad).
+    pub max_abs_eta_y: f64,
+    /// Controller periods in which the allocator saturated at least one agent.
+    pub saturated_periods: usize,
+    /// Controller periods the controller skipped (held commands).
+    pub cycle_errors: usize,
     /// Number of controller calls.
     pub controller_calls: usize,
     /// Number of physics steps.
     pub physics_steps: usize,
+    /// Wall-clock time spent in [`Simulation::run`] (s), logging included.
+    pub wall_time: f64,
+    /// Real-time factor: simulated time over wall time.
+    pub real_time_factor: f64,
 }
 
 /// Result of a run: the samples and a summary.
@@ -242,6 +346,7 @@ pub struct Simulation {
     samples: Vec<Sample>,
     step_index: usize,
     controller_calls: usize,
+    wall_time: f64,
 }
 
 fn arr(v: &Vector3<f64>) -> [f64; 3] {
@@ -286,6 +391,7 @@ impl Simulation {
             samples: Vec::new(),
             step_index: 0,
             controller_calls: 0,
+            wall_time: 0.0,
         })
     }
 
@@ -373,8 +479,23 @@ impl Simulation {
     pub fn run(
         &mut self,
         controller: &mut dyn FlightController,
-        mut log: Option<&mut McapLog>,
+        log: Option<&mut McapLog>,
     ) -> Result<RunResult, SimError> {
+        let start = std::time::Instant::now();
+        let result = self.run_loop(controller, log);
+        self.wall_time += start.elapsed().as_secs_f64();
+        result?;
+        Ok(RunResult {
+            samples: self.samples.clone(),
+            summary: self.summary(),
+        })
+    }
+
+    fn run_loop(
+        &mut self,
+        controller: &mut dyn FlightController,
+        mut log: Option<&mut McapLog>,
+    ) -> Result<(), SimError> {
         let dt = self.scenario.physics.dt;
         let period = self.scenario.controller_period;
         let scene_every = ((self.options.scene_period / period).round() as usize).max(1);
@@ -420,30 +541,34 @@ impl Simulation {
             self.world.step(&forces, &extra)?;
             self.step_index += 1;
         }
-        Ok(RunResult {
-            samples: self.samples.clone(),
-            summary: self.summary(),
-        })
+        Ok(())
     }
 
     fn record(&mut self, t: f64, s: &RigidState, r: &Reference, out: &ControlOutput) {
         let d = &out.diagnostics;
-        let planned = d
-            .planner
-            .as_ref()
-            .map(|p| roll_pitch_yaw(&crate::math::from_rows(&p.r_d))[0]);
+        let r_d = d.planner.as_ref().map(|p| crate::math::from_rows(&p.r_d));
         self.samples.push(Sample {
             t,
             position: arr(&s.position),
             velocity: arr(&s.velocity),
             reference_position: arr(&r.position),
             roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
+            reference_roll_pitch_yaw: roll_pitch_yaw(&r.rotation),
             reference_roll: r.roll,
-            planned_roll: planned,
+            planned_roll: r_d.map(|m| m[(2, 1)].atan2(m[(2, 2)])),
+            planned_roll_pitch_yaw: r_d.as_ref().map(roll_pitch_yaw),
+            attitude_error: r_d
+                .as_ref()
+                .map(|m| crate::math::rotation_distance(&s.rotation, m)),
             theta: d.planner.as_ref().map(|p| p.theta),
             e_f: d.allocation.as_ref().map(|a| a.e_f),
+            saturated_agents: d
+                .allocation
+                .as_ref()
+                .map(|a| a.saturated.iter().filter(|x| **x).count()),
             v_x: d.lyapunov.map(|l| l.v_x),
             v_r: d.lyapunov.map(|l| l.v_r),
+            cycle_error: d.cycle_error.is_some(),
             commands: out.commands.clone(),
             actual: self.actuators.actual(),
             failed: self.failed_true.clone(),
@@ -508,6 +633,15 @@ impl Simulation {
         if let Some(c) = &d.control {
             log.write(LogKind::Control, t, c)?;
         }
+        if d.cycle_error.is_some() || d.failure_note.is_some() {
+            // A skipped cycle has no law output: log why on the control channel.
+            log.write(
+                LogKind::Control,
+                t,
+                &serde_json::json!({"extra": {
+                    "cycle_error": d.cycle_error, "failure_note": d.failure_note}}),
+            )?;
+        }
         if let Some(a) = &d.allocation {
             log.write(LogKind::Allocation, t, a)?;
         }
@@ -545,36 +679,90 @@ impl Simulation {
     /// Summary of the run so far (final state from the physics, extremes from the samples).
     pub fn summary(&self) -> RunSummary {
         let s = self.world.state();
-        let err = |x: &Sample| {
-            let d: Vec<f64> = (0..3)
-                .map(|i| x.position[i] - x.reference_position[i])
-                .collect();
-            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-        };
-        let max_opt = |f: &dyn Fn(&Sample) -> Option<f64>| {
-            self.samples
-                .iter()
-                .filter_map(f)
-                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
+        let samples = &self.samples;
+        let max_of = |it: &mut dyn Iterator<Item = f64>| {
+            it.fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
         };
         let tilt = |x: &Sample| {
             let [r, p, _] = x.roll_pitch_yaw;
             (r.cos() * p.cos()).clamp(-1.0, 1.0).acos()
         };
+        let nearest = |t: f64| {
+            samples
+                .iter()
+                .min_by(|a, b| (a.t - t).abs().total_cmp(&(b.t - t).abs()))
+                .filter(|x| (x.t - t).abs() <= self.scenario.controller_period)
+                .map(Sample::horizontal_error)
+        };
+        let weight = self.team.mass() * self.scenario.physics.gravity;
+        let e_f_max = samples.iter().filter_map(|x| x.e_f.map(|e| (x.t, e))).fold(
+            None,
+            |m: Option<(f64, f64)>, (t, e)| match m {
+                Some((_, me)) if me >= e => m,
+                _ => Some((t, e)),
+            },
+        );
+        let working_thrusts = || {
+            samples.iter().flat_map(|x| {
+                x.commands
+                    .iter()
+                    .zip(&x.failed)
+                    .filter(|(_, f)| !**f)
+                    .map(|(c, _)| c.thrust)
+            })
+        };
+        let commands = || samples.iter().flat_map(|x| x.commands.iter());
+        let time = self.world.time();
         RunSummary {
             scenario: self.scenario.name.clone(),
-            time: self.world.time(),
+            time,
             final_position: arr(&s.position),
             final_velocity: arr(&s.velocity),
             final_omega: arr(&s.omega),
             final_roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
-            max_position_error: self.samples.iter().map(err).fold(0.0, f64::max),
-            final_position_error: self.samples.last().map(err).unwrap_or(0.0),
-            max_tilt: self.samples.iter().map(tilt).fold(0.0, f64::max),
-            max_planned_roll: max_opt(&|x| x.planned_roll.map(f64::abs)),
-            max_e_f: max_opt(&|x| x.e_f),
+            max_position_error: samples
+                .iter()
+                .map(Sample::position_error)
+                .fold(0.0, f64::max),
+            max_position_error_after_4s: samples
+                .iter()
+                .filter(|x| x.t >= SETTLING_TIME - 1e-9)
+                .map(Sample::position_error)
+                .fold(0.0, f64::max),
+            final_position_error: samples.last().map(Sample::position_error).unwrap_or(0.0),
+            horizontal_error_at_4s: nearest(4.0),
+            horizontal_error_at_12s: nearest(12.0),
+            max_tilt: samples.iter().map(tilt).fold(0.0, f64::max),
+            max_roll: samples
+                .iter()
+                .map(|x| x.roll_pitch_yaw[0].abs())
+                .fold(0.0, f64::max),
+            max_planned_roll: max_of(
+                &mut samples.iter().filter_map(|x| x.planned_roll.map(f64::abs)),
+            ),
+            max_e_f: e_f_max.map(|(_, e)| e),
+            max_e_f_time: e_f_max.map(|(t, _)| t),
+            max_e_f_over_weight: e_f_max.map(|(_, e)| e / weight),
+            final_v_x: samples.last().and_then(|x| x.v_x),
+            final_v_r: samples.last().and_then(|x| x.v_r),
+            min_thrust: working_thrusts()
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.min(v)))),
+            max_thrust: max_of(&mut working_thrusts()),
+            max_abs_eta_x: commands().map(|c| c.eta_x.abs()).fold(0.0, f64::max),
+            max_abs_eta_y: commands().map(|c| c.eta_y.abs()).fold(0.0, f64::max),
+            saturated_periods: samples
+                .iter()
+                .filter(|x| x.saturated_agents.is_some_and(|n| n > 0))
+                .count(),
+            cycle_errors: samples.iter().filter(|x| x.cycle_error).count(),
             controller_calls: self.controller_calls,
             physics_steps: self.step_index,
+            wall_time: self.wall_time,
+            real_time_factor: if self.wall_time > 0.0 {
+                time / self.wall_time
+            } else {
+                f64::INFINITY
+            },
         }
     }
 }

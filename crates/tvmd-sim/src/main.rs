@@ -1,0 +1,561 @@
+//! `tvmd-sim`: run the paper's simulation (and other scenarios) with the tvmd controller, the
+//! relaxation study, and plots.
+//!
+//! ```text
+//! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
+//! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
+//! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
+//! tvmd-sim list
+//! tvmd-sim show NAME
+//! ```
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use tvmd_sim::control::hover_roll_limit;
+use tvmd_sim::metrics::PaperMetrics;
+use tvmd_sim::plot::{self, PlotSeries};
+use tvmd_sim::runner::run_scenario;
+use tvmd_sim::scenario::{Scenario, BUILTIN_NAMES};
+use tvmd_sim::sim::{RunResult, RunSummary};
+use tvmd_sim::SimError;
+
+/// Simulator of thrust-vectoring modular team UAVs with the tvmd controller in the loop.
+#[derive(Parser, Debug)]
+#[command(name = "tvmd-sim", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run one scenario with the tvmd controller; print a summary, write the MCAP log, the
+    /// summary JSON and (with --plots) the figures.
+    Run {
+        /// A built-in scenario name (see `tvmd-sim list`) or a TOML file.
+        #[arg(default_value = "paper-tilt")]
+        scenario: String,
+        /// MCAP log to write (default: out/<scenario name>.mcap).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Do not write an MCAP log.
+        #[arg(long, conflicts_with = "out")]
+        no_log: bool,
+        /// Directory for the PNG figures (state profile, Lyapunov candidates).
+        #[arg(long)]
+        plots: Option<PathBuf>,
+        /// Summary JSON to write (default: beside the log as <log stem>.summary.json; none with
+        /// --no-log).
+        #[arg(long)]
+        summary: Option<PathBuf>,
+        /// Override the scenario's planner relaxation s.
+        #[arg(long)]
+        relaxation: Option<f64>,
+        /// Override the scenario's allocator (redistributed-pseudo-inverse, pseudo-inverse,
+        /// weighted-pseudo-inverse, clarabel).
+        #[arg(long)]
+        allocator: Option<String>,
+    },
+    /// The relaxation study: the scenario flown once per relaxation s (in parallel threads).
+    Sweep {
+        /// Relaxations s, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "0.25,0.5,0.75,1.0")]
+        relaxations: Vec<f64>,
+        /// A built-in scenario name or a TOML file.
+        #[arg(long, default_value = "paper-tilt")]
+        scenario: String,
+        /// Directory for the relaxation-study figure (relaxation.png).
+        #[arg(long)]
+        plots: Option<PathBuf>,
+        /// Directory for one MCAP log per run (<scenario>-s<s>.mcap); none by default.
+        #[arg(long)]
+        logs: Option<PathBuf>,
+        /// JSON file for the table.
+        #[arg(long)]
+        summary: Option<PathBuf>,
+        /// Worker threads (default: available cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+    /// Re-plot runs from their MCAP logs: figures of each run, and the relaxation-study figure
+    /// when several logs are given.
+    Plot {
+        /// MCAP logs written by `tvmd-sim run` or `sweep --logs`.
+        #[arg(required = true)]
+        logs: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// List the built-in scenarios.
+    List,
+    /// Print a built-in scenario as TOML (a starting point for a scenario file).
+    Show {
+        /// Built-in scenario name.
+        name: String,
+    },
+}
+
+/// Errors of the command line.
+#[derive(Debug)]
+enum CliError {
+    Sim(SimError),
+    Other(String),
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Sim(e) => write!(f, "{e}"),
+            Self::Other(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl From<SimError> for CliError {
+    fn from(e: SimError) -> Self {
+        Self::Sim(e)
+    }
+}
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        Self::Sim(SimError::Io(e))
+    }
+}
+
+impl From<serde_json::Error> for CliError {
+    fn from(e: serde_json::Error) -> Self {
+        Self::Sim(SimError::Json(e))
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run {
+            scenario,
+            out,
+            no_log,
+            plots,
+            summary,
+            relaxation,
+            allocator,
+        } => cmd_run(RunArgs {
+            scenario,
+            out,
+            no_log,
+            plots,
+            summary,
+            relaxation,
+            allocator,
+        }),
+        Command::Sweep {
+            relaxations,
+            scenario,
+            plots,
+            logs,
+            summary,
+            jobs,
+        } => cmd_sweep(&relaxations, &scenario, plots, logs, summary, jobs),
+        Command::Plot { logs, out } => cmd_plot(&logs, &out),
+        Command::List => {
+            for name in BUILTIN_NAMES {
+                // Built-ins always exist.
+                let d = Scenario::builtin(name)
+                    .map(|s| s.description)
+                    .unwrap_or_default();
+                println!("{name:<24} {d}");
+            }
+            Ok(())
+        }
+        Command::Show { name } => Scenario::builtin(&name)
+            .and_then(|s| s.to_toml_string())
+            .map(|t| print!("{t}"))
+            .map_err(CliError::from),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A built-in name, or a TOML file if the argument names an existing file or ends in `.toml`.
+fn load_scenario(arg: &str) -> Result<Scenario, SimError> {
+    let path = Path::new(arg);
+    if arg.ends_with(".toml") || path.is_file() {
+        Scenario::from_file(path)
+    } else {
+        Scenario::builtin(arg)
+    }
+}
+
+fn progress_bar(ticks: u64, message: &str) -> ProgressBar {
+    let target = if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(ticks), target);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} ticks (eta {eta})",
+    ) {
+        bar.set_style(style);
+    }
+    bar.set_message(message.to_string());
+    bar
+}
+
+fn ticks_of(s: &Scenario) -> u64 {
+    (s.duration / s.controller_period).ceil().max(1.0) as u64
+}
+
+/// Everything `run` writes to the summary JSON.
+#[derive(Serialize)]
+struct RunReport<'a> {
+    scenario: &'a str,
+    relaxation: f64,
+    allocator: &'a str,
+    /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
+    hover_roll_limit: Option<f64>,
+    summary: &'a RunSummary,
+    paper: PaperMetrics,
+    log: Option<String>,
+}
+
+struct RunArgs {
+    scenario: String,
+    out: Option<PathBuf>,
+    no_log: bool,
+    plots: Option<PathBuf>,
+    summary: Option<PathBuf>,
+    relaxation: Option<f64>,
+    allocator: Option<String>,
+}
+
+fn cmd_run(a: RunArgs) -> Result<(), CliError> {
+    let mut scenario = load_scenario(&a.scenario)?;
+    if let Some(s) = a.relaxation {
+        scenario.relaxation = s;
+    }
+    if let Some(name) = a.allocator {
+        scenario.allocator = name;
+    }
+    scenario.validate()?;
+    let log = if a.no_log {
+        None
+    } else {
+        Some(
+            a.out
+                .unwrap_or_else(|| PathBuf::from(format!("out/{}.mcap", scenario.name))),
+        )
+    };
+    let bar = progress_bar(ticks_of(&scenario), &scenario.name);
+    let mut tick = |_t: f64| bar.inc(1);
+    let result = run_scenario(&scenario, log.as_deref(), Some(&mut tick));
+    bar.finish_and_clear();
+    let result = result?;
+    let report = RunReport {
+        scenario: &scenario.name,
+        relaxation: scenario.relaxation,
+        allocator: &scenario.allocator,
+        hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
+        summary: &result.summary,
+        paper: PaperMetrics::new(&scenario, &result.samples),
+        log: log.as_ref().map(|p| p.display().to_string()),
+    };
+    print_run(&report);
+    let summary_path = a
+        .summary
+        .or_else(|| log.as_ref().map(|l| l.with_extension("summary.json")));
+    if let Some(p) = &summary_path {
+        write_json(p, &report)?;
+        println!("summary:  {}", p.display());
+    }
+    if let Some(l) = &log {
+        println!("log:      {} (open in Foxglove)", l.display());
+    }
+    if let Some(dir) = &a.plots {
+        let series =
+            PlotSeries::from_samples(&scenario.name, Some(scenario.relaxation), &result.samples);
+        for p in plot::write_run_figures(&series, dir, &scenario.name)? {
+            println!("figure:   {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")?;
+    Ok(())
+}
+
+fn opt(v: Option<f64>, unit: &str) -> String {
+    v.map_or_else(|| "-".to_string(), |x| format!("{x:.6} {unit}"))
+}
+
+fn opt_e(v: Option<f64>, unit: &str) -> String {
+    v.map_or_else(|| "-".to_string(), |x| format!("{x:.3e} {unit}"))
+}
+
+fn print_run(r: &RunReport<'_>) {
+    let s = r.summary;
+    let p = &r.paper;
+    let rows: Vec<(&str, String)> = vec![
+        ("scenario", r.scenario.to_string()),
+        ("relaxation s", format!("{}", r.relaxation)),
+        ("allocator", r.allocator.to_string()),
+        ("simulated time", format!("{:.3} s", s.time)),
+        (
+            "wall time / RTF",
+            format!(
+                "{:.3} s / {:.1}x real time",
+                s.wall_time, s.real_time_factor
+            ),
+        ),
+        (
+            "max position error",
+            format!("{:.4} m", s.max_position_error),
+        ),
+        (
+            "max pos. error t >= 4 s",
+            format!("{:.4} m", s.max_position_error_after_4s),
+        ),
+        (
+            "final position error",
+            format!("{:.4} m", s.final_position_error),
+        ),
+        (
+            "horizontal error 4 s/12 s",
+            format!(
+                "{} / {}",
+                opt(s.horizontal_error_at_4s, "m"),
+                opt(s.horizontal_error_at_12s, "m")
+            ),
+        ),
+        ("max planned roll", opt(s.max_planned_roll, "rad")),
+        ("atan(c_y(1, s))", opt(r.hover_roll_limit, "rad")),
+        ("max actual roll", format!("{:.6} rad", s.max_roll)),
+        (
+            "stage-B attitude settling",
+            opt(p.stage_b_attitude_settling, "s"),
+        ),
+        (
+            "max e_f (at t)",
+            format!("{} ({})", opt_e(s.max_e_f, "N"), opt(s.max_e_f_time, "s")),
+        ),
+        ("max e_f / (m_C g)", opt_e(s.max_e_f_over_weight, "")),
+        ("final V_x", opt_e(s.final_v_x, "")),
+        (
+            "largest rise of V_x",
+            p.max_v_x_rise.map_or_else(
+                || "-".to_string(),
+                |r| {
+                    format!(
+                        "{:.3e} -> {:.3e} ({:.2} s -> {:.2} s)",
+                        r.from_value, r.to_value, r.from, r.to
+                    )
+                },
+            ),
+        ),
+        (
+            "thrust min / max",
+            format!("{} / {}", opt(s.min_thrust, "N"), opt(s.max_thrust, "N")),
+        ),
+        (
+            "max |eta_x| / |eta_y|",
+            format!("{:.4} / {:.4} rad", s.max_abs_eta_x, s.max_abs_eta_y),
+        ),
+        ("saturated periods", s.saturated_periods.to_string()),
+        ("skipped cycles", s.cycle_errors.to_string()),
+        (
+            "final position",
+            format!(
+                "[{:.4}, {:.4}, {:.4}] m",
+                s.final_position[0], s.final_position[1], s.final_position[2]
+            ),
+        ),
+        (
+            "final speed",
+            format!(
+                "{:.2e} m/s",
+                s.final_velocity.iter().map(|v| v * v).sum::<f64>().sqrt()
+            ),
+        ),
+    ];
+    for (k, v) in rows {
+        println!("{k:<26} {v}");
+    }
+}
+
+/// One row of the relaxation study.
+#[derive(Serialize, Clone)]
+struct SweepRow {
+    relaxation: f64,
+    max_planned_roll: Option<f64>,
+    hover_roll_limit: f64,
+    max_e_f: Option<f64>,
+    max_e_f_time: Option<f64>,
+    e_f_onset: Option<f64>,
+    max_position_error_after_4s: f64,
+    max_position_error_6_to_12s: Option<f64>,
+    final_v_x: Option<f64>,
+    saturated_periods: usize,
+    real_time_factor: f64,
+}
+
+fn cmd_sweep(
+    relaxations: &[f64],
+    scenario_arg: &str,
+    plots: Option<PathBuf>,
+    logs: Option<PathBuf>,
+    summary: Option<PathBuf>,
+    jobs: Option<usize>,
+) -> Result<(), CliError> {
+    let base = load_scenario(scenario_arg)?;
+    let mut scenarios = Vec::new();
+    for &s in relaxations {
+        let mut sc = base.clone();
+        sc.relaxation = s;
+        sc.name = format!("{}-s{s}", base.name);
+        sc.validate()?;
+        scenarios.push(sc);
+    }
+    if scenarios.is_empty() {
+        return Err(CliError::Other("no relaxation given".into()));
+    }
+    let jobs = jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, scenarios.len());
+    let total: u64 = scenarios.iter().map(ticks_of).sum();
+    let bar = progress_bar(total, &format!("{} runs", scenarios.len()));
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<RunResult, SimError>>>> =
+        Mutex::new((0..scenarios.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                let Some(sc) = scenarios.get(k) else { break };
+                let log = logs.as_ref().map(|d| d.join(format!("{}.mcap", sc.name)));
+                let mut tick = |_t: f64| bar.inc(1);
+                let r = run_scenario(sc, log.as_deref(), Some(&mut tick));
+                if let Ok(mut all) = results.lock() {
+                    all[k] = Some(r);
+                }
+            });
+        }
+    });
+    bar.finish_and_clear();
+    let results = results
+        .into_inner()
+        .map_err(|_| CliError::Other("a sweep worker panicked".into()))?;
+    let mut rows = Vec::new();
+    let mut series = Vec::new();
+    for (sc, r) in scenarios.iter().zip(results) {
+        let r = r.ok_or_else(|| CliError::Other(format!("run {} did not finish", sc.name)))?;
+        let r = r.map_err(|e| CliError::Other(format!("run {}: {e}", sc.name)))?;
+        let s = &r.summary;
+        let paper = PaperMetrics::new(sc, &r.samples);
+        rows.push(SweepRow {
+            relaxation: sc.relaxation,
+            max_planned_roll: s.max_planned_roll,
+            hover_roll_limit: hover_roll_limit(sc, sc.relaxation)?,
+            max_e_f: s.max_e_f,
+            max_e_f_time: s.max_e_f_time,
+            e_f_onset: paper.e_f_onset,
+            max_position_error_after_4s: s.max_position_error_after_4s,
+            max_position_error_6_to_12s: paper.max_position_error_6_to_12s,
+            final_v_x: s.final_v_x,
+            saturated_periods: s.saturated_periods,
+            real_time_factor: s.real_time_factor,
+        });
+        series.push(PlotSeries::from_samples(
+            &sc.name,
+            Some(sc.relaxation),
+            &r.samples,
+        ));
+    }
+    let na =
+        |v: Option<f64>, prec: usize| v.map_or_else(|| "-".to_string(), |x| format!("{x:.prec$}"));
+    println!(
+        "{:>5} {:>11} {:>11} {:>10} {:>6} {:>9} {:>10} {:>10} {:>10} {:>6}",
+        "s",
+        "max phi_d",
+        "atan(c_y)",
+        "max e_f",
+        "at t",
+        "e_f>1uN",
+        "|e_x|t>=4",
+        "|e_x|6-12",
+        "final V_x",
+        "sat."
+    );
+    println!(
+        "{:>5} {:>11} {:>11} {:>10} {:>6} {:>9} {:>10} {:>10} {:>10} {:>6}",
+        "", "(rad)", "(rad)", "(N)", "(s)", "from (s)", "(m)", "(m)", "", "(per.)"
+    );
+    for r in &rows {
+        println!(
+            "{:>5} {:>11.6} {:>11.6} {:>10.3e} {:>6.2} {:>9} {:>10.4} {:>10} {:>10.3e} {:>6}",
+            r.relaxation,
+            r.max_planned_roll.unwrap_or(f64::NAN),
+            r.hover_roll_limit,
+            r.max_e_f.unwrap_or(f64::NAN),
+            r.max_e_f_time.unwrap_or(f64::NAN),
+            na(r.e_f_onset, 2),
+            r.max_position_error_after_4s,
+            na(r.max_position_error_6_to_12s, 4),
+            r.final_v_x.unwrap_or(f64::NAN),
+            r.saturated_periods
+        );
+    }
+    if let Some(p) = &summary {
+        write_json(p, &rows)?;
+        println!("summary:  {}", p.display());
+    }
+    if let Some(dir) = &plots {
+        let path = dir.join("relaxation.png");
+        plot::relaxation_study(&series, &path)?;
+        println!("figure:   {}", path.display());
+    }
+    if let Some(dir) = &logs {
+        println!("logs:     {}", dir.display());
+    }
+    Ok(())
+}
+
+fn cmd_plot(logs: &[PathBuf], out: &Path) -> Result<(), CliError> {
+    let mut all = Vec::new();
+    for path in logs {
+        let series = PlotSeries::from_mcap_file(path)?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| series.label.clone());
+        for p in plot::write_run_figures(&series, out, &stem)? {
+            println!("figure:   {}", p.display());
+        }
+        all.push(series);
+    }
+    if all.len() > 1 {
+        let path = out.join("relaxation.png");
+        plot::relaxation_study(&all, &path)?;
+        println!("figure:   {}", path.display());
+    }
+    Ok(())
+}
