@@ -17,9 +17,9 @@
 //!
 //! Layout: one Rust module per core area ([`team`], [`afs`], [`planner`], [`law`],
 //! [`allocation`], [`controller`]), each with a `register` function called by the module
-//! initializer. The simulator bindings (`tvmd.sim`) will follow the same pattern: a `sim`
-//! module whose `register` builds a submodule `_tvmd.sim` (added with `m.add_submodule`), and
-//! a `python/tvmd/sim.py` re-exporting it, so that `import tvmd.sim` works.
+//! initializer. The simulator `tvmd-sim` is the submodule `_tvmd.sim` ([`sim`], added with
+//! `m.add_submodule`), re-exported by `python/tvmd/sim.py` so that `import tvmd.sim` works
+//! (stubs in `python/tvmd/sim.pyi`).
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -40,6 +40,7 @@ mod convert;
 mod errors;
 mod law;
 mod planner;
+mod sim;
 mod team;
 
 /// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
@@ -61,5 +62,6 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     law::register(m)?;
     allocation::register(m)?;
     controller::register(m)?;
+    sim::register(m)?;
     Ok(())
 }

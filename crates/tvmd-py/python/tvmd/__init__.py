@@ -13,6 +13,7 @@ UAV*). Equation numbers refer to the paper.
   :func:`control_wrench` -- the control law (eq. 12).
 * :func:`allocate` -- the allocators (pseudo-inverse, weighted, redistributed, Clarabel).
 * :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`.
+* :mod:`tvmd.sim` -- the simulator ``tvmd-sim`` (the paper's simulation, relaxation study).
 
 Arrays are float64 NumPy arrays, SI units, z up, twist ``xi = [Omega; v]`` in the body frame,
 wrenches ``[torque; force]``. Errors: ``ValueError`` (wrong shapes, NaN/inf; the subclasses
@@ -48,6 +49,7 @@ from ._tvmd import (
     gimbal_inverse,
     thrust_direction,
 )
+from . import sim  # the submodule tvmd.sim (not in __all__)
 
 __all__ = [
     "ALLOCATORS",

@@ -9,6 +9,9 @@ from typing import Any, Iterable, Mapping, Optional, Tuple, Union, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+# The submodule `_tvmd.sim` (the simulator), re-exported as `tvmd.sim`; stubs in `sim.pyi`.
+from . import sim as sim
+
 __version__: str
 CAPACITY: int
 GRAVITY: float
