@@ -18,13 +18,15 @@ cargo fmt --all -- --check
 
 step "cargo clippy -D warnings (default features, then with clarabel)"
 cargo clippy --workspace --all-targets -- -D warnings
-cargo clippy -p tvmd-core -p tvmd --all-targets --features tvmd-core/clarabel,tvmd/clarabel -- -D warnings
+cargo clippy -p tvmd-core -p tvmd -p tvmd-sim -p tvmd-py --all-targets \
+  --features tvmd-core/clarabel,tvmd/clarabel,tvmd-sim/clarabel,tvmd-py/clarabel -- -D warnings
 
 step "cargo test (workspace)"
 cargo test --workspace
 
-step "cargo test --features clarabel (core with the constrained allocator)"
+step "cargo test --features clarabel (the constrained allocator; the paper scenario flown with it)"
 cargo test -p tvmd-core --features clarabel
+cargo test -p tvmd-sim --features clarabel --test closed_loop
 
 step "benchmarks compile (cargo bench --no-run)"
 cargo bench --workspace --no-run
@@ -41,7 +43,7 @@ python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet -r crates/tvmd-py/requirements-test.txt
 rm -rf target/wheels
-.venv/bin/maturin build --release -m crates/tvmd-py/Cargo.toml -o target/wheels
+.venv/bin/maturin build --release --features clarabel -m crates/tvmd-py/Cargo.toml -o target/wheels
 .venv/bin/python -m pip install --quiet --force-reinstall --no-deps target/wheels/tvmd-*.whl
 .venv/bin/python -m pytest -q crates/tvmd-py/tests
 

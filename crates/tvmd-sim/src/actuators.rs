@@ -36,13 +36,8 @@ impl AgentCommand {
     }
 }
 
-/// Thrust direction in the agent frame (eq. 1):
-/// `a_hat = [cos(eta_x) sin(eta_y), -sin(eta_x), cos(eta_x) cos(eta_y)]`.
-pub fn thrust_direction(eta_x: f64, eta_y: f64) -> Vector3<f64> {
-    let (sx, cx) = eta_x.sin_cos();
-    let (sy, cy) = eta_y.sin_cos();
-    Vector3::new(cx * sy, -sx, cx * cy)
-}
+/// `a_hat(eta_x, eta_y)` of eq. (1): the plant uses the core's gimbal model.
+pub use tvmd_core::gimbal::thrust_direction;
 
 /// The agent's force in the team (body) frame: `T R_z(m_i pi/2) a_hat(eta_x, eta_y)`.
 pub fn agent_force_body(cmd: &AgentCommand, quarter_turns: i32) -> Vector3<f64> {
@@ -251,7 +246,7 @@ mod tests {
 
     #[test]
     fn direction_is_unit_and_matches_eq1() {
-        let d = thrust_direction(0.3, -0.7);
+        let d = thrust_direction(0.3f64, -0.7);
         assert!((d.norm() - 1.0).abs() < 1e-15);
         assert!(
             (d - Vector3::new(

@@ -7,17 +7,9 @@ pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// The exact rotation `R_z(m pi/2)` about the body z axis by `m` quarter turns.
-///
-/// Entries are exactly 0 or +-1 (no trigonometric round-off); `m` may be any integer
-/// (it is reduced modulo 4, negative values included).
+/// `R_z(m pi/2)`, exact for whole quarter turns (the core's, shared by plant and controller).
 pub fn quarter_turn(m: i32) -> Matrix3<f64> {
-    match m.rem_euclid(4) {
-        0 => Matrix3::identity(),
-        1 => Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0),
-        2 => Matrix3::new(-1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0),
-        _ => Matrix3::new(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0),
-    }
+    tvmd_core::effectiveness::quarter_turn(m)
 }
 
 /// Rotation about the world x axis by `angle` (roll).
