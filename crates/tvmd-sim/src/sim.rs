@@ -555,7 +555,7 @@ impl Simulation {
             roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
             reference_roll_pitch_yaw: roll_pitch_yaw(&r.rotation),
             reference_roll: r.roll,
-            planned_roll: r_d.map(|m| m[(2, 1)].atan2(m[(2, 2)])),
+            planned_roll: r_d.as_ref().map(crate::control::planned_roll),
             planned_roll_pitch_yaw: r_d.as_ref().map(roll_pitch_yaw),
             attitude_error: r_d
                 .as_ref()
