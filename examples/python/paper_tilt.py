@@ -12,7 +12,7 @@ the infeasible pi/3 between 4 s and 10 s, descent; SPEC "The paper's simulation"
 
 Usage (after installing the wheel, see crates/tvmd-py/README.md)::
 
-    python examples/python/paper_tilt.py --out paper_tilt.png [--s 0.5] [--mcap run.mcap]
+    python examples/python/paper_tilt.py --out paper_tilt.png [--relaxation 0.5] [--mcap run.mcap]
 
 matplotlib is optional for the bindings but needed here (``pip install matplotlib``); without
 ``--show`` the figure is written with the Agg backend, so no display is needed.
@@ -31,7 +31,8 @@ import tvmd.sim
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--s", type=float, default=0.5, help="planner relaxation s in (0, 1] (0.5)")
+    p.add_argument("--relaxation", "--s", dest="relaxation", type=float, default=0.5,
+                   help="planner relaxation s in (0, 1] (0.5)")  # fmt: skip
     p.add_argument("--scenario", default="paper-tilt",
                    help="built-in scenario or TOML file (paper-tilt)")  # fmt: skip
     p.add_argument("--out", default="paper_tilt.png", help="figure file (paper_tilt.png)")
@@ -120,7 +121,7 @@ def main(argv=None):
     args = parse_args(argv)
     plt = load_pyplot(args.show)
     try:
-        r = tvmd.sim.run(args.scenario, relaxation=args.s, mcap=args.mcap)
+        r = tvmd.sim.run(args.scenario, relaxation=args.relaxation, mcap=args.mcap)
     except (ValueError, OSError, RuntimeError) as e:
         sys.exit(f"error: {e}")
     print_summary(r)

@@ -2,10 +2,9 @@
 //! chosen by name at run time (`tvmd_core::AnyAllocator`).
 
 use nalgebra::{Vector3, Vector6};
-use numpy::{PyArray1, PyArray2};
+use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator, GimbalCommand,
@@ -13,10 +12,11 @@ use tvmd_core::{
 };
 
 use crate::convert::{
-    any, array1, bool_array, check_finite, class_arg, finite_scalar, float_array, record_dict,
-    record_repr, rows_array, shape_error, shape_str, vector6,
+    array1, bool_array, check_finite, class_arg, finite_scalar, float_array, rows_array,
+    shape_error, shape_str, vector6,
 };
 use crate::errors::OrRaise;
+use crate::record::record;
 use crate::team::{failure_mask, PyTeam};
 use crate::CAPACITY;
 
@@ -36,9 +36,6 @@ pub(crate) const ALLOCATORS: &[&str] = &[
     "weighted-pseudo-inverse",
     "redistributed-pseudo-inverse",
 ];
-
-/// The default allocator (also the controller's).
-pub(crate) const DEFAULT_ALLOCATOR: &str = "redistributed-pseudo-inverse";
 
 /// Options of the allocators that take any.
 pub(crate) struct AllocatorOptions<'a, 'py> {
@@ -226,7 +223,7 @@ pub(crate) fn rate_limits_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option
 ///         apply to the method, wrong shapes, NaN/inf input.
 ///     ConfigError: a degraded team that cannot produce every wrench, bad weights or rates.
 #[pyfunction]
-#[pyo3(signature = (team, wrench, method = DEFAULT_ALLOCATOR, weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None))]
+#[pyo3(signature = (team, wrench, method = "redistributed-pseudo-inverse", weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn allocate(
     team: &Bound<'_, PyAny>,
@@ -285,143 +282,68 @@ pub(crate) fn allocate(
         wrench: Vector6::from(u_d),
     };
     let allocation = allocator.allocate(&request);
-    Ok(PyAllocation::new(&allocation, n, name, report(&allocator)))
+    Ok(PyAllocation {
+        inner: AllocationData {
+            allocation,
+            n,
+            method: name,
+            report: report(&allocator),
+        },
+    })
 }
 
-/// The result of one allocation.
-///
-/// Attributes:
-///     forces: (n, 3) agent-frame forces `f_i`, each inside its admissible set (zero for
-///         failed agents).
-///     wrench: (6,) `u = M f`, the wrench they produce.
-///     e_f: `||u_fd - u_f||`, the paper's allocation error (force part).
-///     wrench_error: `||u_d - M f||` over the whole wrench.
-///     rounds: solve rounds (pseudo-inverse 1, redistribution up to n, Clarabel iterations).
-///     saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
-///     fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
-///     method: the allocator's name.
-///     report: Clarabel's solve report (text), None for the other allocators.
-#[pyclass(module = "tvmd", name = "Allocation", frozen)]
-pub struct PyAllocation {
-    forces: Vec<[f64; 3]>,
-    wrench: [f64; 6],
-    e_f: f64,
-    wrench_error: f64,
-    rounds: u32,
-    saturated: Vec<bool>,
-    fallback: bool,
-    method: &'static str,
-    report: Option<String>,
+/// A core allocation with what the bindings add: the agent count, the allocator's name and
+/// Clarabel's report.
+pub(crate) struct AllocationData {
+    pub(crate) allocation: Allocation<f64, CAPACITY>,
+    pub(crate) n: usize,
+    pub(crate) method: &'static str,
+    pub(crate) report: Option<String>,
 }
 
-impl PyAllocation {
-    /// The first `n` agents of a core allocation.
-    pub(crate) fn new(
-        allocation: &Allocation<f64, CAPACITY>,
-        n: usize,
-        method: &'static str,
-        report: Option<String>,
-    ) -> Self {
-        let mut wrench = [0.0; 6];
-        for (w, x) in wrench.iter_mut().zip(allocation.wrench.iter()) {
-            *w = *x;
-        }
-        Self {
-            forces: allocation
-                .forces
-                .iter()
-                .take(n)
-                .map(|f: &Vector3<f64>| [f.x, f.y, f.z])
-                .collect(),
-            wrench,
-            e_f: allocation.e_f,
-            wrench_error: allocation.wrench_error,
-            rounds: allocation.rounds,
-            saturated: allocation.saturated.iter().take(n).copied().collect(),
-            fallback: allocation.fallback,
-            method,
-            report,
-        }
-    }
-
-    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Vec<(&'static str, Bound<'py, PyAny>)>> {
-        Ok(vec![
-            ("forces", self.forces(py).into_any()),
-            ("wrench", self.wrench(py).into_any()),
-            ("e_f", any(py, self.e_f)?),
-            ("wrench_error", any(py, self.wrench_error)?),
-            ("rounds", any(py, self.rounds)?),
-            ("saturated", self.saturated(py).into_any()),
-            ("fallback", any(py, self.fallback)?),
-            ("method", any(py, self.method)?),
-            ("report", any(py, self.report.clone())?),
-        ])
-    }
+/// The forces of the first `n` agents as `(n, 3)`.
+pub(crate) fn forces_array<'py>(
+    py: Python<'py>,
+    forces: &[Vector3<f64>],
+    n: usize,
+) -> Bound<'py, PyArray2<f64>> {
+    let rows: Vec<[f64; 3]> = forces.iter().take(n).map(|f| [f.x, f.y, f.z]).collect();
+    rows_array(py, &rows)
 }
 
-#[pymethods]
-impl PyAllocation {
-    /// (n, 3) agent-frame forces.
-    #[getter]
-    fn forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        rows_array(py, &self.forces)
-    }
-
-    /// (6,) `u = M f`.
-    #[getter]
-    fn wrench<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, &self.wrench)
-    }
-
-    /// `e_f = ||u_fd - u_f||`.
-    #[getter]
-    fn e_f(&self) -> f64 {
-        self.e_f
-    }
-
-    /// `||u_d - M f||`.
-    #[getter]
-    fn wrench_error(&self) -> f64 {
-        self.wrench_error
-    }
-
-    /// Solve rounds.
-    #[getter]
-    fn rounds(&self) -> u32 {
-        self.rounds
-    }
-
-    /// (n,) saturated agents.
-    #[getter]
-    fn saturated<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        bool_array(py, &self.saturated)
-    }
-
-    /// Whether the allocator fell back to the redistributed pseudo-inverse.
-    #[getter]
-    fn fallback(&self) -> bool {
-        self.fallback
-    }
-
-    /// The allocator's name.
-    #[getter]
-    fn method(&self) -> &'static str {
-        self.method
-    }
-
-    /// Clarabel's solve report, None otherwise.
-    #[getter]
-    fn report(&self) -> Option<String> {
-        self.report.clone()
-    }
-
-    /// The fields as a dict.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py)?)
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("Allocation", &self.fields(py)?)
+record! {
+    /// The result of one allocation.
+    ///
+    /// Attributes:
+    ///     forces: (n, 3) agent-frame forces `f_i`, each inside its admissible set (zero for
+    ///         failed agents).
+    ///     wrench: (6,) `u = M f`, the wrench they produce.
+    ///     e_f: `||u_fd - u_f||`, the paper's allocation error (force part).
+    ///     wrench_error: `||u_d - M f||` over the whole wrench.
+    ///     rounds: solve rounds (pseudo-inverse 1, redistribution up to n, Clarabel iterations).
+    ///     saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
+    ///     fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
+    ///     method: the allocator's name.
+    ///     report: Clarabel's solve report (text), None for the other allocators.
+    "Allocation" in "tvmd" => PyAllocation(AllocationData) |py, o| {
+        /// (n, 3) agent-frame forces.
+        forces => forces_array(py, &o.allocation.forces, o.n),
+        /// (6,) `u = M f`.
+        wrench => array1(py, o.allocation.wrench.as_slice()),
+        /// `e_f = ||u_fd - u_f||`.
+        e_f => o.allocation.e_f,
+        /// `||u_d - M f||`.
+        wrench_error => o.allocation.wrench_error,
+        /// Solve rounds.
+        rounds => o.allocation.rounds,
+        /// (n,) saturated agents.
+        saturated => bool_array(py, o.allocation.saturated.get(..o.n).unwrap_or_default()),
+        /// Whether the allocator fell back to the redistributed pseudo-inverse.
+        fallback => o.allocation.fallback,
+        /// The allocator's name.
+        method => o.method,
+        /// Clarabel's solve report, None otherwise.
+        report => o.report.clone(),
     }
 }
 

@@ -1,25 +1,20 @@
 //! `tvmd.Controller` (one `step` per control period) and its `StepOutput`.
 
-use numpy::{PyArray1, PyArray2};
+use numpy::PyArray2;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
 
 use tvmd_core::team::presets;
-use tvmd_core::{
-    AnyAllocator, AttitudePlanner, ControlOutput, Controller, ControllerSettings, Relaxation,
-};
+use tvmd_core::{AnyAllocator, AttitudePlanner, ControlOutput, Controller, ControllerSettings};
 
-use crate::afs::PyAfs;
+use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{
-    make_allocator, rate_limits_arg, report, AllocatorOptions, DEFAULT_ALLOCATOR,
+    make_allocator, rate_limits_arg, report, AllocationData, AllocatorOptions, PyAllocation,
 };
-use crate::convert::{
-    any, array1, bool_array, class_arg, commands_array, matrix_array, record_dict, record_repr,
-    rows_array,
-};
+use crate::convert::{array1, class_arg, commands_array};
 use crate::errors::{cycle_error, OrRaise};
-use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
-use crate::planner::{iteration_cap, status_name};
+use crate::law::{gains_arg, reference_arg, state_arg, PyGains, PyLawOutput};
+use crate::planner::{iteration_cap, relaxation_arg, PyPlannerResult};
+use crate::record::record;
 use crate::team::{failed_list, failure_mask, PyTeam};
 use crate::CAPACITY;
 
@@ -31,7 +26,8 @@ use crate::CAPACITY;
 /// Args:
 ///     team: the `Team`.
 ///     gains: `Gains`; None for the paper's (`Gains.paper()`).
-///     s: AFS relaxation of the planner, in (0, 1].
+///     relaxation: AFS relaxation `s` of the planner, in (0, 1]; default 0.5 (`s=` is an
+///         alias).
 ///     gravity: `g` (m/s^2).
 ///     period: control period `dt` (s) (used by the rate limits).
 ///     allocator: allocator name (see `tvmd.ALLOCATORS` and `tvmd.allocate`).
@@ -56,12 +52,12 @@ pub struct PyController {
 #[pymethods]
 impl PyController {
     #[new]
-    #[pyo3(signature = (team, gains = None, s = 0.5, gravity = presets::GRAVITY, period = 0.01, allocator = DEFAULT_ALLOCATOR, rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "redistributed-pseudo-inverse", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,
         gains: Option<&Bound<'_, PyAny>>,
-        s: f64,
+        relaxation: Option<f64>,
         gravity: f64,
         period: f64,
         allocator: &str,
@@ -71,9 +67,10 @@ impl PyController {
         regularization: Option<f64>,
         planner_tolerance: Option<f64>,
         planner_max_iterations: Option<i64>,
+        s: Option<f64>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
-        let relaxation = Relaxation::new(s).or_raise()?;
+        let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
         let settings = ControllerSettings {
             gains: gains_arg(gains)?,
             relaxation,
@@ -151,9 +148,12 @@ impl PyController {
         let n = self.inner.team().len();
         match self.inner.step(&state, &reference) {
             Ok(out) => Ok(PyStepOutput {
-                out: Box::new(out),
-                n,
-                report: report(self.inner.allocator()),
+                inner: StepData {
+                    out: Box::new(out),
+                    n,
+                    method: self.allocator,
+                    report: report(self.inner.allocator()),
+                },
             }),
             Err(error) => Err(cycle_error(py, &error, n)),
         }
@@ -177,7 +177,7 @@ impl PyController {
 
     /// The planner relaxation `s`.
     #[getter]
-    fn s(&self) -> f64 {
+    fn relaxation(&self) -> f64 {
         self.inner.settings().relaxation.get()
     }
 
@@ -240,287 +240,59 @@ impl PyController {
 
     fn __repr__(&self) -> String {
         format!(
-            "Controller(n={}, s={}, allocator='{}', failed={:?})",
+            "Controller(n={}, relaxation={}, allocator='{}', failed={:?})",
             self.inner.team().len(),
-            self.s(),
+            self.relaxation(),
             self.allocator,
             self.failed()
         )
     }
 }
 
-/// Everything one `Controller.step` computed (read-only; arrays are fresh copies).
-///
-/// Attributes:
-///     R_d: (3, 3) planned attitude. theta: planned tilt (rad).
-///     planner_status: "already_feasible", "planned", "zero_force" or "unreachable".
-///     planner_iterations: bisection iterations.
-///     t_Tf, t_eta: the force-projection factors, `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
-///     f_r: (3,) `t_Tf R u_fr`, the inertial force the planner aligns with.
-///     u_r: (6,) `[u_tau_r; u_fr]`. u_d: (6,) `blockdiag(I, K_f) u_r`.
-///     wrench: (6,) `M f`, the allocated wrench.
-///     e_f: `||u_fd - u_f||`. wrench_error: `||u_d - M f||`.
-///     e_x: (3,). e_R: (3,). e_xi: (6,) `[e_Omega; e_v]`. V_R, V_x: Lyapunov values.
-///     forces: (n, 3) agent-frame forces. commands: (n, 4) columns `eta_x, eta_y, thrust, omega`
-///         (idle for failed agents). saturated: (n,) bool. rounds: allocator rounds.
-///     fallback: the allocator fell back to the redistributed pseudo-inverse.
-///     command_clamp: the largest clamp the command inversion applied (normalized).
-///     allocator_report: Clarabel's solve report (text), None for the other allocators.
-#[pyclass(module = "tvmd", name = "StepOutput", frozen)]
-pub struct PyStepOutput {
+/// One `Controller.step` as the bindings keep it: the core's output and what `StepOutput`
+/// adds (the agent count, the allocator's name and Clarabel's report).
+pub(crate) struct StepData {
     out: Box<ControlOutput<f64, CAPACITY>>,
     n: usize,
+    method: &'static str,
     report: Option<String>,
 }
 
-/// The field names of `StepOutput`, in `to_dict` / `repr` order.
-const STEP_FIELDS: &[&str] = &[
-    "R_d",
-    "theta",
-    "planner_status",
-    "planner_iterations",
-    "t_Tf",
-    "t_eta",
-    "f_r",
-    "u_r",
-    "u_d",
-    "wrench",
-    "e_f",
-    "wrench_error",
-    "e_x",
-    "e_R",
-    "e_xi",
-    "V_R",
-    "V_x",
-    "forces",
-    "commands",
-    "saturated",
-    "rounds",
-    "fallback",
-    "command_clamp",
-    "allocator_report",
-];
-
-impl PyStepOutput {
-    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let o = &self.out;
-        Ok(match name {
-            "R_d" => self.r_d(py).into_any(),
-            "theta" => any(py, o.planner.theta)?,
-            "planner_status" => any(py, status_name(o.planner.status))?,
-            "planner_iterations" => any(py, o.planner.iterations)?,
-            "t_Tf" => any(py, o.projection.t_tf)?,
-            "t_eta" => any(py, o.projection.t_eta)?,
-            "f_r" => self.f_r(py).into_any(),
-            "u_r" => self.u_r(py).into_any(),
-            "u_d" => self.u_d(py).into_any(),
-            "wrench" => self.wrench(py).into_any(),
-            "e_f" => any(py, o.allocation.e_f)?,
-            "wrench_error" => any(py, o.allocation.wrench_error)?,
-            "e_x" => self.e_x(py).into_any(),
-            "e_R" => self.e_r(py).into_any(),
-            "e_xi" => self.e_xi(py).into_any(),
-            "V_R" => any(py, o.law.v_r)?,
-            "V_x" => any(py, o.law.v_x)?,
-            "forces" => self.forces(py).into_any(),
-            "commands" => self.commands(py).into_any(),
-            "saturated" => self.saturated(py).into_any(),
-            "rounds" => any(py, o.allocation.rounds)?,
-            "fallback" => any(py, o.allocation.fallback)?,
-            "command_clamp" => any(py, o.command_clamp)?,
-            "allocator_report" => any(py, self.report.clone())?,
-            other => {
-                return Err(pyo3::exceptions::PyAttributeError::new_err(format!(
-                    "StepOutput has no field '{other}'"
-                )))
-            }
-        })
-    }
-
-    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Vec<(&'static str, Bound<'py, PyAny>)>> {
-        STEP_FIELDS
-            .iter()
-            .map(|name| Ok((*name, self.field(py, name)?)))
-            .collect()
-    }
-}
-
-#[pymethods]
-impl PyStepOutput {
-    /// (3, 3) planned attitude `R_d`.
-    #[getter(R_d)]
-    fn r_d<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.out.planner.r_d)
-    }
-
-    /// Planned tilt `theta*` (rad).
-    #[getter]
-    fn theta(&self) -> f64 {
-        self.out.planner.theta
-    }
-
-    /// "already_feasible", "planned", "zero_force" or "unreachable".
-    #[getter]
-    fn planner_status(&self) -> &'static str {
-        status_name(self.out.planner.status)
-    }
-
-    /// Bisection iterations.
-    #[getter]
-    fn planner_iterations(&self) -> u32 {
-        self.out.planner.iterations
-    }
-
-    /// `t_Tf`.
-    #[getter(t_Tf)]
-    fn t_tf(&self) -> f64 {
-        self.out.projection.t_tf
-    }
-
-    /// `t_eta`.
-    #[getter]
-    fn t_eta(&self) -> f64 {
-        self.out.projection.t_eta
-    }
-
-    /// (3,) `f_r = t_Tf R u_fr` (inertial).
-    #[getter]
-    fn f_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.f_r.as_slice())
-    }
-
-    /// (6,) `u_r = [u_tau_r; u_fr]`.
-    #[getter]
-    fn u_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.law.u_r.as_slice())
-    }
-
-    /// (6,) `u_d = blockdiag(I, K_f) u_r`.
-    #[getter]
-    fn u_d<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.law.u_d.as_slice())
-    }
-
-    /// (6,) `M f`, the allocated wrench.
-    #[getter]
-    fn wrench<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.allocation.wrench.as_slice())
-    }
-
-    /// `e_f = ||u_fd - u_f||`.
-    #[getter]
-    fn e_f(&self) -> f64 {
-        self.out.allocation.e_f
-    }
-
-    /// `||u_d - M f||`.
-    #[getter]
-    fn wrench_error(&self) -> f64 {
-        self.out.allocation.wrench_error
-    }
-
-    /// (3,) `e_x = x - x_r`.
-    #[getter]
-    fn e_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.law.e_x.as_slice())
-    }
-
-    /// (3,) `e_R`.
-    #[getter(e_R)]
-    fn e_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.law.e_r.as_slice())
-    }
-
-    /// (6,) `e_xi = [e_Omega; e_v]`.
-    #[getter]
-    fn e_xi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.out.law.e_xi.as_slice())
-    }
-
-    /// `V_R`.
-    #[getter(V_R)]
-    fn v_r(&self) -> f64 {
-        self.out.law.v_r
-    }
-
-    /// `V_x`.
-    #[getter(V_x)]
-    fn v_x(&self) -> f64 {
-        self.out.law.v_x
-    }
-
-    /// (n, 3) agent-frame forces.
-    #[getter]
-    fn forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let rows: Vec<[f64; 3]> = self
-            .out
-            .allocation
-            .forces
-            .iter()
-            .take(self.n)
-            .map(|f| [f.x, f.y, f.z])
-            .collect();
-        rows_array(py, &rows)
-    }
-
-    /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
-    #[getter]
-    fn commands<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        commands_array(py, &self.out.commands, self.n)
-    }
-
-    /// (n,) saturated agents.
-    #[getter]
-    fn saturated<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let saturated: Vec<bool> = self
-            .out
-            .allocation
-            .saturated
-            .iter()
-            .take(self.n)
-            .copied()
-            .collect();
-        bool_array(py, &saturated)
-    }
-
-    /// Allocator rounds.
-    #[getter]
-    fn rounds(&self) -> u32 {
-        self.out.allocation.rounds
-    }
-
-    /// Whether the allocator fell back to the redistributed pseudo-inverse.
-    #[getter]
-    fn fallback(&self) -> bool {
-        self.out.allocation.fallback
-    }
-
-    /// Largest clamp of the command inversion (normalized).
-    #[getter]
-    fn command_clamp(&self) -> f64 {
-        self.out.command_clamp
-    }
-
-    /// Clarabel's solve report, None otherwise.
-    #[getter]
-    fn allocator_report(&self) -> Option<String> {
-        self.report.clone()
-    }
-
-    /// The field names, in `to_dict` order.
-    #[classattr]
-    #[pyo3(name = "FIELDS")]
-    fn field_names<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        PyTuple::new(py, STEP_FIELDS)
-    }
-
-    /// The fields as a dict.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py)?)
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("StepOutput", &self.fields(py)?)
+record! {
+    /// Everything one `Controller.step` computed, nested like the core's `ControlOutput`
+    /// (read-only; each access returns fresh arrays).
+    ///
+    /// Attributes:
+    ///     planner: PlannerResult (`R_d`, `theta`, `iterations`, `status`).
+    ///     projection: ForceProjection (`force = K_f u_fr`, `t_Tf`, `t_eta`).
+    ///     f_r: (3,) `t_Tf R u_fr`, the inertial force the planner aligns with.
+    ///     law: LawOutput (`e_x`, `e_R`, `e_xi`, `u_r`, `u_d`, `V_R`, `V_x`).
+    ///     allocation: Allocation (`forces`, `wrench` = `M f`, `e_f`, `wrench_error`, `rounds`,
+    ///         `saturated`, `fallback`, `method`, `report`).
+    ///     commands: (n, 4) columns `eta_x, eta_y, thrust, omega` (idle for failed agents).
+    ///     command_clamp: the largest clamp the command inversion applied (normalized).
+    "StepOutput" in "tvmd" => PyStepOutput(StepData) |py, o| {
+        /// The planner's result (eqs. 9-11).
+        planner => PyPlannerResult { inner: o.out.planner },
+        /// The force projection `K_f` (eqs. 12-13).
+        projection => PyForceProjection { inner: o.out.projection },
+        /// (3,) `f_r = t_Tf R u_fr` (inertial).
+        f_r => array1(py, o.out.f_r.as_slice()),
+        /// The control law's output (eq. 12).
+        law => PyLawOutput { inner: o.out.law },
+        /// The allocation (eqs. 4 and 6).
+        allocation => PyAllocation {
+            inner: AllocationData {
+                allocation: o.out.allocation,
+                n: o.n,
+                method: o.method,
+                report: o.report.clone(),
+            },
+        },
+        /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
+        commands => commands_array(py, &o.out.commands, o.n),
+        /// Largest clamp of the command inversion (normalized).
+        command_clamp => o.out.command_clamp,
     }
 }
 

@@ -412,30 +412,6 @@ pub(crate) fn commands_array<'py>(
     rows_array(py, &rows)
 }
 
-/// A dataclass-like `Name(field=repr, ...)` from named values.
-pub(crate) fn record_repr(
-    name: &str,
-    fields: &[(&'static str, Bound<'_, PyAny>)],
-) -> PyResult<String> {
-    let mut parts = Vec::with_capacity(fields.len());
-    for (key, value) in fields {
-        parts.push(format!("{key}={}", value.repr()?));
-    }
-    Ok(format!("{name}({})", parts.join(", ")))
-}
-
-/// A dict from named values.
-pub(crate) fn record_dict<'py>(
-    py: Python<'py>,
-    fields: Vec<(&'static str, Bound<'py, PyAny>)>,
-) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
-    let dict = pyo3::types::PyDict::new(py);
-    for (key, value) in fields {
-        dict.set_item(key, value)?;
-    }
-    Ok(dict)
-}
-
 /// `value.into_bound_py_any(py)` for the field lists of the result records.
 pub(crate) fn any<'py, T>(py: Python<'py>, value: T) -> PyResult<Bound<'py, PyAny>>
 where

@@ -12,11 +12,11 @@ use tvmd_core::law::{LawOutput, Plant};
 use tvmd_core::{Gains, Reference, RigidState};
 
 use crate::convert::{
-    any, array1, check_finite, class_arg, finite_matrix3, finite_scalar, finite_vector3,
-    float_array, matrix3, matrix3_or_diagonal, matrix_array, record_dict, record_repr, shape_error,
-    vector3,
+    array1, check_finite, class_arg, finite_matrix3, finite_scalar, finite_vector3, float_array,
+    matrix3, matrix3_or_diagonal, matrix_array, shape_error, vector3,
 };
 use crate::errors::OrRaise;
+use crate::record::record;
 
 /// Whether every off-diagonal entry is zero.
 fn is_diagonal(m: &Matrix3<f64>) -> bool {
@@ -26,22 +26,6 @@ fn is_diagonal(m: &Matrix3<f64>) -> bool {
 // ---------------------------------------------------------------------------------------------
 // Gains
 // ---------------------------------------------------------------------------------------------
-
-/// Gains of the control law (eq. 12): `K_x`, `K_R` and `K_xi = blockdiag(K_Omega, K_v)`
-/// (twist order `[Omega; v]`). Not scaled by mass or inertia.
-///
-/// Args:
-///     k_x: `K_x`, (3,) diagonal or (3, 3) symmetric with a positive diagonal.
-///     k_r: `K_R`, (3,) diagonal or (3, 3).
-///     k_xi: `K_xi`, (6,) diagonal or a block-diagonal (6, 6) matrix `blockdiag(K_Omega, K_v)`.
-///
-/// Raises:
-///     ConfigError: a gain is not finite, not symmetric or has a non-positive diagonal entry.
-///     ValueError: wrong shapes, or a (6, 6) `k_xi` with non-zero off-diagonal blocks.
-#[pyclass(module = "tvmd", name = "Gains", frozen)]
-pub struct PyGains {
-    pub(crate) inner: Gains<f64>,
-}
 
 /// `K_xi` from a (6,) diagonal or a block-diagonal (6, 6) matrix: `(K_Omega, K_v)`.
 fn k_xi_blocks(obj: &Bound<'_, PyAny>) -> PyResult<(Matrix3<f64>, Matrix3<f64>)> {
@@ -73,94 +57,71 @@ fn k_xi_blocks(obj: &Bound<'_, PyAny>) -> PyResult<(Matrix3<f64>, Matrix3<f64>)>
     }
 }
 
-#[pymethods]
-impl PyGains {
-    #[new]
-    fn new(
-        k_x: &Bound<'_, PyAny>,
-        k_r: &Bound<'_, PyAny>,
-        k_xi: &Bound<'_, PyAny>,
-    ) -> PyResult<Self> {
-        let k_x = matrix3_or_diagonal(k_x, "k_x")?;
-        let k_r = matrix3_or_diagonal(k_r, "k_r")?;
-        let (k_omega, k_v) = k_xi_blocks(k_xi)?;
-        let inner = Gains::new(k_x, k_r, k_omega, k_v).or_raise()?;
-        Ok(Self { inner })
+/// `Gains(k_x=[..], ...)` for diagonal gains, else `Gains(<full matrices>)`.
+fn gains_repr(g: &Gains<f64>) -> String {
+    let d = |m: &Matrix3<f64>| format!("[{}, {}, {}]", m.m11, m.m22, m.m33);
+    if [g.k_x, g.k_r, g.k_omega, g.k_v].iter().all(is_diagonal) {
+        let (x, r, o, v) = (d(&g.k_x), d(&g.k_r), d(&g.k_omega), d(&g.k_v));
+        format!("Gains(k_x={x}, k_r={r}, k_omega={o}, k_v={v})")
+    } else {
+        "Gains(<full matrices>)".to_string()
     }
+}
 
-    /// The paper's gains: `K_x = diag(0.4, 0.4, 1)`, `K_R = diag(12, 12, 1)`,
-    /// `K_xi = diag(8, 8, 1.5, 0.8, 0.8, 2)`.
-    #[staticmethod]
-    fn paper() -> Self {
-        Self {
-            inner: Gains::paper(),
+/// `blockdiag(K_Omega, K_v)` (6, 6).
+fn k_xi<'py>(py: Python<'py>, g: &Gains<f64>) -> Bound<'py, PyArray2<f64>> {
+    let mut k = Matrix6::zeros();
+    k.fixed_view_mut::<3, 3>(0, 0).copy_from(&g.k_omega);
+    k.fixed_view_mut::<3, 3>(3, 3).copy_from(&g.k_v);
+    let values: Vec<f64> = k.transpose().iter().copied().collect();
+    crate::convert::dense_array(py, 6, 6, &values)
+}
+
+record! {
+    /// Gains of the control law (eq. 12): `K_x`, `K_R` and `K_xi = blockdiag(K_Omega, K_v)`
+    /// (twist order `[Omega; v]`). Not scaled by mass or inertia.
+    ///
+    /// Args:
+    ///     k_x: `K_x`, (3,) diagonal or (3, 3) symmetric with a positive diagonal.
+    ///     k_r: `K_R`, (3,) diagonal or (3, 3).
+    ///     k_xi: `K_xi`, (6,) diagonal or a block-diagonal (6, 6) matrix `blockdiag(K_Omega, K_v)`.
+    ///
+    /// Raises:
+    ///     ConfigError: a gain is not finite, not symmetric or has a non-positive diagonal entry.
+    ///     ValueError: wrong shapes, or a (6, 6) `k_xi` with non-zero off-diagonal blocks.
+    "Gains" in "tvmd" => PyGains(Gains<f64>) repr gains_repr |py, o| {
+        /// `K_x` (3, 3).
+        k_x => matrix_array(py, &o.k_x),
+        /// `K_R` (3, 3).
+        k_r => matrix_array(py, &o.k_r),
+        /// `K_Omega` (3, 3), the angular-velocity block of `K_xi`.
+        k_omega => matrix_array(py, &o.k_omega),
+        /// `K_v` (3, 3), the velocity block of `K_xi`.
+        k_v => matrix_array(py, &o.k_v),
+        /// `K_xi = blockdiag(K_Omega, K_v)` (6, 6).
+        k_xi => k_xi(py, o),
+    }
+    methods {
+        #[new]
+        fn new(
+            k_x: &Bound<'_, PyAny>,
+            k_r: &Bound<'_, PyAny>,
+            k_xi: &Bound<'_, PyAny>,
+        ) -> PyResult<Self> {
+            let k_x = matrix3_or_diagonal(k_x, "k_x")?;
+            let k_r = matrix3_or_diagonal(k_r, "k_r")?;
+            let (k_omega, k_v) = k_xi_blocks(k_xi)?;
+            let inner = Gains::new(k_x, k_r, k_omega, k_v).or_raise()?;
+            Ok(Self { inner })
         }
-    }
 
-    /// `K_x` (3, 3).
-    #[getter]
-    fn k_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.k_x)
-    }
-
-    /// `K_R` (3, 3).
-    #[getter]
-    fn k_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.k_r)
-    }
-
-    /// `K_Omega` (3, 3), the angular-velocity block of `K_xi`.
-    #[getter]
-    fn k_omega<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.k_omega)
-    }
-
-    /// `K_v` (3, 3), the velocity block of `K_xi`.
-    #[getter]
-    fn k_v<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.k_v)
-    }
-
-    /// `K_xi = blockdiag(K_Omega, K_v)` (6, 6).
-    #[getter]
-    fn k_xi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let mut k = Matrix6::zeros();
-        k.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&self.inner.k_omega);
-        k.fixed_view_mut::<3, 3>(3, 3).copy_from(&self.inner.k_v);
-        let rows: Vec<[f64; 6]> = k
-            .row_iter()
-            .map(|r| {
-                let mut out = [0.0; 6];
-                for (o, x) in out.iter_mut().zip(r.iter()) {
-                    *o = *x;
-                }
-                out
-            })
-            .collect();
-        crate::convert::rows_array(py, &rows)
-    }
-
-    fn __repr__(&self) -> String {
-        let d = |m: &Matrix3<f64>| format!("[{}, {}, {}]", m.m11, m.m22, m.m33);
-        let diagonal = [
-            self.inner.k_x,
-            self.inner.k_r,
-            self.inner.k_omega,
-            self.inner.k_v,
-        ]
-        .iter()
-        .all(is_diagonal);
-        if diagonal {
-            format!(
-                "Gains(k_x={}, k_r={}, k_omega={}, k_v={})",
-                d(&self.inner.k_x),
-                d(&self.inner.k_r),
-                d(&self.inner.k_omega),
-                d(&self.inner.k_v)
-            )
-        } else {
-            "Gains(<full matrices>)".to_string()
+        /// The paper's gains: `K_x = diag(0.4, 0.4, 1)`, `K_R = diag(12, 12, 1)`,
+        /// `K_xi = diag(8, 8, 1.5, 0.8, 0.8, 2)`.
+        #[staticmethod]
+        fn paper() -> Self {
+            Self {
+                inner: Gains::paper(),
+            }
         }
     }
 }
@@ -178,335 +139,239 @@ pub(crate) fn gains_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Gains<f64>> 
 // State and reference
 // ---------------------------------------------------------------------------------------------
 
-/// The measured state: pose and body-frame twist `xi = [Omega; v]`.
-///
-/// Args:
-///     position: `x` (3,), CoM position in the inertial frame (m), z up.
-///     attitude: `R` (3, 3), body-to-inertial rotation; default identity.
-///     angular_velocity: `Omega` (3,), body frame (rad/s); default 0.
-///     velocity: `v` (3,), body frame, `x_dot = R v` (m/s); default 0.
-///
-/// Wherever a state is expected a dict with these keys is accepted too. Values are not
-/// validated here: `Controller.step` reports NaN/inf or a non-rotation attitude as a
-/// `CycleError`, the law functions as an `InputError`.
-#[pyclass(module = "tvmd", name = "State", frozen)]
-pub struct PyState {
-    pub(crate) inner: RigidState<f64>,
+const STATE_KEYS: &[&str] = &["position", "attitude", "angular_velocity", "velocity"];
+const REFERENCE_KEYS: &[&str] = &[
+    "position",
+    "velocity",
+    "acceleration",
+    "attitude",
+    "angular_velocity",
+    "angular_acceleration",
+];
+
+/// Reads a `State`/`Reference` argument: the class itself, or a dict of its keyword arguments
+/// (`position` required, the rest optional), each value named `what.key` in errors.
+struct Fields<'py> {
+    what: &'static str,
+    values: Vec<Option<Bound<'py, PyAny>>>,
+    keys: &'static [&'static str],
 }
 
-const STATE_KEYS: &str = "position, attitude, angular_velocity, velocity";
-const REFERENCE_KEYS: &str =
-    "position, velocity, acceleration, attitude, angular_velocity, angular_acceleration";
-
-/// An optional 3-vector (default 0).
-fn opt_vector3(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Vector3<f64>> {
-    match obj {
-        Some(o) if !o.is_none() => vector3(o, name),
-        _ => Ok(Vector3::zeros()),
-    }
-}
-
-/// An optional rotation (default identity).
-fn opt_matrix3(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Matrix3<f64>> {
-    match obj {
-        Some(o) if !o.is_none() => matrix3(o, name),
-        _ => Ok(Matrix3::identity()),
-    }
-}
-
-/// Checks that a dict only has known keys.
-fn check_keys(dict: &Bound<'_, PyDict>, what: &str, known: &str) -> PyResult<()> {
-    for key in dict.keys() {
-        let key: String = key
-            .extract()
-            .map_err(|_| PyTypeError::new_err(format!("`{what}` keys must be strings")))?;
-        if !known.split(", ").any(|k| k == key) {
+impl<'py> Fields<'py> {
+    fn from_dict(
+        obj: &Bound<'py, PyAny>,
+        what: &'static str,
+        keys: &'static [&'static str],
+    ) -> PyResult<Self> {
+        let dict = obj.cast::<PyDict>().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "`{what}` must be a tvmd.{} or a dict with keys {}",
+                if what == "state" {
+                    "State"
+                } else {
+                    "Reference"
+                },
+                keys.join(", ")
+            ))
+        })?;
+        for key in dict.keys() {
+            let key: String = key
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("`{what}` keys must be strings")))?;
+            if !keys.contains(&key.as_str()) {
+                return Err(PyValueError::new_err(format!(
+                    "unknown key '{key}' in `{what}`; expected some of: {}",
+                    keys.join(", ")
+                )));
+            }
+        }
+        let values = keys
+            .iter()
+            .map(|k| dict.get_item(k))
+            .collect::<PyResult<Vec<_>>>()?;
+        if values.first().is_none_or(Option::is_none) {
             return Err(PyValueError::new_err(format!(
-                "unknown key '{key}' in `{what}`; expected some of: {known}"
+                "`{what}` needs a 'position'"
             )));
         }
+        Ok(Fields { what, values, keys })
     }
-    Ok(())
+
+    /// The 3-vector under `key` (default 0).
+    fn vector(&self, key: usize) -> PyResult<Vector3<f64>> {
+        match self
+            .values
+            .get(key)
+            .and_then(|v| v.as_ref().filter(|v| !v.is_none()))
+        {
+            Some(v) => vector3(v, &self.name(key)),
+            None => Ok(Vector3::zeros()),
+        }
+    }
+
+    /// The rotation under `key` (default identity).
+    fn rotation(&self, key: usize) -> PyResult<Matrix3<f64>> {
+        match self
+            .values
+            .get(key)
+            .and_then(|v| v.as_ref().filter(|v| !v.is_none()))
+        {
+            Some(v) => matrix3(v, &self.name(key)),
+            None => Ok(Matrix3::identity()),
+        }
+    }
+
+    fn name(&self, key: usize) -> String {
+        format!(
+            "{}.{}",
+            self.what,
+            self.keys.get(key).copied().unwrap_or("?")
+        )
+    }
+
+    fn state(&self) -> PyResult<RigidState<f64>> {
+        Ok(RigidState {
+            position: self.vector(0)?,
+            attitude: self.rotation(1)?,
+            angular_velocity: self.vector(2)?,
+            velocity: self.vector(3)?,
+        })
+    }
+
+    fn reference(&self) -> PyResult<Reference<f64>> {
+        Ok(Reference {
+            position: self.vector(0)?,
+            velocity: self.vector(1)?,
+            acceleration: self.vector(2)?,
+            attitude: self.rotation(3)?,
+            angular_velocity: self.vector(4)?,
+            angular_acceleration: self.vector(5)?,
+        })
+    }
 }
 
-impl PyState {
-    fn build(
-        position: &Bound<'_, PyAny>,
-        attitude: Option<&Bound<'_, PyAny>>,
-        angular_velocity: Option<&Bound<'_, PyAny>>,
-        velocity: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<RigidState<f64>> {
-        Ok(RigidState {
-            position: vector3(position, "state.position")?,
-            attitude: opt_matrix3(attitude, "state.attitude")?,
-            angular_velocity: opt_vector3(angular_velocity, "state.angular_velocity")?,
-            velocity: opt_vector3(velocity, "state.velocity")?,
-        })
+/// The keyword arguments of a constructor as [`Fields`].
+fn args<'py>(
+    what: &'static str,
+    keys: &'static [&'static str],
+    values: &[Option<&Bound<'py, PyAny>>],
+) -> Fields<'py> {
+    Fields {
+        what,
+        values: values.iter().map(|v| v.cloned()).collect(),
+        keys,
     }
 }
 
 /// A state argument: a `State` or a dict with the same keys (`position` required).
 pub(crate) fn state_arg(obj: &Bound<'_, PyAny>) -> PyResult<RigidState<f64>> {
-    if let Ok(state) = obj.cast::<PyState>() {
-        return Ok(state.get().inner);
-    }
-    let dict = obj.cast::<PyDict>().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "`state` must be a tvmd.State or a dict with keys {STATE_KEYS}"
-        ))
-    })?;
-    check_keys(dict, "state", STATE_KEYS)?;
-    let position = dict
-        .get_item("position")?
-        .ok_or_else(|| PyValueError::new_err("`state` needs a 'position'"))?;
-    PyState::build(
-        &position,
-        dict.get_item("attitude")?.as_ref(),
-        dict.get_item("angular_velocity")?.as_ref(),
-        dict.get_item("velocity")?.as_ref(),
-    )
-}
-
-#[pymethods]
-impl PyState {
-    #[new]
-    #[pyo3(signature = (position, attitude = None, angular_velocity = None, velocity = None))]
-    fn new(
-        position: &Bound<'_, PyAny>,
-        attitude: Option<&Bound<'_, PyAny>>,
-        angular_velocity: Option<&Bound<'_, PyAny>>,
-        velocity: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        Ok(Self {
-            inner: Self::build(position, attitude, angular_velocity, velocity)?,
-        })
-    }
-
-    /// `x` (3,) (m).
-    #[getter]
-    fn position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.position.as_slice())
-    }
-
-    /// `R` (3, 3).
-    #[getter]
-    fn attitude<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.attitude)
-    }
-
-    /// `Omega` (3,) (rad/s), body frame.
-    #[getter]
-    fn angular_velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.angular_velocity.as_slice())
-    }
-
-    /// `v` (3,) (m/s), body frame.
-    #[getter]
-    fn velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.velocity.as_slice())
-    }
-
-    /// The fields as a dict (accepted wherever a state is).
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py))
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("State", &self.fields(py))
-    }
-}
-
-impl PyState {
-    fn fields<'py>(&self, py: Python<'py>) -> Vec<(&'static str, Bound<'py, PyAny>)> {
-        vec![
-            ("position", self.position(py).into_any()),
-            ("attitude", self.attitude(py).into_any()),
-            ("angular_velocity", self.angular_velocity(py).into_any()),
-            ("velocity", self.velocity(py).into_any()),
-        ]
-    }
-}
-
-/// The reference pose and its derivatives (feed-forward); unknown derivatives are zero.
-///
-/// Args:
-///     position: `x_r` (3,) (m).
-///     velocity: `x_r_dot` (3,), inertial (m/s); default 0.
-///     acceleration: `x_r_ddot` (3,), inertial (m/s^2); default 0.
-///     attitude: `R_r` (3, 3), the reference attitude; default identity.
-///     angular_velocity: `Omega_d` (3,), body frame of the reference (rad/s); default 0.
-///     angular_acceleration: `Omega_d_dot` (3,) (rad/s^2); default 0.
-///
-/// Wherever a reference is expected a dict with these keys is accepted too.
-#[pyclass(module = "tvmd", name = "Reference", frozen)]
-pub struct PyReference {
-    pub(crate) inner: Reference<f64>,
-}
-
-impl PyReference {
-    fn build(
-        position: &Bound<'_, PyAny>,
-        velocity: Option<&Bound<'_, PyAny>>,
-        acceleration: Option<&Bound<'_, PyAny>>,
-        attitude: Option<&Bound<'_, PyAny>>,
-        angular_velocity: Option<&Bound<'_, PyAny>>,
-        angular_acceleration: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Reference<f64>> {
-        Ok(Reference {
-            position: vector3(position, "reference.position")?,
-            velocity: opt_vector3(velocity, "reference.velocity")?,
-            acceleration: opt_vector3(acceleration, "reference.acceleration")?,
-            attitude: opt_matrix3(attitude, "reference.attitude")?,
-            angular_velocity: opt_vector3(angular_velocity, "reference.angular_velocity")?,
-            angular_acceleration: opt_vector3(
-                angular_acceleration,
-                "reference.angular_acceleration",
-            )?,
-        })
-    }
-
-    fn fields<'py>(&self, py: Python<'py>) -> Vec<(&'static str, Bound<'py, PyAny>)> {
-        let r = &self.inner;
-        vec![
-            ("position", array1(py, r.position.as_slice()).into_any()),
-            ("velocity", array1(py, r.velocity.as_slice()).into_any()),
-            (
-                "acceleration",
-                array1(py, r.acceleration.as_slice()).into_any(),
-            ),
-            ("attitude", matrix_array(py, &r.attitude).into_any()),
-            (
-                "angular_velocity",
-                array1(py, r.angular_velocity.as_slice()).into_any(),
-            ),
-            (
-                "angular_acceleration",
-                array1(py, r.angular_acceleration.as_slice()).into_any(),
-            ),
-        ]
+    match obj.cast::<PyState>() {
+        Ok(state) => Ok(state.get().inner),
+        Err(_) => Fields::from_dict(obj, "state", STATE_KEYS)?.state(),
     }
 }
 
 /// A reference argument: a `Reference` or a dict with the same keys (`position` required).
 pub(crate) fn reference_arg(obj: &Bound<'_, PyAny>) -> PyResult<Reference<f64>> {
-    if let Ok(reference) = obj.cast::<PyReference>() {
-        return Ok(reference.get().inner);
+    match obj.cast::<PyReference>() {
+        Ok(reference) => Ok(reference.get().inner),
+        Err(_) => Fields::from_dict(obj, "reference", REFERENCE_KEYS)?.reference(),
     }
-    let dict = obj.cast::<PyDict>().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "`reference` must be a tvmd.Reference or a dict with keys {REFERENCE_KEYS}"
-        ))
-    })?;
-    check_keys(dict, "reference", REFERENCE_KEYS)?;
-    let position = dict
-        .get_item("position")?
-        .ok_or_else(|| PyValueError::new_err("`reference` needs a 'position'"))?;
-    PyReference::build(
-        &position,
-        dict.get_item("velocity")?.as_ref(),
-        dict.get_item("acceleration")?.as_ref(),
-        dict.get_item("attitude")?.as_ref(),
-        dict.get_item("angular_velocity")?.as_ref(),
-        dict.get_item("angular_acceleration")?.as_ref(),
-    )
 }
 
-#[pymethods]
-impl PyReference {
-    #[new]
-    #[pyo3(signature = (position, velocity = None, acceleration = None, attitude = None, angular_velocity = None, angular_acceleration = None))]
-    fn new(
-        position: &Bound<'_, PyAny>,
-        velocity: Option<&Bound<'_, PyAny>>,
-        acceleration: Option<&Bound<'_, PyAny>>,
-        attitude: Option<&Bound<'_, PyAny>>,
-        angular_velocity: Option<&Bound<'_, PyAny>>,
-        angular_acceleration: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        Ok(Self {
-            inner: Self::build(
-                position,
-                velocity,
-                acceleration,
-                attitude,
-                angular_velocity,
-                angular_acceleration,
-            )?,
-        })
+record! {
+    /// The measured state: pose and body-frame twist `xi = [Omega; v]`.
+    ///
+    /// Args:
+    ///     position: `x` (3,), CoM position in the inertial frame (m), z up.
+    ///     attitude: `R` (3, 3), body-to-inertial rotation; default identity.
+    ///     angular_velocity: `Omega` (3,), body frame (rad/s); default 0.
+    ///     velocity: `v` (3,), body frame, `x_dot = R v` (m/s); default 0.
+    ///
+    /// Wherever a state is expected a dict with these keys is accepted too. Values are not
+    /// validated here: `Controller.step` reports NaN/inf or a non-rotation attitude as a
+    /// `CycleError`, the law functions as an `InputError`.
+    "State" in "tvmd" => PyState(RigidState<f64>) |py, o| {
+        /// `x` (3,) (m).
+        position => array1(py, o.position.as_slice()),
+        /// `R` (3, 3).
+        attitude => matrix_array(py, &o.attitude),
+        /// `Omega` (3,) (rad/s), body frame.
+        angular_velocity => array1(py, o.angular_velocity.as_slice()),
+        /// `v` (3,) (m/s), body frame.
+        velocity => array1(py, o.velocity.as_slice()),
     }
-
-    /// Hover, level, at `position` with zero feed-forward.
-    #[staticmethod]
-    fn hover(position: &Bound<'_, PyAny>) -> PyResult<Self> {
-        Ok(Self {
-            inner: Reference::hover(vector3(position, "reference.position")?),
-        })
+    methods {
+        #[new]
+        #[pyo3(signature = (position, attitude = None, angular_velocity = None, velocity = None))]
+        fn new(
+            position: &Bound<'_, PyAny>,
+            attitude: Option<&Bound<'_, PyAny>>,
+            angular_velocity: Option<&Bound<'_, PyAny>>,
+            velocity: Option<&Bound<'_, PyAny>>,
+        ) -> PyResult<Self> {
+            let values = [Some(position), attitude, angular_velocity, velocity];
+            let inner = args("state", STATE_KEYS, &values).state()?;
+            Ok(Self { inner })
+        }
     }
+}
 
-    /// `x_r` (3,).
-    #[getter]
-    fn position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.position.as_slice())
+record! {
+    /// The reference pose and its derivatives (feed-forward); unknown derivatives are zero.
+    ///
+    /// Args:
+    ///     position: `x_r` (3,) (m).
+    ///     velocity: `x_r_dot` (3,), inertial (m/s); default 0.
+    ///     acceleration: `x_r_ddot` (3,), inertial (m/s^2); default 0.
+    ///     attitude: `R_r` (3, 3), the reference attitude; default identity.
+    ///     angular_velocity: `Omega_d` (3,), body frame of the reference (rad/s); default 0.
+    ///     angular_acceleration: `Omega_d_dot` (3,) (rad/s^2); default 0.
+    ///
+    /// Wherever a reference is expected a dict with these keys is accepted too.
+    "Reference" in "tvmd" => PyReference(Reference<f64>) |py, o| {
+        /// `x_r` (3,).
+        position => array1(py, o.position.as_slice()),
+        /// `x_r_dot` (3,).
+        velocity => array1(py, o.velocity.as_slice()),
+        /// `x_r_ddot` (3,).
+        acceleration => array1(py, o.acceleration.as_slice()),
+        /// `R_r` (3, 3).
+        attitude => matrix_array(py, &o.attitude),
+        /// `Omega_d` (3,).
+        angular_velocity => array1(py, o.angular_velocity.as_slice()),
+        /// `Omega_d_dot` (3,).
+        angular_acceleration => array1(py, o.angular_acceleration.as_slice()),
     }
+    methods {
+        #[new]
+        #[pyo3(signature = (position, velocity = None, acceleration = None, attitude = None, angular_velocity = None, angular_acceleration = None))]
+        fn new(
+            position: &Bound<'_, PyAny>,
+            velocity: Option<&Bound<'_, PyAny>>,
+            acceleration: Option<&Bound<'_, PyAny>>,
+            attitude: Option<&Bound<'_, PyAny>>,
+            angular_velocity: Option<&Bound<'_, PyAny>>,
+            angular_acceleration: Option<&Bound<'_, PyAny>>,
+        ) -> PyResult<Self> {
+            let values = [Some(position), velocity, acceleration, attitude, angular_velocity, angular_acceleration];
+            let inner = args("reference", REFERENCE_KEYS, &values).reference()?;
+            Ok(Self { inner })
+        }
 
-    /// `x_r_dot` (3,).
-    #[getter]
-    fn velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.velocity.as_slice())
-    }
-
-    /// `x_r_ddot` (3,).
-    #[getter]
-    fn acceleration<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.acceleration.as_slice())
-    }
-
-    /// `R_r` (3, 3).
-    #[getter]
-    fn attitude<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.attitude)
-    }
-
-    /// `Omega_d` (3,).
-    #[getter]
-    fn angular_velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.angular_velocity.as_slice())
-    }
-
-    /// `Omega_d_dot` (3,).
-    #[getter]
-    fn angular_acceleration<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.angular_acceleration.as_slice())
-    }
-
-    /// The fields as a dict (accepted wherever a reference is).
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py))
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("Reference", &self.fields(py))
+        /// Hover, level, at `position` with zero feed-forward.
+        #[staticmethod]
+        fn hover(position: &Bound<'_, PyAny>) -> PyResult<Self> {
+            Ok(Self {
+                inner: Reference::hover(vector3(position, "reference.position")?),
+            })
+        }
     }
 }
 
 // ---------------------------------------------------------------------------------------------
 // Plant
 // ---------------------------------------------------------------------------------------------
-
-/// Rigid-body parameters of the law: `G = blockdiag(J_C, m_C I)` and gravity `g` along `-e_3`
-/// (eqs. 2-3). `team.plant(gravity=9.81)` builds it from a team.
-///
-/// Args:
-///     mass: `m_C` (kg).
-///     inertia: `J_C` (3, 3) (kg m^2).
-///     gravity: `g` (m/s^2).
-///
-/// Raises:
-///     ValueError: NaN/inf values or a wrong shape.
-#[pyclass(module = "tvmd", name = "Plant", frozen)]
-pub struct PyPlant {
-    pub(crate) inner: Plant<f64>,
-}
 
 impl PyPlant {
     /// A plant of finite parameters.
@@ -524,46 +389,42 @@ impl PyPlant {
     }
 }
 
-#[pymethods]
-impl PyPlant {
-    #[new]
-    #[pyo3(signature = (mass, inertia, gravity = tvmd_core::team::presets::GRAVITY))]
-    fn new(mass: f64, inertia: &Bound<'_, PyAny>, gravity: f64) -> PyResult<Self> {
-        Self::create(mass, matrix3(inertia, "inertia")?, gravity)
-    }
+/// `Plant(mass=.., inertia=diag[..], gravity=..)`.
+fn plant_repr(p: &Plant<f64>) -> String {
+    let j = &p.inertia;
+    let off = if is_diagonal(j) { "" } else { "+offdiag" };
+    let (m, g) = (p.mass, p.gravity);
+    format!(
+        "Plant(mass={m}, inertia=diag[{}, {}, {}]{off}, gravity={g})",
+        j.m11, j.m22, j.m33
+    )
+}
 
-    /// `m_C` (kg).
-    #[getter]
-    fn mass(&self) -> f64 {
-        self.inner.mass
+record! {
+    /// Rigid-body parameters of the law: `G = blockdiag(J_C, m_C I)` and gravity `g` along `-e_3`
+    /// (eqs. 2-3). `team.plant(gravity=9.81)` builds it from a team.
+    ///
+    /// Args:
+    ///     mass: `m_C` (kg).
+    ///     inertia: `J_C` (3, 3) (kg m^2).
+    ///     gravity: `g` (m/s^2).
+    ///
+    /// Raises:
+    ///     ValueError: NaN/inf values or a wrong shape.
+    "Plant" in "tvmd" => PyPlant(Plant<f64>) repr plant_repr |py, o| {
+        /// `m_C` (kg).
+        mass => o.mass,
+        /// `J_C` (3, 3) (kg m^2).
+        inertia => matrix_array(py, &o.inertia),
+        /// `g` (m/s^2).
+        gravity => o.gravity,
     }
-
-    /// `J_C` (3, 3) (kg m^2).
-    #[getter]
-    fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.inertia)
-    }
-
-    /// `g` (m/s^2).
-    #[getter]
-    fn gravity(&self) -> f64 {
-        self.inner.gravity
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Plant(mass={}, inertia=diag[{}, {}, {}]{}, gravity={})",
-            self.inner.mass,
-            self.inner.inertia.m11,
-            self.inner.inertia.m22,
-            self.inner.inertia.m33,
-            if is_diagonal(&self.inner.inertia) {
-                ""
-            } else {
-                "+offdiag"
-            },
-            self.inner.gravity
-        )
+    methods {
+        #[new]
+        #[pyo3(signature = (mass, inertia, gravity = tvmd_core::team::presets::GRAVITY))]
+        fn new(mass: f64, inertia: &Bound<'_, PyAny>, gravity: f64) -> PyResult<Self> {
+            Self::create(mass, matrix3(inertia, "inertia")?, gravity)
+        }
     }
 }
 
@@ -656,87 +517,32 @@ pub(crate) fn control_wrench(
     Ok(PyLawOutput { inner: out })
 }
 
-/// Everything the control law computes in one period (eq. 12).
-///
-/// Attributes:
-///     e_x: (3,) `x - x_r`.
-///     e_R: (3,) `1/2 (R_d^T R - R^T R_d)^vee`.
-///     e_xi: (6,) `xi - xi_d = [e_Omega; e_v]`.
-///     u_r: (6,) `[u_tau_r; u_fr]`.
-///     u_d: (6,) `blockdiag(I, K_f) u_r`.
-///     V_R: `Psi + ||e_Omega||_{K_Omega}`.
-///     V_x: `||e_x||_{K_x} + ||e_v||_{K_v}`.
-#[pyclass(module = "tvmd", name = "LawOutput", frozen)]
-pub struct PyLawOutput {
-    inner: LawOutput<f64>,
-}
-
-impl PyLawOutput {
-    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Vec<(&'static str, Bound<'py, PyAny>)>> {
-        let o = &self.inner;
-        Ok(vec![
-            ("e_x", array1(py, o.e_x.as_slice()).into_any()),
-            ("e_R", array1(py, o.e_r.as_slice()).into_any()),
-            ("e_xi", array1(py, o.e_xi.as_slice()).into_any()),
-            ("u_r", array1(py, o.u_r.as_slice()).into_any()),
-            ("u_d", array1(py, o.u_d.as_slice()).into_any()),
-            ("V_R", any(py, o.v_r)?),
-            ("V_x", any(py, o.v_x)?),
-        ])
-    }
-}
-
-#[pymethods]
-impl PyLawOutput {
-    /// (3,) `e_x`.
-    #[getter]
-    fn e_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.e_x.as_slice())
-    }
-
-    /// (3,) `e_R`.
-    #[getter(e_R)]
-    fn e_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.e_r.as_slice())
-    }
-
-    /// (6,) `e_xi = [e_Omega; e_v]`.
-    #[getter]
-    fn e_xi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.e_xi.as_slice())
-    }
-
-    /// (6,) `u_r = [u_tau_r; u_fr]`.
-    #[getter]
-    fn u_r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.u_r.as_slice())
-    }
-
-    /// (6,) `u_d = blockdiag(I, K_f) u_r`.
-    #[getter]
-    fn u_d<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.u_d.as_slice())
-    }
-
-    /// `V_R`.
-    #[getter(V_R)]
-    fn v_r(&self) -> f64 {
-        self.inner.v_r
-    }
-
-    /// `V_x`.
-    #[getter(V_x)]
-    fn v_x(&self) -> f64 {
-        self.inner.v_x
-    }
-
-    /// The fields as a dict.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py)?)
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("LawOutput", &self.fields(py)?)
+record! {
+    /// Everything the control law computes in one period (eq. 12).
+    ///
+    /// Attributes:
+    ///     e_x: (3,) `x - x_r`.
+    ///     e_R: (3,) `1/2 (R_d^T R - R^T R_d)^vee`.
+    ///     e_xi: (6,) `xi - xi_d = [e_Omega; e_v]`.
+    ///     u_r: (6,) `[u_tau_r; u_fr]`.
+    ///     u_d: (6,) `blockdiag(I, K_f) u_r`.
+    ///     V_R: `Psi + ||e_Omega||_{K_Omega}`.
+    ///     V_x: `||e_x||_{K_x} + ||e_v||_{K_v}`.
+    "LawOutput" in "tvmd" => PyLawOutput(LawOutput<f64>) |py, o| {
+        /// (3,) `e_x = x - x_r`.
+        e_x => array1(py, o.e_x.as_slice()),
+        /// (3,) `e_R`.
+        e_r as "e_R" => array1(py, o.e_r.as_slice()),
+        /// (6,) `e_xi = [e_Omega; e_v]`.
+        e_xi => array1(py, o.e_xi.as_slice()),
+        /// (6,) `u_r = [u_tau_r; u_fr]`.
+        u_r => array1(py, o.u_r.as_slice()),
+        /// (6,) `u_d = blockdiag(I, K_f) u_r`.
+        u_d => array1(py, o.u_d.as_slice()),
+        /// `V_R`.
+        v_r as "V_R" => o.v_r,
+        /// `V_x`.
+        v_x as "V_x" => o.v_x,
     }
 }
 

@@ -40,6 +40,7 @@ mod convert;
 mod errors;
 mod law;
 mod planner;
+mod record;
 mod sim;
 mod team;
 

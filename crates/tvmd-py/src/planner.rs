@@ -1,17 +1,13 @@
 //! `tvmd.AttitudePlanner` (eqs. 9-11) and its `PlannerResult`.
 
-use nalgebra::Matrix3;
-use numpy::PyArray2;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
-use tvmd_core::{AttitudePlanner, PlannerStatus, Relaxation};
+use tvmd_core::{AttitudePlanner, PlannerOutput, PlannerStatus, Relaxation};
 
 use crate::afs::PyAfs;
-use crate::convert::{
-    any, class_arg, finite_matrix3, finite_vector3, matrix_array, record_dict, record_repr,
-};
+use crate::convert::{class_arg, finite_matrix3, finite_vector3, matrix_array};
 use crate::errors::OrRaise;
+use crate::record::record;
 
 /// Default iteration cap of the core's planner.
 const DEFAULT_MAX_ITERATIONS: u32 = 64;
@@ -26,6 +22,27 @@ pub(crate) fn iteration_cap(value: Option<i64>) -> PyResult<u32> {
             ))
         }),
     }
+}
+
+/// The relaxation `s` from the keyword `relaxation` or its alias `s` (at most one of them),
+/// else `default`.
+pub(crate) fn relaxation_arg(
+    relaxation: Option<f64>,
+    s: Option<f64>,
+    default: Option<f64>,
+) -> PyResult<Relaxation<f64>> {
+    let value = match (relaxation, s) {
+        (Some(_), Some(_)) => {
+            return Err(pyo3::exceptions::PyTypeError::new_err(
+                "give `relaxation` or its alias `s`, not both",
+            ))
+        }
+        (Some(v), None) | (None, Some(v)) => v,
+        (None, None) => default.ok_or_else(|| {
+            pyo3::exceptions::PyTypeError::new_err("missing required argument `relaxation`")
+        })?,
+    };
+    Relaxation::new(value).or_raise()
 }
 
 /// The planner status as a Python string.
@@ -47,7 +64,7 @@ pub(crate) fn status_name(status: PlannerStatus) -> &'static str {
 /// and rolls about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
 ///
 /// Args:
-///     s: AFS relaxation in (0, 1].
+///     relaxation: AFS relaxation `s` in (0, 1] (`s=` is an alias).
 ///     tolerance: bisection tolerance on `theta` (rad); default `max(1e-10, 8 eps)`.
 ///     max_iterations: bisection iteration cap (>= 1); default 64.
 ///
@@ -62,9 +79,14 @@ pub struct PyAttitudePlanner {
 #[pymethods]
 impl PyAttitudePlanner {
     #[new]
-    #[pyo3(signature = (s, tolerance = None, max_iterations = None))]
-    fn new(s: f64, tolerance: Option<f64>, max_iterations: Option<i64>) -> PyResult<Self> {
-        let planner = AttitudePlanner::new(Relaxation::new(s).or_raise()?);
+    #[pyo3(signature = (relaxation = None, tolerance = None, max_iterations = None, *, s = None))]
+    fn new(
+        relaxation: Option<f64>,
+        tolerance: Option<f64>,
+        max_iterations: Option<i64>,
+        s: Option<f64>,
+    ) -> PyResult<Self> {
+        let planner = AttitudePlanner::new(relaxation_arg(relaxation, s, None)?);
         let max_iterations = iteration_cap(max_iterations)?;
         let inner = planner
             .with_tolerance(tolerance.unwrap_or(planner.tolerance()), max_iterations)
@@ -77,7 +99,7 @@ impl PyAttitudePlanner {
 
     /// The relaxation `s`.
     #[getter]
-    fn s(&self) -> f64 {
+    fn relaxation(&self) -> f64 {
         self.inner.relaxation().get()
     }
 
@@ -116,85 +138,39 @@ impl PyAttitudePlanner {
         let r_r = finite_matrix3(R_r, "R_r")?;
         let f_r = finite_vector3(f_r, "f_r")?;
         let afs = class_arg::<PyAfs>(afs, "afs")?.get();
-        let out = self.inner.plan(&afs.inner, &r_r, &f_r).or_raise()?;
-        Ok(PyPlannerResult {
-            r_d: out.r_d,
-            theta: out.theta,
-            iterations: out.iterations,
-            status: out.status,
-        })
+        let inner = self.inner.plan(&afs.inner.afs, &r_r, &f_r).or_raise()?;
+        Ok(PyPlannerResult { inner })
     }
 
     fn __repr__(&self) -> String {
         format!(
-            "AttitudePlanner(s={}, tolerance={:e}, max_iterations={})",
-            self.s(),
+            "AttitudePlanner(relaxation={}, tolerance={:e}, max_iterations={})",
+            self.relaxation(),
             self.tolerance(),
             self.max_iterations
         )
     }
 }
 
-/// The planner's output (eqs. 9-11).
-///
-/// Attributes:
-///     R_d: (3, 3) planned attitude `[b_xd b_yd b_zd]`.
-///     theta: the tilt `theta*` from `b_zr` toward `f_r` (rad).
-///     iterations: bisection iterations used (0 unless status is "planned").
-///     status: "already_feasible" (`R_d = R_r`), "planned" (bisection), "zero_force"
-///         (`f_r = 0`, `R_d = R_r`) or "unreachable" (`||f_r|| > n sigma_Tf`: `b_zd` along `f_r`).
-#[pyclass(module = "tvmd", name = "PlannerResult", frozen)]
-pub struct PyPlannerResult {
-    r_d: Matrix3<f64>,
-    theta: f64,
-    iterations: u32,
-    status: PlannerStatus,
-}
-
-impl PyPlannerResult {
-    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Vec<(&'static str, Bound<'py, PyAny>)>> {
-        Ok(vec![
-            ("R_d", self.r_d(py).into_any()),
-            ("theta", any(py, self.theta)?),
-            ("iterations", any(py, self.iterations)?),
-            ("status", any(py, self.status())?),
-        ])
-    }
-}
-
-#[pymethods]
-impl PyPlannerResult {
-    /// (3, 3) planned attitude `R_d`.
-    #[getter(R_d)]
-    fn r_d<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.r_d)
-    }
-
-    /// `theta*` (rad).
-    #[getter]
-    fn theta(&self) -> f64 {
-        self.theta
-    }
-
-    /// Bisection iterations used.
-    #[getter]
-    fn iterations(&self) -> u32 {
-        self.iterations
-    }
-
-    /// "already_feasible", "planned", "zero_force" or "unreachable".
-    #[getter]
-    fn status(&self) -> &'static str {
-        status_name(self.status)
-    }
-
-    /// The fields as a dict.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, self.fields(py)?)
-    }
-
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        record_repr("PlannerResult", &self.fields(py)?)
+record! {
+    /// The planner's output (eqs. 9-11).
+    ///
+    /// Attributes:
+    ///     R_d: (3, 3) planned attitude `[b_xd b_yd b_zd]`.
+    ///     theta: the tilt `theta*` from `b_zr` toward `f_r` (rad).
+    ///     iterations: bisection iterations used (0 unless status is "planned").
+    ///     status: "already_feasible" (`R_d = R_r`), "planned" (bisection), "zero_force"
+    ///         (`f_r = 0`, `R_d = R_r`) or "unreachable" (`||f_r|| > n sigma_Tf`: `b_zd` along
+    ///         `f_r`).
+    "PlannerResult" in "tvmd" => PyPlannerResult(PlannerOutput<f64>) |py, o| {
+        /// (3, 3) planned attitude `R_d`.
+        r_d as "R_d" => matrix_array(py, &o.r_d),
+        /// `theta*` (rad).
+        theta => o.theta,
+        /// Bisection iterations used.
+        iterations => o.iterations,
+        /// "already_feasible", "planned", "zero_force" or "unreachable".
+        status => status_name(o.status),
     }
 }
 

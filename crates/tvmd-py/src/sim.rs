@@ -23,9 +23,9 @@ use std::sync::Mutex;
 
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{PyArray1, PyArray2, PyArray3};
-use pyo3::exceptions::{PyAttributeError, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+use pyo3::types::{PyDict, PyList, PyString};
 
 use tvmd_sim::actuators::AgentCommand;
 use tvmd_sim::control::hover_roll_limit;
@@ -36,6 +36,7 @@ use tvmd_sim::sim::{RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
 use crate::convert::{any, array1, bool_array, scalars};
+use crate::record::record;
 
 /// The default scenario of [`run`] and [`relaxation_sweep`].
 const DEFAULT_SCENARIO: &str = "paper-tilt";
@@ -324,7 +325,9 @@ fn run_specs(
         .zip(outcomes)
         .enumerate()
         .map(|(k, (spec, outcome))| match outcome {
-            Ok(result) => Ok(PySimResult::new(spec, result)),
+            Ok(result) => Ok(PySimResult {
+                inner: SimData::new(spec, result),
+            }),
             Err(f) => Err(f.into_py(&label(k, &spec), spec.mcap.as_deref())),
         })
         .collect()
@@ -334,8 +337,8 @@ fn run_specs(
 // Functions
 // ---------------------------------------------------------------------------------------------
 
-/// The names of the built-in scenarios (`"paper-tilt"` is the paper's simulation, SPEC "The
-/// paper's simulation"; `"relaxation-<s>"` the relaxation study; failures, A4-Con, ...).
+/// The names of the built-in scenarios (`"paper-tilt"` is the paper's simulation, see
+/// docs/method.md; `"relaxation-<s>"` the relaxation study; failures, A4-Con, ...).
 #[pyfunction]
 fn builtin_scenarios() -> Vec<&'static str> {
     BUILTIN_NAMES.to_vec()
@@ -396,7 +399,9 @@ fn run(
     .spec("scenario")?;
     let outcome = py.detach(|| execute(&spec));
     match outcome {
-        Ok(result) => Ok(PySimResult::new(spec, result)),
+        Ok(result) => Ok(PySimResult {
+            inner: SimData::new(spec, result),
+        }),
         Err(f) => Err(f.into_py("", spec.mcap.as_deref())),
     }
 }
@@ -508,35 +513,8 @@ fn relaxation_sweep(
 // Result
 // ---------------------------------------------------------------------------------------------
 
-/// The result of one simulated run (read-only; every array access returns a fresh float64
-/// copy, so bind it to a name before indexing in a loop).
-///
-/// `K` samples, one per controller tick (`t_k = k controller_period`, true state before the
-/// tick's commands act); `n` agents. SI units, z up, angles in rad. Values a controller did not
-/// report at a tick (a skipped cycle) are NaN.
-///
-/// Attributes:
-///     scenario_name, relaxation (`s`), allocator, mcap_path (str or None), n_agents,
-///     mass (`m_C`, kg), gravity (`g`, m/s^2), hover_roll_limit (`atan(c_y(1, s))`, rad: the
-///     planned roll at which the planner saturates in hover).
-///     t: (K,) time (s).
-///     position, velocity, reference_position: (K, 3) `x` (m), `x_dot` (m/s), `x_r` (m).
-///     attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of `R`, `R_r`
-///         and the planned `R_d`.
-///     reference_roll: (K,) `phi_r`. planned_roll: (K,) `phi_d = atan2(R_d[2,1], R_d[2,2])`.
-///     attitude_error: (K,) angle between `R` and `R_d`. theta: (K,) planner angle `theta*`.
-///     e_f: (K,) allocation error `||u_fd - u_f||` (N). saturated_agents: (K,) int64, agents
-///         the allocator saturated (-1 if not reported).
-///     V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
-///     commands, actual: (K, n, 3) commanded and actual actuator values, columns
-///         `eta_x, eta_y` (rad), `thrust` (N). failed: (K, n) bool, true failure flags.
-///     summary: dict, every field of tvmd-sim's `RunSummary` (`max_planned_roll`, `max_e_f`,
-///         `max_e_f_over_weight` = `max e_f / (m_C g)`, `max_position_error_after_4s`, ...).
-///     paper_metrics: dict, tvmd-sim's `PaperMetrics` (horizontal errors at 4 and 12 s,
-///         stage-B attitude settling, `e_f` onset, `V_x` rise, ...).
-///     scenario_toml: the scenario that ran, as TOML.
-#[pyclass(module = "tvmd.sim", name = "SimResult", frozen)]
-pub struct PySimResult {
+/// One run as `SimResult` keeps it: the scenario that ran, its samples and metrics.
+pub(crate) struct SimData {
     scenario: Scenario,
     mcap: Option<PathBuf>,
     samples: Vec<Sample>,
@@ -547,78 +525,232 @@ pub struct PySimResult {
     n: usize,
 }
 
-/// The field names of `SimResult`, in `to_dict` order.
-const RESULT_FIELDS: &[&str] = &[
-    "scenario_name",
-    "relaxation",
-    "allocator",
-    "mcap_path",
-    "n_agents",
-    "mass",
-    "gravity",
-    "hover_roll_limit",
-    "t",
-    "position",
-    "velocity",
-    "reference_position",
-    "attitude_rpy",
-    "reference_rpy",
-    "reference_roll",
-    "planned_roll",
-    "planned_rpy",
-    "attitude_error",
-    "theta",
-    "e_f",
-    "saturated_agents",
-    "V_x",
-    "V_R",
-    "cycle_error",
-    "commands",
-    "actual",
-    "failed",
-    "summary",
-    "paper_metrics",
-    "scenario_toml",
-];
+impl SimData {
+    fn new(spec: RunSpec, result: RunResult) -> Self {
+        let scenario = spec.scenario;
+        let paper = PaperMetrics::new(&scenario, &result.samples);
+        let hover_roll_limit = hover_roll_limit(&scenario, scenario.relaxation).ok();
+        let team = scenario.team_body().ok();
+        let n = result
+            .samples
+            .first()
+            .map(|s| s.commands.len())
+            .or_else(|| team.as_ref().map(|t| t.len()))
+            .unwrap_or(0);
+        Self {
+            mass: team.as_ref().map(|t| t.mass()),
+            paper,
+            hover_roll_limit,
+            n,
+            mcap: spec.mcap,
+            samples: result.samples,
+            summary: result.summary,
+            scenario,
+        }
+    }
 
-fn column<'py>(
-    py: Python<'py>,
-    samples: &[Sample],
-    f: impl Fn(&Sample) -> Option<f64>,
-) -> Bound<'py, PyArray1<f64>> {
-    let values: Vec<f64> = samples.iter().map(|s| f(s).unwrap_or(f64::NAN)).collect();
-    array1(py, &values)
+    fn mcap_string(&self) -> Option<String> {
+        self.mcap.as_ref().map(|p| p.display().to_string())
+    }
+
+    /// A (K,) column; NaN where a sample has no value.
+    fn column<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&Sample) -> Option<f64>,
+    ) -> Bound<'py, PyArray1<f64>> {
+        let values: Vec<f64> = self
+            .samples
+            .iter()
+            .map(|s| f(s).unwrap_or(f64::NAN))
+            .collect();
+        array1(py, &values)
+    }
+
+    /// A (K, 3) column; NaN rows where a sample has no value.
+    fn column3<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&Sample) -> Option<[f64; 3]>,
+    ) -> Bound<'py, PyArray2<f64>> {
+        let rows: Vec<[f64; 3]> = self
+            .samples
+            .iter()
+            .map(|s| f(s).unwrap_or([f64::NAN; 3]))
+            .collect();
+        crate::convert::rows_array(py, &rows)
+    }
+
+    /// (K, n, 3) actuator values `eta_x, eta_y, thrust`.
+    fn agents<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&Sample) -> &[AgentCommand],
+    ) -> Bound<'py, PyArray3<f64>> {
+        let a = Array3::from_shape_fn((self.samples.len(), self.n, 3), |(k, i, j)| {
+            self.samples
+                .get(k)
+                .and_then(|s| f(s).get(i))
+                .and_then(|c| [c.eta_x, c.eta_y, c.thrust].get(j).copied())
+                .unwrap_or(f64::NAN)
+        });
+        PyArray3::from_owned_array(py, a)
+    }
+
+    fn saturated_agents<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let v: Vec<i64> = self
+            .samples
+            .iter()
+            .map(|x| {
+                x.saturated_agents
+                    .map_or(-1, |c| i64::try_from(c).unwrap_or(i64::MAX))
+            })
+            .collect();
+        PyArray1::from_owned_array(py, Array1::from(v))
+    }
+
+    fn failed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<bool>> {
+        let a = Array2::from_shape_fn((self.samples.len(), self.n), |(k, i)| {
+            self.samples
+                .get(k)
+                .and_then(|x| x.failed.get(i))
+                .copied()
+                .unwrap_or(false)
+        });
+        PyArray2::from_owned_array(py, a)
+    }
+
+    fn scenario_toml(&self) -> PyResult<String> {
+        self.scenario
+            .to_toml_string()
+            .map_err(|e| sim_error(e, "", None))
+    }
+
+    fn repr(&self) -> String {
+        format!(
+            "SimResult(scenario_name='{}', relaxation={}, allocator='{}', samples={}, \
+             n_agents={}, mcap_path={})",
+            self.scenario.name,
+            self.scenario.relaxation,
+            self.scenario.allocator,
+            self.samples.len(),
+            self.n,
+            self.mcap_string()
+                .map_or_else(|| "None".to_string(), |p| format!("'{p}'"))
+        )
+    }
 }
 
-fn column3<'py>(
-    py: Python<'py>,
-    samples: &[Sample],
-    f: impl Fn(&Sample) -> Option<[f64; 3]>,
-) -> Bound<'py, PyArray2<f64>> {
-    let rows: Vec<[f64; 3]> = samples
-        .iter()
-        .map(|s| f(s).unwrap_or([f64::NAN; 3]))
-        .collect();
-    crate::convert::rows_array(py, &rows)
+record! {
+    /// The result of one simulated run (read-only; every array access returns a fresh float64
+    /// copy, so bind it to a name before indexing in a loop).
+    ///
+    /// `K` samples, one per controller tick (`t_k = k controller_period`, true state before the
+    /// tick's commands act); `n` agents. SI units, z up, angles in rad. Values a controller did
+    /// not report at a tick (a skipped cycle) are NaN.
+    ///
+    /// Attributes:
+    ///     scenario_name, relaxation (`s`), allocator, mcap_path (str or None), n_agents,
+    ///     mass (`m_C`, kg), gravity (`g`, m/s^2), hover_roll_limit (`atan(c_y(1, s))`, rad: the
+    ///     planned roll at which the planner saturates in hover).
+    ///     t: (K,) time (s).
+    ///     position, velocity, reference_position: (K, 3) `x` (m), `x_dot` (m/s), `x_r` (m).
+    ///     attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of `R`, `R_r`
+    ///         and the planned `R_d`.
+    ///     reference_roll: (K,) `phi_r`. planned_roll: (K,) `phi_d = atan2(R_d[2,1], R_d[2,2])`.
+    ///     attitude_error: (K,) angle between `R` and `R_d`. theta: (K,) planner angle `theta*`.
+    ///     e_f: (K,) allocation error `||u_fd - u_f||` (N). saturated_agents: (K,) int64, agents
+    ///         the allocator saturated (-1 if not reported).
+    ///     V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
+    ///     commands, actual: (K, n, 3) commanded and actual actuator values, columns
+    ///         `eta_x, eta_y` (rad), `thrust` (N). failed: (K, n) bool, true failure flags.
+    ///     summary: dict, every field of tvmd-sim's `RunSummary` (`max_planned_roll`, `max_e_f`,
+    ///         `max_e_f_over_weight` = `max e_f / (m_C g)`, `max_position_error_after_4s`, ...).
+    ///     paper_metrics: dict, tvmd-sim's `PaperMetrics` (horizontal errors at 4 and 12 s,
+    ///         stage-B attitude settling, `e_f` onset, `V_x` rise, ...).
+    ///     scenario_toml: the scenario that ran, as TOML.
+    "SimResult" in "tvmd.sim" => PySimResult(SimData) repr SimData::repr |py, o| {
+        /// Name of the scenario that ran (`"<name>-s<s>"` in a relaxation sweep).
+        scenario_name => o.scenario.name.as_str(),
+        /// Planner relaxation `s` of the run.
+        relaxation => o.scenario.relaxation,
+        /// Allocator of the run.
+        allocator => o.scenario.allocator.as_str(),
+        /// Path of the MCAP log written, or None.
+        mcap_path => o.mcap_string(),
+        /// Number of agents `n`.
+        n_agents => o.n,
+        /// Team mass `m_C` (kg).
+        mass => o.mass,
+        /// Gravity `g` of the run (m/s^2).
+        gravity => o.scenario.physics.gravity,
+        /// `atan(c_y(1, s))` (rad): the planned roll at which the planner saturates in hover for
+        /// this team, limits and `s`.
+        hover_roll_limit => o.hover_roll_limit,
+        /// (K,) time `t` (s).
+        t => o.column(py, |x| Some(x.t)),
+        /// (K, 3) position `x` of the centre of mass (m).
+        position => o.column3(py, |x| Some(x.position)),
+        /// (K, 3) world velocity `x_dot` (m/s).
+        velocity => o.column3(py, |x| Some(x.velocity)),
+        /// (K, 3) reference position `x_r` (m).
+        reference_position => o.column3(py, |x| Some(x.reference_position)),
+        /// (K, 3) roll, pitch, yaw of `R` (rad, ZYX: `R = R_z(yaw) R_y(pitch) R_x(roll)`).
+        attitude_rpy => o.column3(py, |x| Some(x.roll_pitch_yaw)),
+        /// (K, 3) roll, pitch, yaw of the reference `R_r` (rad).
+        reference_rpy => o.column3(py, |x| Some(x.reference_roll_pitch_yaw)),
+        /// (K,) reference roll `phi_r` (rad).
+        reference_roll => o.column(py, |x| Some(x.reference_roll)),
+        /// (K,) planned roll `phi_d = atan2(R_d[2,1], R_d[2,2])` (rad); NaN if not reported.
+        planned_roll => o.column(py, |x| x.planned_roll),
+        /// (K, 3) roll, pitch, yaw of the planned `R_d` (rad); NaN if not reported.
+        planned_rpy => o.column3(py, |x| x.planned_roll_pitch_yaw),
+        /// (K,) angle between `R` and the planned `R_d` (rad); NaN if not reported.
+        attitude_error => o.column(py, |x| x.attitude_error),
+        /// (K,) planner bisection angle `theta*` (rad); NaN if not reported.
+        theta => o.column(py, |x| x.theta),
+        /// (K,) allocation error `e_f = ||u_fd - u_f||` (N); NaN if not reported.
+        e_f => o.column(py, |x| x.e_f),
+        /// (K,) int64: agents the allocator saturated (-1 if not reported).
+        saturated_agents => o.saturated_agents(py),
+        /// (K,) Lyapunov candidate `V_x = ||e_x||_{K_x} + ||e_v||_{K_v}`; NaN if not reported.
+        v_x as "V_x" => o.column(py, |x| x.v_x),
+        /// (K,) Lyapunov candidate `V_R = Psi(R, R_d) + ||e_Omega||_{K_Omega}`; NaN if not
+        /// reported.
+        v_r as "V_R" => o.column(py, |x| x.v_r),
+        /// (K,) bool: the controller skipped the cycle (held its previous commands).
+        cycle_error => bool_array(py, &o.samples.iter().map(|x| x.cycle_error).collect::<Vec<_>>()),
+        /// (K, n, 3) commands per agent: `eta_x`, `eta_y` (rad), `thrust` (N).
+        commands => o.agents(py, |x| &x.commands),
+        /// (K, n, 3) actual actuator outputs at each tick (before the new commands act).
+        actual => o.agents(py, |x| &x.actual),
+        /// (K, n) bool: true failure flags of the agents.
+        failed => o.failed(py),
+        /// Every field of tvmd-sim's `RunSummary` as a dict (a fresh dict per access).
+        summary => record_to_py(py, &o.summary)?,
+        /// tvmd-sim's `PaperMetrics` (see docs/method.md, "Reproduction targets") as a dict.
+        paper_metrics => record_to_py(py, &o.paper)?,
+        /// The scenario that ran (overrides applied), as TOML text.
+        scenario_toml => o.scenario_toml()?,
+    }
+    methods {
+        fn __len__(&self) -> usize {
+            self.inner.samples.len()
+        }
+    }
 }
 
-fn agent_columns<'py>(
+/// A tvmd-sim record (serde) as Python objects: objects become dicts, arrays lists.
+fn record_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,
-    samples: &[Sample],
-    n: usize,
-    f: impl Fn(&Sample) -> &[AgentCommand],
-) -> Bound<'py, PyArray3<f64>> {
-    let a = Array3::from_shape_fn((samples.len(), n, 3), |(k, i, j)| {
-        samples
-            .get(k)
-            .and_then(|s| f(s).get(i))
-            .and_then(|c| [c.eta_x, c.eta_y, c.thrust].get(j).copied())
-            .unwrap_or(f64::NAN)
-    });
-    PyArray3::from_owned_array(py, a)
+    record: &T,
+) -> PyResult<Bound<'py, PyAny>> {
+    let value = serde_json::to_value(record)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot convert a tvmd-sim record: {e}")))?;
+    json_to_py(py, &value)
 }
 
-/// A JSON value (of a tvmd-sim record) as Python objects: objects become dicts, arrays lists.
+/// A JSON value as Python objects.
 fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     use serde_json::Value;
     Ok(match value {
@@ -645,325 +777,6 @@ fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound
             dict.into_any()
         }
     })
-}
-
-fn record_to_py<'py, T: serde::Serialize>(
-    py: Python<'py>,
-    record: &T,
-) -> PyResult<Bound<'py, PyAny>> {
-    let value = serde_json::to_value(record)
-        .map_err(|e| PyRuntimeError::new_err(format!("cannot convert a tvmd-sim record: {e}")))?;
-    json_to_py(py, &value)
-}
-
-impl PySimResult {
-    fn new(spec: RunSpec, result: RunResult) -> Self {
-        let scenario = spec.scenario;
-        let paper = PaperMetrics::new(&scenario, &result.samples);
-        let hover_roll_limit = hover_roll_limit(&scenario, scenario.relaxation).ok();
-        let team = scenario.team_body().ok();
-        let n = result
-            .samples
-            .first()
-            .map(|s| s.commands.len())
-            .or_else(|| team.as_ref().map(|t| t.len()))
-            .unwrap_or(0);
-        Self {
-            mass: team.as_ref().map(|t| t.mass()),
-            paper,
-            hover_roll_limit,
-            n,
-            mcap: spec.mcap,
-            samples: result.samples,
-            summary: result.summary,
-            scenario,
-        }
-    }
-
-    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let s = &self.samples;
-        Ok(match name {
-            "scenario_name" => any(py, self.scenario.name.as_str())?,
-            "relaxation" => any(py, self.scenario.relaxation)?,
-            "allocator" => any(py, self.scenario.allocator.as_str())?,
-            "mcap_path" => any(py, self.mcap_string())?,
-            "n_agents" => any(py, self.n)?,
-            "mass" => any(py, self.mass)?,
-            "gravity" => any(py, self.scenario.physics.gravity)?,
-            "hover_roll_limit" => any(py, self.hover_roll_limit)?,
-            "t" => column(py, s, |x| Some(x.t)).into_any(),
-            "position" => column3(py, s, |x| Some(x.position)).into_any(),
-            "velocity" => column3(py, s, |x| Some(x.velocity)).into_any(),
-            "reference_position" => column3(py, s, |x| Some(x.reference_position)).into_any(),
-            "attitude_rpy" => column3(py, s, |x| Some(x.roll_pitch_yaw)).into_any(),
-            "reference_rpy" => column3(py, s, |x| Some(x.reference_roll_pitch_yaw)).into_any(),
-            "reference_roll" => column(py, s, |x| Some(x.reference_roll)).into_any(),
-            "planned_roll" => column(py, s, |x| x.planned_roll).into_any(),
-            "planned_rpy" => column3(py, s, |x| x.planned_roll_pitch_yaw).into_any(),
-            "attitude_error" => column(py, s, |x| x.attitude_error).into_any(),
-            "theta" => column(py, s, |x| x.theta).into_any(),
-            "e_f" => column(py, s, |x| x.e_f).into_any(),
-            "saturated_agents" => {
-                let v: Vec<i64> = s
-                    .iter()
-                    .map(|x| {
-                        x.saturated_agents
-                            .map_or(-1, |c| i64::try_from(c).unwrap_or(i64::MAX))
-                    })
-                    .collect();
-                PyArray1::from_owned_array(py, Array1::from(v)).into_any()
-            }
-            "V_x" => column(py, s, |x| x.v_x).into_any(),
-            "V_R" => column(py, s, |x| x.v_r).into_any(),
-            "cycle_error" => {
-                let v: Vec<bool> = s.iter().map(|x| x.cycle_error).collect();
-                bool_array(py, &v).into_any()
-            }
-            "commands" => agent_columns(py, s, self.n, |x| &x.commands).into_any(),
-            "actual" => agent_columns(py, s, self.n, |x| &x.actual).into_any(),
-            "failed" => {
-                let a = Array2::from_shape_fn((s.len(), self.n), |(k, i)| {
-                    s.get(k)
-                        .and_then(|x| x.failed.get(i))
-                        .copied()
-                        .unwrap_or(false)
-                });
-                PyArray2::from_owned_array(py, a).into_any()
-            }
-            "summary" => record_to_py(py, &self.summary)?,
-            "paper_metrics" => record_to_py(py, &self.paper)?,
-            "scenario_toml" => any(py, self.scenario_toml()?)?,
-            other => {
-                return Err(PyAttributeError::new_err(format!(
-                    "SimResult has no field '{other}'"
-                )))
-            }
-        })
-    }
-
-    fn mcap_string(&self) -> Option<String> {
-        self.mcap.as_ref().map(|p| p.display().to_string())
-    }
-}
-
-#[pymethods]
-impl PySimResult {
-    /// (K,) time `t` (s).
-    #[getter]
-    fn t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "t")
-    }
-
-    /// (K, 3) position `x` of the centre of mass (m).
-    #[getter]
-    fn position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "position")
-    }
-
-    /// (K, 3) world velocity `x_dot` (m/s).
-    #[getter]
-    fn velocity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "velocity")
-    }
-
-    /// (K, 3) reference position `x_r` (m).
-    #[getter]
-    fn reference_position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "reference_position")
-    }
-
-    /// (K, 3) roll, pitch, yaw of `R` (rad, ZYX: `R = R_z(yaw) R_y(pitch) R_x(roll)`).
-    #[getter]
-    fn attitude_rpy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "attitude_rpy")
-    }
-
-    /// (K, 3) roll, pitch, yaw of the reference `R_r` (rad).
-    #[getter]
-    fn reference_rpy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "reference_rpy")
-    }
-
-    /// (K,) reference roll `phi_r` (rad).
-    #[getter]
-    fn reference_roll<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "reference_roll")
-    }
-
-    /// (K,) planned roll `phi_d = atan2(R_d[2,1], R_d[2,2])` (rad); NaN if not reported.
-    #[getter]
-    fn planned_roll<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "planned_roll")
-    }
-
-    /// (K, 3) roll, pitch, yaw of the planned `R_d` (rad); NaN if not reported.
-    #[getter]
-    fn planned_rpy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "planned_rpy")
-    }
-
-    /// (K,) angle between `R` and the planned `R_d` (rad); NaN if not reported.
-    #[getter]
-    fn attitude_error<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "attitude_error")
-    }
-
-    /// (K,) planner bisection angle `theta*` (rad); NaN if not reported.
-    #[getter]
-    fn theta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "theta")
-    }
-
-    /// (K,) allocation error `e_f = ||u_fd - u_f||` (N); NaN if not reported.
-    #[getter]
-    fn e_f<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "e_f")
-    }
-
-    /// (K,) int64: agents the allocator saturated (-1 if not reported).
-    #[getter]
-    fn saturated_agents<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "saturated_agents")
-    }
-
-    /// (K,) Lyapunov candidate `V_x = ||e_x||_{K_x} + ||e_v||_{K_v}`; NaN if not reported.
-    #[getter(V_x)]
-    fn v_x<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "V_x")
-    }
-
-    /// (K,) Lyapunov candidate `V_R = Psi(R, R_d) + ||e_Omega||_{K_Omega}`; NaN if not reported.
-    #[getter(V_R)]
-    fn v_r<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "V_R")
-    }
-
-    /// (K,) bool: the controller skipped the cycle (held its previous commands).
-    #[getter]
-    fn cycle_error<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "cycle_error")
-    }
-
-    /// (K, n, 3) commands per agent: `eta_x`, `eta_y` (rad), `thrust` (N).
-    #[getter]
-    fn commands<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "commands")
-    }
-
-    /// (K, n, 3) actual actuator outputs at each tick (before the new commands act).
-    #[getter]
-    fn actual<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "actual")
-    }
-
-    /// (K, n) bool: true failure flags of the agents.
-    #[getter]
-    fn failed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "failed")
-    }
-
-    /// Every field of tvmd-sim's `RunSummary` as a dict (a fresh dict per access).
-    #[getter]
-    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "summary")
-    }
-
-    /// tvmd-sim's `PaperMetrics` (SPEC "Reproduction targets") as a dict.
-    #[getter]
-    fn paper_metrics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.field(py, "paper_metrics")
-    }
-
-    /// Name of the scenario that ran (`"<name>-s<s>"` in a relaxation sweep).
-    #[getter]
-    fn scenario_name(&self) -> &str {
-        &self.scenario.name
-    }
-
-    /// Planner relaxation `s` of the run.
-    #[getter]
-    fn relaxation(&self) -> f64 {
-        self.scenario.relaxation
-    }
-
-    /// Allocator of the run.
-    #[getter]
-    fn allocator(&self) -> &str {
-        &self.scenario.allocator
-    }
-
-    /// Path of the MCAP log written, or None.
-    #[getter]
-    fn mcap_path(&self) -> Option<String> {
-        self.mcap_string()
-    }
-
-    /// Number of agents `n`.
-    #[getter]
-    fn n_agents(&self) -> usize {
-        self.n
-    }
-
-    /// Team mass `m_C` (kg).
-    #[getter]
-    fn mass(&self) -> Option<f64> {
-        self.mass
-    }
-
-    /// Gravity `g` of the run (m/s^2).
-    #[getter]
-    fn gravity(&self) -> f64 {
-        self.scenario.physics.gravity
-    }
-
-    /// `atan(c_y(1, s))` (rad): the planned roll at which the planner saturates in hover for
-    /// this team, limits and `s`.
-    #[getter]
-    fn hover_roll_limit(&self) -> Option<f64> {
-        self.hover_roll_limit
-    }
-
-    /// The scenario that ran (overrides applied), as TOML text.
-    #[getter]
-    fn scenario_toml(&self) -> PyResult<String> {
-        self.scenario
-            .to_toml_string()
-            .map_err(|e| sim_error(e, "", None))
-    }
-
-    /// The field names, in `to_dict` order.
-    #[classattr]
-    #[pyo3(name = "FIELDS")]
-    fn field_names<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        PyTuple::new(py, RESULT_FIELDS)
-    }
-
-    /// Every field as a dict (arrays, the summary dicts and the scenario TOML).
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let dict = PyDict::new(py);
-        for name in RESULT_FIELDS {
-            dict.set_item(*name, self.field(py, name)?)?;
-        }
-        Ok(dict)
-    }
-
-    fn __len__(&self) -> usize {
-        self.samples.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "SimResult(scenario_name='{}', relaxation={}, allocator='{}', samples={}, \
-             n_agents={}, mcap_path={})",
-            self.scenario.name,
-            self.scenario.relaxation,
-            self.scenario.allocator,
-            self.samples.len(),
-            self.n,
-            self.mcap_string()
-                .map_or_else(|| "None".to_string(), |p| format!("'{p}'"))
-        )
-    }
 }
 
 /// Registers the submodule `sim` (`tvmd._tvmd.sim`).

@@ -14,36 +14,8 @@ use crate::convert::{
 };
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
+use crate::record::record;
 use crate::CAPACITY;
-
-/// The team configuration `Xi = {(p_i, psi_i)}` with agent limits, masses and navigator
-/// (paper, "Modeling"; eqs. 3-6), validated. Up to 64 agents.
-///
-/// Args:
-///     positions: (n, 3) agent positions `p_i` in the team CoM frame {C} (m).
-///     quarter_turns: (n,) integers `m_i`, the agent yaws `psi_i = m_i pi/2`.
-///     masses: (n,) agent masses `m_i` (kg), or one mass for every agent.
-///     sigma_x: gimbal limit `sigma_x` of `|eta_x|` (rad), in (0, pi/2] (eq. 6).
-///     sigma_y: gimbal limit `sigma_y` of `|eta_y|` (rad), in (0, pi/2] (eq. 6).
-///     max_thrust: `sigma_Tf`, the maximum thrust of one agent (N). Rotor speeds are then
-///         normalized (`omega = 1` at maximum thrust); see `Team.from_rotor` for eq. (5).
-///     min_thrust: idle thrust (N) in [0, max_thrust), the smallest thrust allocated.
-///     navigator_mass: `m_0` (kg), >= 0.
-///     navigator_inertia: `J_0` (3, 3), symmetric positive semi-definite; default 0.
-///     agent_inertias: optional (n, 3, 3) inertias of the agents about their own CoM, in {C}
-///         axes (extension of the paper's point-mass model).
-///
-/// Team mass `m_C = m_0 + sum m_i`, inertia `J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)`.
-///
-/// Raises:
-///     ConfigError (a ValueError): the core's validation failed (no agents, more than 64,
-///         non-finite values, gimbal limits outside (0, pi/2], non-positive masses or thrust,
-///         a bad navigator inertia, or `M(Xi)` not of rank 6).
-///     ValueError / TypeError: wrong shapes or dtypes.
-#[pyclass(module = "tvmd", name = "Team", frozen)]
-pub struct PyTeam {
-    pub(crate) inner: TeamConfig<f64, CAPACITY>,
-}
 
 /// Agent specs from the array arguments.
 fn agent_specs(
@@ -141,8 +113,88 @@ impl PyTeam {
     }
 }
 
-#[pymethods]
-impl PyTeam {
+/// `Team(n=.., arrangement=.., ...)`.
+fn team_repr(t: &TeamConfig<f64, CAPACITY>) -> String {
+    let l = t.limits();
+    format!(
+        "Team(n={}, arrangement='{}', n_x={}, mass={}, sigma_x={}, sigma_y={}, max_thrust={})",
+        t.len(),
+        arrangement(t),
+        t.n_x(&FailureMask::none()),
+        t.mass(),
+        l.sigma_x,
+        l.sigma_y,
+        l.max_thrust
+    )
+}
+
+fn arrangement(t: &TeamConfig<f64, CAPACITY>) -> &'static str {
+    match t.arrangement() {
+        Arrangement::Con => "Con",
+        Arrangement::Inc => "Inc",
+    }
+}
+
+record! {
+    /// The team configuration `Xi = {(p_i, psi_i)}` with agent limits, masses and navigator
+    /// (paper, "Modeling"; eqs. 3-6), validated. Up to 64 agents.
+    ///
+    /// Args:
+    ///     positions: (n, 3) agent positions `p_i` in the team CoM frame {C} (m).
+    ///     quarter_turns: (n,) integers `m_i`, the agent yaws `psi_i = m_i pi/2`.
+    ///     masses: (n,) agent masses `m_i` (kg), or one mass for every agent.
+    ///     sigma_x: gimbal limit `sigma_x` of `|eta_x|` (rad), in (0, pi/2] (eq. 6).
+    ///     sigma_y: gimbal limit `sigma_y` of `|eta_y|` (rad), in (0, pi/2] (eq. 6).
+    ///     max_thrust: `sigma_Tf`, the maximum thrust of one agent (N). Rotor speeds are then
+    ///         normalized (`omega = 1` at maximum thrust); see `Team.from_rotor` for eq. (5).
+    ///     min_thrust: idle thrust (N) in [0, max_thrust), the smallest thrust allocated.
+    ///     navigator_mass: `m_0` (kg), >= 0.
+    ///     navigator_inertia: `J_0` (3, 3), symmetric positive semi-definite; default 0.
+    ///     agent_inertias: optional (n, 3, 3) inertias of the agents about their own CoM, in {C}
+    ///         axes (extension of the paper's point-mass model).
+    ///
+    /// Team mass `m_C = m_0 + sum m_i`, inertia `J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)`.
+    ///
+    /// Raises:
+    ///     ConfigError (a ValueError): the core's validation failed (no agents, more than 64,
+    ///         non-finite values, gimbal limits outside (0, pi/2], non-positive masses or thrust,
+    ///         a bad navigator inertia, or `M(Xi)` not of rank 6).
+    ///     ValueError / TypeError: wrong shapes or dtypes.
+    "Team" in "tvmd" => PyTeam(TeamConfig<f64, CAPACITY>) repr team_repr |py, o| {
+        /// `n`, the number of agents.
+        n => o.len(),
+        /// `n_x`: agents with even `m_i` (x gimbal axis along the team's x axis).
+        n_x => o.n_x(&FailureMask::none()),
+        /// `n_y = n - n_x`: agents with odd `m_i`.
+        n_y => o.n_y(&FailureMask::none()),
+        /// `m_C = m_0 + sum m_i`, the team mass (kg).
+        mass => o.mass(),
+        /// `J_C` (3, 3), the team inertia about its CoM (kg m^2).
+        inertia => matrix_array(py, &o.inertia()),
+        /// (n, 3) agent positions `p_i` in {C} (m).
+        positions => rows_array(py, &o.agents().iter().map(|a| a.position.into()).collect::<Vec<[f64; 3]>>()),
+        /// (n,) int64 quarter turns `m_i` (`psi_i = m_i pi/2`).
+        quarter_turns => PyArray1::from_vec(py, o.agents().iter().map(|a| i64::from(a.quarter_turns)).collect()),
+        /// (n,) agent masses `m_i` (kg).
+        masses => array1(py, &o.agents().iter().map(|a| a.mass).collect::<Vec<_>>()),
+        /// "Con" if every `m_i` is even (all gimbal axes aligned with the team's), else "Inc".
+        arrangement => arrangement(o),
+        /// `sigma_x` (rad), the limit of `|eta_x|`.
+        sigma_x => o.limits().sigma_x,
+        /// `sigma_y` (rad), the limit of `|eta_y|`.
+        sigma_y => o.limits().sigma_y,
+        /// `sigma_Tf` (N), the maximum thrust of one agent.
+        max_thrust => o.limits().max_thrust,
+        /// The idle thrust (N).
+        min_thrust => o.limits().min_thrust,
+        /// `rho d^4 c_l` of eq. (5) (N s^2/rad^2); equals `max_thrust` for normalized speeds.
+        thrust_coefficient => o.limits().thrust_coefficient,
+        /// `m_0` (kg).
+        navigator_mass => o.navigator().mass,
+        /// `J_0` (3, 3) (kg m^2).
+        navigator_inertia => matrix_array(py, &o.navigator().inertia),
+    }
+    methods {
     #[new]
     #[pyo3(signature = (positions, quarter_turns, masses, sigma_x, sigma_y, max_thrust, min_thrust = 0.0, navigator_mass = 0.0, navigator_inertia = None, agent_inertias = None))]
     #[allow(clippy::too_many_arguments)]
@@ -234,118 +286,6 @@ impl PyTeam {
         Self::wrap(presets::ring(n, radius, inconsistent, limits))
     }
 
-    /// `n`, the number of agents.
-    #[getter]
-    fn n(&self) -> usize {
-        self.inner.len()
-    }
-
-    /// `n_x`: agents with even `m_i` (x gimbal axis along the team's x axis).
-    #[getter]
-    fn n_x(&self) -> usize {
-        self.inner.n_x(&FailureMask::none())
-    }
-
-    /// `n_y = n - n_x`: agents with odd `m_i`.
-    #[getter]
-    fn n_y(&self) -> usize {
-        self.inner.n_y(&FailureMask::none())
-    }
-
-    /// `m_C = m_0 + sum m_i`, the team mass (kg).
-    #[getter]
-    fn mass(&self) -> f64 {
-        self.inner.mass()
-    }
-
-    /// `J_C` (3, 3), the team inertia about its CoM (kg m^2).
-    #[getter]
-    fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.inertia())
-    }
-
-    /// (n, 3) agent positions `p_i` in {C} (m).
-    #[getter]
-    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let rows: Vec<[f64; 3]> = self
-            .inner
-            .agents()
-            .iter()
-            .map(|a| [a.position.x, a.position.y, a.position.z])
-            .collect();
-        rows_array(py, &rows)
-    }
-
-    /// (n,) int64 quarter turns `m_i` (`psi_i = m_i pi/2`).
-    #[getter]
-    fn quarter_turns<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let turns: Vec<i64> = self
-            .inner
-            .agents()
-            .iter()
-            .map(|a| i64::from(a.quarter_turns))
-            .collect();
-        PyArray1::from_vec(py, turns)
-    }
-
-    /// (n,) agent masses `m_i` (kg).
-    #[getter]
-    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let masses: Vec<f64> = self.inner.agents().iter().map(|a| a.mass).collect();
-        array1(py, &masses)
-    }
-
-    /// "Con" if every `m_i` is even (all gimbal axes aligned with the team's), else "Inc".
-    #[getter]
-    fn arrangement(&self) -> &'static str {
-        match self.inner.arrangement() {
-            Arrangement::Con => "Con",
-            Arrangement::Inc => "Inc",
-        }
-    }
-
-    /// `sigma_x` (rad), the limit of `|eta_x|`.
-    #[getter]
-    fn sigma_x(&self) -> f64 {
-        self.inner.limits().sigma_x
-    }
-
-    /// `sigma_y` (rad), the limit of `|eta_y|`.
-    #[getter]
-    fn sigma_y(&self) -> f64 {
-        self.inner.limits().sigma_y
-    }
-
-    /// `sigma_Tf` (N), the maximum thrust of one agent.
-    #[getter]
-    fn max_thrust(&self) -> f64 {
-        self.inner.limits().max_thrust
-    }
-
-    /// The idle thrust (N).
-    #[getter]
-    fn min_thrust(&self) -> f64 {
-        self.inner.limits().min_thrust
-    }
-
-    /// `rho d^4 c_l` of eq. (5) (N s^2/rad^2); equals `max_thrust` for normalized speeds.
-    #[getter]
-    fn thrust_coefficient(&self) -> f64 {
-        self.inner.limits().thrust_coefficient
-    }
-
-    /// `m_0` (kg).
-    #[getter]
-    fn navigator_mass(&self) -> f64 {
-        self.inner.navigator().mass
-    }
-
-    /// `J_0` (3, 3) (kg m^2).
-    #[getter]
-    fn navigator_inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix_array(py, &self.inner.navigator().inertia)
-    }
-
     /// `M(Xi)`, the (6, 3n) effectiveness matrix of eq. (4), rows `[torque; force]`: block `i`
     /// is `[[p_i]x R_z(psi_i); R_z(psi_i)]`, so the wrench is `u = M f` for the stacked
     /// agent-frame forces `f = [f_1; ...; f_n]`. Columns of failed agents are zero.
@@ -409,18 +349,6 @@ impl PyTeam {
     fn plant(&self, gravity: f64) -> PyResult<PyPlant> {
         PyPlant::create(self.inner.mass(), self.inner.inertia(), gravity)
     }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Team(n={}, arrangement='{}', n_x={}, mass={}, sigma_x={}, sigma_y={}, max_thrust={})",
-            self.inner.len(),
-            self.arrangement(),
-            self.n_x(),
-            self.inner.mass(),
-            self.inner.limits().sigma_x,
-            self.inner.limits().sigma_y,
-            self.inner.limits().max_thrust
-        )
     }
 }
 

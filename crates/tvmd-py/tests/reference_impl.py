@@ -1,6 +1,6 @@
 """Independent pure-NumPy reference implementation of the TVMD paper.
 
-This module re-implements, from ``SPEC.md`` and the paper's equations, the pure
+This module re-implements, from ``docs/method.md`` and the paper's equations, the pure
 functions of the TVMD core (gimbal model, effectiveness matrix, approximated
 attainable force space, force projection, attitude planner, control law and
 pseudo-inverse allocation). It deliberately shares no code with the Rust crates:
@@ -12,19 +12,19 @@ Equation numbers count the numbered equations of the paper in order:
     (1) gimbal reduced attitude      (2) kinematics x_dot = R v, R_dot = R [Omega]x
     (3) G xi_dot = C(xi) xi + u + g  (4) wrench u = M(Xi) f
     (5) thrust T = rho d^4 c_l w^2   (6) gimbal / speed limits
-    (7) approximated AFS (cone)      (8) semi-axes c_x, c_y (two lines: 7-8 in SPEC)
+    (7) approximated AFS (cone)      (8) semi-axes c_x, c_y (two lines: 7-8 in docs/method.md)
     (9) attitude planner R_d         (10) t_Tf scaling
     (11) planner optimisation (bisection on theta)
     (12) control law u_d = blockdiag(I, K_f) u_r     (13) t_eta projection
 
-Conventions (as in SPEC.md):
+Conventions (as in docs/method.md):
 
 * SI units, angles in radians, z axis up, gravity g = 9.81 m/s^2 by default.
 * The twist is xi = [Omega; v], both expressed in the body (team) frame {C}; x_dot = R v.
 * Wrenches are ordered [torque; force]; M is 6 x 3n.
 * Agent yaw psi_i = m_i * pi/2 is always carried as the integer number of quarter turns m_i.
 * sigma_Tf ("max_thrust") is the maximum thrust of ONE agent.
-* The gravity wrench is g_C = [0; -m_C g R^T e3] (SPEC: the paper prints it without the minus
+* The gravity wrench is g_C = [0; -m_C g R^T e3] (docs/method.md: the paper prints it without the minus
   sign, which is wrong for a z-up frame); the control law's "- g_C" therefore adds +m_C g R^T e3.
 
 Only NumPy is used.
@@ -198,7 +198,7 @@ def team_mass_inertia(positions, masses, navigator_mass=0.0, navigator_inertia=N
     m_C = m_0 + sum m_i,  J_C = J_0 - sum m_i [p_i]x [p_i]x (point-mass agents).
 
     ``navigator_inertia`` (J_0, 3x3) defaults to zero. ``agent_inertias`` is the optional
-    extension of SPEC: a sequence of per-agent 3x3 inertias about each agent's own CoM,
+    extension of docs/method.md: a sequence of per-agent 3x3 inertias about each agent's own CoM,
     expressed in {C}, added to J_C. Positions are taken relative to the team CoM.
     Returns ``(m_C, J_C)``.
     """
@@ -232,7 +232,7 @@ def _g_term(n_k, n, sigma, z, max_thrust):
       = (n_k/n)(1 - delta(n_k)) |z| tan(sigma)    otherwise,
     where delta is the Kronecker delta (1 iff n_k = 0), so the term vanishes without agents.
     ``wide`` tells whether the sigma >= pi/2 branch was taken with at least one agent; such
-    an axis does not shrink to 0 at z = 0, so the z > 0 requirement is lifted (SPEC).
+    an axis does not shrink to 0 at z = 0, so the z > 0 requirement is lifted (docs/method.md).
     """
     if sigma >= _HALF_PI:
         return n_k * max_thrust, n_k > 0
@@ -284,7 +284,7 @@ def afs_contains(u, n, n_x, sigma_x, sigma_y, s, max_thrust):
       * ||u|| <= n sigma_Tf (the paper writes a strict "<"; we accept the boundary so that a
         force scaled by t_Tf to exactly n sigma_Tf is attainable),
       * u^T C(u_z) u <= 1, and
-      * u_z > 0, unless some semi-axis comes from the sigma >= pi/2 branch of g (SPEC reading;
+      * u_z > 0, unless some semi-axis comes from the sigma >= pi/2 branch of g (docs/method.md reading;
         the tan-branch cone would otherwise be mirrored below the x-y plane by |z|).
     """
     u = np.asarray(u, dtype=float)
@@ -361,7 +361,7 @@ def attitude_planner(R_r, f_r, n, n_x, sigma_x, sigma_y, max_thrust, s, tol=1e-1
       Franchi et al.'s arcsin bound), and the smallest feasible theta is found by bisection.
       Each trial attitude is completed by :func:`_frame_from_bz` and checked as
       R_d^T f_r in the AFS.
-    * Improvements prescribed by SPEC: the bisection keeps the invariant "hi is feasible" and
+    * Improvements prescribed by docs/method.md: the bisection keeps the invariant "hi is feasible" and
       returns hi (the last *feasible* point, never the infeasible side); it stops when
       hi - lo <= tol or after max_iter halvings; if f_r is (anti)parallel to b_zr
       (||b_zr x f_r|| <= 1e-9 ||f_r||) the rotation axis is k = b_xr (i.e. the vehicle rolls,
@@ -452,13 +452,13 @@ def control_law(
     two derivatives, reference attitude ``R_r``, desired rate ``Omega_d`` and its derivative
     (both in the desired frame). Gains: ``K_x``, ``K_R`` (3x3) and ``K_xi`` (6x6, order
     [Omega; v]; a vector is read as a diagonal). ``K_xi`` must be block diagonal, because
-    SPEC computes the force part before R_d (and hence e_Omega) is known.
+    docs/method.md computes the force part before R_d (and hence e_Omega) is known.
 
     Model (eqs. (2)-(3)): G = blockdiag(J_C, m_C I),
     C(xi) = blockdiag([J_C Omega]x, -m_C [Omega]x)  (J Omega_dot = (J Omega) x Omega + tau,
     m v_dot = -m Omega x v + f), gravity wrench g_C = [0; -m_C g R^T e3] (z up).
 
-    One cycle, in SPEC's order:
+    One cycle, in the order of docs/method.md:
       1. e_x = x - x_r, xi_d,v = R^T x_r_dot, e_v = v - xi_d,v,
          xi_d_dot,v = R^T x_r_ddot - Omega x R^T x_r_dot and
          u_fr = m (xi_d_dot,v + Omega x xi_d,v) - K_v e_v - R^T K_x e_x + m g R^T e3
@@ -586,7 +586,7 @@ def agent_commands(f):
 
 
 # ---------------------------------------------------------------------------
-# The paper's team and scenario (section "Simulations", SPEC scenario "paper-tilt")
+# The paper's team and scenario (section "Simulations", docs/method.md, scenario "paper-tilt")
 # ---------------------------------------------------------------------------
 
 _A4_HALF = 0.5 * math.sqrt(2.0) / 2.0
@@ -637,7 +637,7 @@ def paper_a4_inc():
 
     4 agents at (+-a, +-a, 0), a = 0.5 sqrt(2)/2 m, in the order (+a,+a), (+a,-a), (-a,-a),
     (-a,+a); m_i = 0.7 kg, navigator mass 0; sigma_x = pi/6, sigma_y = pi/4,
-    sigma_Tf = 2 m_i g; SPEC gains (not scaled by mass or inertia), s = 0.5, 100 Hz control.
+    sigma_Tf = 2 m_i g; the gains of docs/method.md (not scaled by mass or inertia), s = 0.5, 100 Hz control.
     """
     return _paper_team([1, 1, 0, 0])
 
@@ -648,7 +648,7 @@ def paper_a4_con():
 
 
 def paper_reference(t):
-    """Reference of the paper's simulation (SPEC scenario "paper-tilt") at time ``t``.
+    """Reference of the paper's simulation (docs/method.md, scenario "paper-tilt") at time ``t``.
 
     A) 0-2 s: x_r = [0, 0, 0.75 (1 - cos(pi t / 2))], then hover at z = 1.5 m;
     B) 4-10 s: roll phi_r = (pi/6)(1 + cos((t - 7) pi / 3)) about the body x axis

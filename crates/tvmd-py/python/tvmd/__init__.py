@@ -12,7 +12,8 @@ UAV*). Equation numbers refer to the paper.
 * :class:`Gains`, :class:`State`, :class:`Reference`, :class:`Plant`, :func:`force_request`,
   :func:`control_wrench` -- the control law (eq. 12).
 * :func:`allocate` -- the allocators (pseudo-inverse, weighted, redistributed, Clarabel).
-* :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`.
+* :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`
+  (``out.planner``, ``out.projection``, ``out.law``, ``out.allocation``, ``out.commands``).
 * :mod:`tvmd.sim` -- the simulator ``tvmd-sim`` (the paper's simulation, relaxation study).
 
 Arrays are float64 NumPy arrays, SI units, z up, twist ``xi = [Omega; v]`` in the body frame,
@@ -32,6 +33,7 @@ from ._tvmd import (
     ConfigError,
     Controller,
     CycleError,
+    ForceProjection,
     Gains,
     InputError,
     LawOutput,
@@ -62,6 +64,7 @@ __all__ = [
     "ConfigError",
     "Controller",
     "CycleError",
+    "ForceProjection",
     "Gains",
     "InputError",
     "LawOutput",
