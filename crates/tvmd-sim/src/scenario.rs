@@ -429,6 +429,19 @@ impl Scenario {
         })
     }
 
+    /// The scenario named by a command-line or Python argument: a TOML file if `name_or_path`
+    /// ends in `.toml` or names an existing file, else a built-in (see [`BUILTIN_NAMES`]).
+    /// Errors: [`SimError::Io`] for a file that cannot be read, [`SimError::ScenarioParse`] /
+    /// [`SimError::InvalidScenario`] naming the field, [`SimError::UnknownScenario`].
+    pub fn load(name_or_path: &str) -> Result<Self, SimError> {
+        let path = Path::new(name_or_path);
+        if name_or_path.ends_with(".toml") || path.is_file() {
+            Self::from_file(path)
+        } else {
+            Self::builtin(name_or_path)
+        }
+    }
+
     /// Serialises the scenario as TOML (the format [`Scenario::from_toml_str`] reads).
     pub fn to_toml_string(&self) -> Result<String, SimError> {
         toml::to_string(self).map_err(|e| SimError::ScenarioParse {
@@ -671,6 +684,41 @@ impl Scenario {
     }
 }
 
+/// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// Planner relaxation `s` in `(0, 1]`.
+    pub relaxation: Option<f64>,
+    /// Allocator name (one of [`crate::scenario::ALLOCATOR_NAMES`]).
+    pub allocator: Option<String>,
+}
+
+impl Overrides {
+    /// True if nothing is overridden.
+    pub fn is_empty(&self) -> bool {
+        self.relaxation.is_none() && self.allocator.is_none()
+    }
+
+    /// Applies the overrides to `scenario` and validates the result; errors name the field.
+    pub fn apply(&self, scenario: &mut Scenario) -> Result<(), SimError> {
+        if let Some(s) = self.relaxation {
+            scenario.relaxation = s;
+        }
+        if let Some(a) = &self.allocator {
+            scenario.allocator.clone_from(a);
+        }
+        scenario.validate()
+    }
+}
+
+impl Scenario {
+    /// This scenario with `overrides` applied, validated.
+    pub fn with_overrides(mut self, overrides: &Overrides) -> Result<Self, SimError> {
+        overrides.apply(&mut self)?;
+        Ok(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -778,5 +826,71 @@ state_noise = { position = 0.01, seed = 7 }
         assert_eq!(s.disturbances.state_noise.unwrap().seed, 7);
         assert_eq!(s.max_thrust().unwrap(), 12.0);
         assert!(matches!(s.reference, ReferenceConfig::Hover { .. }));
+    }
+
+    #[test]
+    fn overrides_replace_and_validate() {
+        let o = Overrides {
+            relaxation: Some(1.0),
+            allocator: Some("pseudo-inverse".into()),
+        };
+        let s = Scenario::default().with_overrides(&o).unwrap();
+        assert_eq!(s.relaxation, 1.0);
+        assert_eq!(s.allocator, "pseudo-inverse");
+        assert_eq!(
+            Scenario::default()
+                .with_overrides(&Overrides::default())
+                .unwrap(),
+            Scenario::default()
+        );
+        let bad = Overrides {
+            relaxation: Some(1.5),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "relaxation"),
+            "{e}"
+        );
+        let bad = Overrides {
+            allocator: Some("magic".into()),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "allocator"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn load_takes_a_builtin_name_or_a_file() {
+        assert_eq!(
+            Scenario::load("a4-con").unwrap(),
+            Scenario::builtin("a4-con").unwrap()
+        );
+        assert!(matches!(
+            Scenario::load("nope"),
+            Err(SimError::UnknownScenario { .. })
+        ));
+        assert!(matches!(
+            Scenario::load("missing-file.toml"),
+            Err(SimError::Io(_))
+        ));
+        let dir = std::env::temp_dir().join(format!("tvmd-sim-load-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A file without the .toml suffix is still a file.
+        let path = dir.join("scenario");
+        std::fs::write(&path, "name = \"from-file\"\nrelaxation = 1.0\n").unwrap();
+        let s = Scenario::load(path.to_str().unwrap()).unwrap();
+        assert_eq!((s.name.as_str(), s.relaxation), ("from-file", 1.0));
+        std::fs::write(&path, "[physics]\ndt = -1.0\n").unwrap();
+        let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("invalid scenario field `physics.dt`"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
