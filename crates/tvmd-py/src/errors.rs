@@ -18,7 +18,8 @@ pyo3::create_exception!(
     tvmd,
     ConfigError,
     PyValueError,
-    "A team, limit, gain, setting or failure mask that cannot be used (tvmd_core::ConfigError)."
+    "A team, limit, gain, setting or failure mask that cannot be used (tvmd_core::ConfigError). \
+Attribute `field`: the offending field (e.g. 'gains.k_x'), or None."
 );
 
 pyo3::create_exception!(
@@ -45,7 +46,16 @@ pub(crate) trait OrRaise<T> {
 
 impl<T> OrRaise<T> for Result<T, tvmd_core::ConfigError> {
     fn or_raise(self) -> PyResult<T> {
-        self.map_err(|e| ConfigError::new_err(e.to_string()))
+        self.map_err(|e| {
+            let err = ConfigError::new_err(e.to_string());
+            // The core's typed field (e.g. "gains.k_x"), None when the error names none.
+            Python::attach(|py| {
+                let _ = err
+                    .value(py)
+                    .setattr("field", e.field().map(|f| f.as_str()));
+            });
+            err
+        })
     }
 }
 

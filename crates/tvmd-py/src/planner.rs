@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 
-use tvmd_core::{AttitudePlanner, PlannerOutput, PlannerStatus, Relaxation};
+use tvmd_core::{AttitudePlanner, PlannerOutput, Relaxation};
 
 use crate::afs::PyAfs;
 use crate::convert::{class_arg, finite_matrix3, finite_vector3, matrix_array};
@@ -43,16 +43,6 @@ pub(crate) fn relaxation_arg(
         })?,
     };
     Relaxation::new(value).or_raise()
-}
-
-/// The planner status as a Python string.
-pub(crate) fn status_name(status: PlannerStatus) -> &'static str {
-    match status {
-        PlannerStatus::AlreadyFeasible => "already_feasible",
-        PlannerStatus::Planned => "planned",
-        PlannerStatus::ZeroForce => "zero_force",
-        PlannerStatus::Unreachable => "unreachable",
-    }
 }
 
 /// The bisection attitude planner of eqs. (9)-(11): the smallest tilt `theta` of the reference
@@ -159,7 +149,7 @@ record! {
     ///     R_d: (3, 3) planned attitude `[b_xd b_yd b_zd]`.
     ///     theta: the tilt `theta*` from `b_zr` toward `f_r` (rad).
     ///     iterations: bisection iterations used (0 unless status is "planned").
-    ///     status: "already_feasible" (`R_d = R_r`), "planned" (bisection), "zero_force"
+    ///     status: "already-feasible" (`R_d = R_r`), "planned" (bisection), "zero-force"
     ///         (`f_r = 0`, `R_d = R_r`) or "unreachable" (`||f_r|| > n sigma_Tf`: `b_zd` along
     ///         `f_r`).
     "PlannerResult" in "tvmd" => PyPlannerResult(PlannerOutput<f64>) |py, o| {
@@ -169,8 +159,8 @@ record! {
         theta => o.theta,
         /// Bisection iterations used.
         iterations => o.iterations,
-        /// "already_feasible", "planned", "zero_force" or "unreachable".
-        status => status_name(o.status),
+        /// "already-feasible", "planned", "zero-force" or "unreachable".
+        status => o.status.as_str(),
     }
 }
 

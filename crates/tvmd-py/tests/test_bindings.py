@@ -295,7 +295,7 @@ def test_attitude_planner_vectors(case, agreement):
     agreement.record("vectors.planner.R_d (default tolerance)", out.R_d, case["R_d"])
     np.testing.assert_allclose(out.theta, case["theta"], rtol=0.0, atol=PLANNER_TOL)
     np.testing.assert_allclose(out.R_d, np.asarray(case["R_d"]), rtol=0.0, atol=PLANNER_TOL)
-    assert (out.status == "already_feasible") == (case["theta"] == 0.0)
+    assert (out.status == "already-feasible") == (case["theta"] == 0.0)
     assert afs.contains(out.R_d.T @ np.asarray(case["f_r"]), case["s"])
 
 
@@ -311,13 +311,13 @@ def test_planner_random(agreement):
         out = tvmd.AttitudePlanner(s, tolerance=1e-12).plan(afs, R_r, f_r)
         R_d, theta, feasible = ri.attitude_planner(R_r, f_r, n, n_x, sx, sy, T, s, tol=1e-12)
         statuses.add(out.status)
-        assert (out.status == "already_feasible") == feasible
+        assert (out.status == "already-feasible") == feasible
         agreement.record("planner.theta", out.theta, theta)
         agreement.record("planner.R_d", out.R_d, R_d)
         np.testing.assert_allclose(out.theta, theta, rtol=0.0, atol=1e-6)
         np.testing.assert_allclose(out.R_d, R_d, rtol=0.0, atol=1e-6)
         np.testing.assert_allclose(out.R_d.T @ out.R_d, np.eye(3), atol=1e-12)
-    assert {"already_feasible", "planned"} <= statuses
+    assert {"already-feasible", "planned"} <= statuses
 
 
 def test_planner_hover_saturation_law():
@@ -333,7 +333,7 @@ def test_planner_hover_saturation_law():
     out = tvmd.AttitudePlanner(0.5).plan(afs, ri.rot_x(0.4), [0.0, 0.0, team.mass * 9.81])
     assert math.atan2(out.R_d[2, 1], out.R_d[2, 2]) == pytest.approx(0.3287, abs=5e-5)
     zero = tvmd.AttitudePlanner(0.5).plan(afs, ri.rot_x(0.2), [0.0, 0.0, 0.0])
-    assert zero.status == "zero_force" and zero.theta == 0.0
+    assert zero.status == "zero-force" and zero.theta == 0.0
     assert set(zero.to_dict()) == {"R_d", "theta", "iterations", "status"}
     # `relaxation` is the keyword everywhere; `s` stays as an alias.
     assert tvmd.AttitudePlanner(relaxation=0.25).relaxation == tvmd.AttitudePlanner(s=0.25).relaxation == 0.25
@@ -536,7 +536,7 @@ def test_controller_hover_equilibrium(team, allocator, agreement):
     _close(out.law.u_d, [0, 0, 0, 0, 0, mg], rtol=1e-12, atol=1e-12)
     _close(out.allocation.wrench, out.law.u_d, rtol=1e-12, atol=1e-12)
     assert np.all(np.abs(out.commands[:, :2]) < 1e-12)
-    assert out.allocation.e_f < 1e-12 and out.law.V_x == 0.0 and out.planner.status == "already_feasible"
+    assert out.allocation.e_f < 1e-12 and out.law.V_x == 0.0 and out.planner.status == "already-feasible"
     assert out.projection.t_Tf == 1.0 and out.projection.t_eta == 1.0 and not out.allocation.saturated.any()
     # omega normalized to 1 at maximum thrust (eq. 5 without rotor constants).
     _close(out.commands[:, 3], np.sqrt(out.commands[:, 2] / team.max_thrust), rtol=1e-12, atol=0)
@@ -564,7 +564,7 @@ def test_controller_step_matches_reference(agreement):
             value = getattr(out if part is None else getattr(out, part), name)
             agreement.record(f"controller.step.{name}", value, ref[key])
             _close(value, ref[key], rtol=tol, atol=tol)
-        assert (out.planner.status == "already_feasible") == ref["feasible_already"]
+        assert (out.planner.status == "already-feasible") == ref["feasible_already"]
         if not out.allocation.saturated.any():
             compared += 1
             f_ref = ri.pseudo_inverse_allocation(team_ref["M"], ref["u_d"]).reshape(-1, 3)
@@ -775,6 +775,15 @@ def test_error_paths(call, exc, match):
         call()
     # ConfigError/InputError/CycleError are ValueErrors; nothing is a PanicException.
     assert isinstance(info.value, (ValueError, TypeError))
+
+
+def test_config_error_field():
+    with pytest.raises(tvmd.ConfigError) as info:
+        tvmd.Gains([1, -1, 1], [1, 1, 1], np.ones(6))
+    assert info.value.field == "gains.k_x"
+    with pytest.raises(tvmd.ConfigError) as info:
+        tvmd.AttitudePlanner(relaxation=2.0)
+    assert info.value.field == "relaxation"
 
 
 def test_set_failures_keeps_previous_mask_on_error():

@@ -74,13 +74,9 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "a6-agent-failure",
 ];
 
-/// Allocator names a scenario may give (`"clarabel"` needs the `clarabel` feature at run time).
-pub const ALLOCATOR_NAMES: &[&str] = &[
-    "redistributed-pseudo-inverse",
-    "pseudo-inverse",
-    "weighted-pseudo-inverse",
-    "clarabel",
-];
+/// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
+/// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
+pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
 
 /// The team: a preset or explicit agents.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -601,7 +597,9 @@ impl Scenario {
         if let Some(t) = self.limits.max_thrust {
             check_pos("limits.max_thrust", t)?;
         }
-        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str()) {
+        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str())
+            && self.allocator != tvmd_core::allocation::CLARABEL
+        {
             return Err(invalid(
                 "allocator",
                 format!(

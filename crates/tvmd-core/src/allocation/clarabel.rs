@@ -13,7 +13,8 @@ use nalgebra::{Matrix6, Matrix6x3, Vector3, Vector6};
 
 use super::{solve_gram, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse};
 use crate::admissible::AdmissibleSet;
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
+use crate::linalg::weighted_gram;
 use crate::real::{lit, to_f64, Real};
 
 /// Clarabel's termination status (re-exported from `clarabel::solver::SolverStatus`).
@@ -217,12 +218,12 @@ impl<T: Real, const N: usize> ClarabelAllocator<T, N> {
     /// An allocator with regularisation `lambda >= 0` (finite) and wrench weights `W =
     /// diag(weights)` (`[torque; force]` order, each positive and finite; `None`: identity).
     ///
-    /// Errors with [`ConfigError::Parameter`] named `"clarabel.lambda"` or `"clarabel.weights"`.
+    /// Errors with [`ConfigError::Parameter`] naming [`ConfigField::ClarabelLambda`] or [`ConfigField::ClarabelWeights`].
     pub fn new(lambda: T, weights: Option<[T; 6]>) -> Result<Self, ConfigError> {
         let lambda = to_f64(lambda);
         if !lambda.is_finite() || lambda < 0.0 {
             return Err(ConfigError::Parameter {
-                name: "clarabel.lambda",
+                field: ConfigField::ClarabelLambda,
             });
         }
         let mut w = [1.0; 6];
@@ -231,7 +232,7 @@ impl<T: Real, const N: usize> ClarabelAllocator<T, N> {
                 let value = to_f64(value);
                 if !value.is_finite() || value <= 0.0 {
                     return Err(ConfigError::Parameter {
-                        name: "clarabel.weights",
+                        field: ConfigField::ClarabelWeights,
                     });
                 }
                 *slot = value;
@@ -254,13 +255,13 @@ impl<T: Real, const N: usize> ClarabelAllocator<T, N> {
 
     /// Clarabel's absolute and relative duality-gap and feasibility tolerance (default `1e-9`).
     ///
-    /// Errors with [`ConfigError::Parameter`] named `"clarabel.tolerance"` unless positive and
+    /// Errors with [`ConfigError::Parameter`] naming [`ConfigField::ClarabelTolerance`] unless positive and
     /// finite.
     pub fn with_tolerance(mut self, tolerance: T) -> Result<Self, ConfigError> {
         let tol = to_f64(tolerance);
         if !tol.is_finite() || tol <= 0.0 {
             return Err(ConfigError::Parameter {
-                name: "clarabel.tolerance",
+                field: ConfigField::ClarabelTolerance,
             });
         }
         self.settings.tol_gap_abs = tol;
@@ -492,7 +493,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ClarabelAllocator<T, N> {
     }
 
     fn name(&self) -> &'static str {
-        "clarabel"
+        super::any::CLARABEL
     }
 }
 
@@ -762,15 +763,20 @@ impl<const N: usize> Problem<N> {
     /// `forces`: `f_k = B_k^T (sum_free B_j B_j^T + lambda I)^-1 (W u - sum_fixed B_j f_j)`
     /// (minimum norm when the bracket is singular).
     fn least_squares(&self, free: &[bool], forces: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        let mut gram = Matrix6::identity() * self.lambda;
         let mut rhs = self.target;
         for ((agent, is_free), f) in self.agents.iter().zip(free).zip(forces) {
-            if *is_free {
-                gram += agent.block * agent.block.transpose();
-            } else {
+            if !*is_free {
                 rhs -= agent.block * Vector3::from(*f);
             }
         }
+        let gram = weighted_gram(
+            Matrix6::identity() * self.lambda,
+            self.agents
+                .iter()
+                .zip(free)
+                .filter(|(_, is_free)| **is_free)
+                .map(|(agent, _)| (&agent.block, 1.0)),
+        );
         let y = solve_gram(&gram, &rhs);
         self.agents
             .iter()

@@ -29,13 +29,15 @@ AllocatorName = Literal[
     "pseudo-inverse", "weighted-pseudo-inverse", "redistributed-pseudo-inverse", "clarabel"
 ]
 """The allocators (``"clarabel"`` only with the cargo feature, see ``ALLOCATORS``)."""
-PlannerStatus = Literal["already_feasible", "planned", "zero_force", "unreachable"]
+PlannerStatus = Literal["already-feasible", "planned", "zero-force", "unreachable"]
 """How the attitude planner reached its output."""
 Arrangement = Literal["Con", "Inc"]
 """Consistent (every gimbal axis aligned with the team's) or inconsistent team."""
 
 class ConfigError(ValueError):
     """A team, limit, gain, setting or failure mask that cannot be used."""
+
+    field: Optional[str]
 
 class InputError(ValueError):
     """A control-cycle input that cannot be used: not finite, or not a rotation."""
