@@ -411,11 +411,3 @@ pub(crate) fn commands_array<'py>(
         .collect();
     rows_array(py, &rows)
 }
-
-/// `value.into_bound_py_any(py)` for the field lists of the result records.
-pub(crate) fn any<'py, T>(py: Python<'py>, value: T) -> PyResult<Bound<'py, PyAny>>
-where
-    T: IntoPyObjectExt<'py>,
-{
-    value.into_bound_py_any(py)
-}

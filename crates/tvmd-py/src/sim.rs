@@ -21,7 +21,7 @@ use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyString};
 
 use tvmd_sim::actuators::AgentCommand;
 use tvmd_sim::control::hover_roll_limit;
@@ -31,7 +31,7 @@ use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
-use crate::convert::{any, array1, bool_array, scalars};
+use crate::convert::{array1, bool_array, scalars};
 use crate::record::record;
 
 /// The default scenario of [`run`] and [`relaxation_sweep`].
@@ -655,43 +655,16 @@ record! {
     }
 }
 
-/// A tvmd-sim record (serde) as Python objects: objects become dicts, arrays lists.
+/// A tvmd-sim record (serde) as Python objects (`json.loads` of its JSON: objects become
+/// dicts, arrays lists, NaN None).
 fn record_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,
     record: &T,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let value = serde_json::to_value(record)
+    let text = serde_json::to_string(record)
         .map_err(|e| PyRuntimeError::new_err(format!("cannot convert a tvmd-sim record: {e}")))?;
-    json_to_py(py, &value)
-}
-
-/// A JSON value as Python objects.
-fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
-    use serde_json::Value;
-    Ok(match value {
-        Value::Null => py.None().into_bound(py),
-        Value::Bool(b) => any(py, *b)?,
-        Value::Number(x) => match (x.as_i64(), x.as_u64(), x.as_f64()) {
-            (Some(i), _, _) => any(py, i)?,
-            (None, Some(u), _) => any(py, u)?,
-            (None, None, f) => any(py, f.unwrap_or(f64::NAN))?,
-        },
-        Value::String(s) => any(py, s.as_str())?,
-        Value::Array(items) => {
-            let list = PyList::empty(py);
-            for item in items {
-                list.append(json_to_py(py, item)?)?;
-            }
-            list.into_any()
-        }
-        Value::Object(map) => {
-            let dict = PyDict::new(py);
-            for (k, v) in map {
-                dict.set_item(k, json_to_py(py, v)?)?;
-            }
-            dict.into_any()
-        }
-    })
+    py.import(pyo3::intern!(py, "json"))?
+        .call_method1(pyo3::intern!(py, "loads"), (text,))
 }
 
 /// Registers the submodule `sim` (`tvmd._tvmd.sim`).
