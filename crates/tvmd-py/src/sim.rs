@@ -23,12 +23,11 @@ use pyo3::exceptions::{PyAttributeError, PyOSError, PyRuntimeError, PyTypeError,
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
-use tvmd_sim::actuators::AgentCommand;
+use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::metrics::PaperMetrics;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{RunResult, RunSummary, Sample};
+use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
 use crate::convert::{any, array1, bool_array, scalars};
@@ -529,7 +528,7 @@ fn agent_columns<'py>(
     py: Python<'py>,
     samples: &[Sample],
     n: usize,
-    f: impl Fn(&Sample) -> &[AgentCommand],
+    f: impl Fn(&Sample) -> &[ActuatorCommand],
 ) -> Bound<'py, PyArray3<f64>> {
     let a = Array3::from_shape_fn((samples.len(), n, 3), |(k, i, j)| {
         samples
