@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
 use crate::team::AgentLimits;
@@ -65,12 +65,30 @@ impl<T: Real> RateLimits<T> {
         for value in [eta_x, eta_y] {
             if !value.is_finite() || value <= T::zero() {
                 return Err(ConfigError::Parameter {
-                    name: "rate_limits",
+                    field: ConfigField::RateLimits,
                 });
             }
         }
         Ok(Self { eta_x, eta_y })
     }
+}
+
+/// Each agent's admissible set for one period: `base` everywhere, narrowed around each agent's
+/// previous command by `rate_limits = (rates, dt)` when given
+/// ([`AdmissibleSet::with_rate_limit`]). Slots beyond `previous` keep `base`. The one rule the
+/// controller and the bindings share.
+pub fn admissible_sets<T: Real, const N: usize>(
+    base: &AdmissibleSet<T>,
+    rate_limits: Option<(&RateLimits<T>, T)>,
+    previous: impl IntoIterator<Item = GimbalCommand<T>>,
+) -> [AdmissibleSet<T>; N] {
+    let mut sets = [*base; N];
+    if let Some((rates, dt)) = rate_limits {
+        for (set, prev) in sets.iter_mut().zip(previous) {
+            *set = base.with_rate_limit(&prev, rates, dt);
+        }
+    }
+    sets
 }
 
 /// One agent's admissible set: `eta_x in eta_x`, `eta_y in eta_y`, `T in thrust`.

@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
 use crate::real::{count, to_f64, Real};
 
 /// The AFS relaxation `s in (0, 1]`: gimbal limits are shrunk to `s sigma` when planning, which
@@ -15,7 +15,7 @@ impl<T: Real> Relaxation<T> {
     pub fn new(s: T) -> Result<Self, ConfigError> {
         if !s.is_finite() {
             return Err(ConfigError::NonFinite {
-                field: "relaxation",
+                field: ConfigField::Relaxation,
             });
         }
         if s <= T::zero() || s > T::one() {

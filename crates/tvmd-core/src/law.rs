@@ -3,8 +3,9 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use crate::error::{ConfigError, InputError};
+use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{lit, Real};
+use crate::rotation::vee;
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
 /// block-diagonal one keeps the force request independent of the planned attitude (SPEC order).
@@ -41,17 +42,17 @@ impl<T: Real> Gains<T> {
         k_omega: Matrix3<T>,
         k_v: Matrix3<T>,
     ) -> Result<Self, ConfigError> {
-        for (k, name) in [
-            (&k_x, "gains.k_x"),
-            (&k_r, "gains.k_r"),
-            (&k_omega, "gains.k_omega"),
-            (&k_v, "gains.k_v"),
+        for (k, field) in [
+            (&k_x, ConfigField::GainKx),
+            (&k_r, ConfigField::GainKr),
+            (&k_omega, ConfigField::GainKomega),
+            (&k_v, ConfigField::GainKv),
         ] {
             let symmetric =
                 (k - k.transpose()).amax() <= k.amax() * T::default_epsilon() * lit(16.0);
             let positive = k.diagonal().iter().all(|d| *d > T::zero());
             if !k.iter().all(|x| x.is_finite()) || !symmetric || !positive {
-                return Err(ConfigError::Parameter { name });
+                return Err(ConfigError::Parameter { field });
             }
         }
         Ok(Self {
@@ -258,9 +259,4 @@ pub fn control_wrench<T: Real>(
         v_r: psi + quad(&gains.k_omega, &e_omega),
         v_x: quad(&gains.k_x, &e_x) + quad(&gains.k_v, &e_v),
     }
-}
-
-/// `(A)^vee` of a skew-symmetric matrix.
-fn vee<T: Real>(a: &Matrix3<T>) -> Vector3<T> {
-    Vector3::new(a.m32, a.m13, a.m21)
 }

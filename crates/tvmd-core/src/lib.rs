@@ -49,6 +49,7 @@ mod linalg;
 pub mod planner;
 pub mod projection;
 pub mod real;
+pub mod rotation;
 pub mod team;
 
 pub use admissible::{AdmissibleSet, RateLimits};
@@ -56,13 +57,13 @@ pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 #[cfg(feature = "clarabel")]
 pub use allocation::ClarabelAllocator;
 pub use allocation::{
-    Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
+    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;
-pub use error::{ConfigError, InputError};
+pub use error::{ConfigError, ConfigField, InputError};
 pub use gimbal::GimbalCommand;
 pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};

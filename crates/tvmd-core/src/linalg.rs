@@ -4,7 +4,7 @@
 // Triangular solves read clearest with index loops over the fixed 6x6 arrays.
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
-use nalgebra::{Matrix6, Vector6};
+use nalgebra::{Matrix6, Matrix6x3, Vector6};
 
 use crate::real::{eps, lit, Real};
 
@@ -68,6 +68,21 @@ impl<T: Real> Ldlt<T> {
         }
         x
     }
+}
+
+/// `initial + sum_i B_i B_i^T / w_i`, the (weighted) Gram matrix `M W^-1 M^T` of the blocks
+/// `B_i` (6x3) with weights `w_i` (`w_i = 1`: `M M^T`). The one Gram matrix of the crate:
+/// [`crate::Effectiveness::weighted_gram`], the pseudo-inverses and Clarabel's least squares
+/// (`initial = lambda I`) all build theirs here, in this order of additions.
+pub(crate) fn weighted_gram<'a, T: Real>(
+    initial: Matrix6<T>,
+    blocks: impl IntoIterator<Item = (&'a Matrix6x3<T>, T)>,
+) -> Matrix6<T> {
+    let mut gram = initial;
+    for (b, w) in blocks {
+        gram += b * b.transpose() / w;
+    }
+    gram
 }
 
 /// Largest diagonal entry (the scale of a Gram matrix).

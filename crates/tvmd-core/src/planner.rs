@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::error::{ConfigError, InputError};
+use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{eps, lit, Real};
 
 /// How the planner reached its output.
@@ -19,6 +19,33 @@ pub enum PlannerStatus {
     /// Not even `b_zd` along `f_r` is feasible (`||f_r|| > n sigma_Tf`): `R_d` aligns `b_zd`
     /// with `f_r` as closely as the rotation allows (`theta = theta_max`).
     Unreachable,
+}
+
+impl PlannerStatus {
+    /// Every status, in declaration order.
+    pub const ALL: [Self; 4] = [
+        Self::AlreadyFeasible,
+        Self::Planned,
+        Self::ZeroForce,
+        Self::Unreachable,
+    ];
+
+    /// The one spelling used in logs and bindings: `"already-feasible"`, `"planned"`,
+    /// `"zero-force"`, `"unreachable"` (kebab case, as the allocator names).
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::AlreadyFeasible => "already-feasible",
+            Self::Planned => "planned",
+            Self::ZeroForce => "zero-force",
+            Self::Unreachable => "unreachable",
+        }
+    }
+}
+
+impl core::fmt::Display for PlannerStatus {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 
 /// Output of [`AttitudePlanner::plan`].
@@ -62,12 +89,12 @@ impl<T: Real> AttitudePlanner<T> {
     ) -> Result<Self, ConfigError> {
         if !tolerance.is_finite() || tolerance <= T::zero() {
             return Err(ConfigError::Parameter {
-                name: "planner.tolerance",
+                field: ConfigField::PlannerTolerance,
             });
         }
         if max_iterations == 0 {
             return Err(ConfigError::Parameter {
-                name: "planner.max_iterations",
+                field: ConfigField::PlannerMaxIterations,
             });
         }
         self.tolerance = tolerance;

@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::AttainableForceSpace;
 use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, GimbalAxis, MassOf};
+use crate::error::{ConfigError, ConfigField, GimbalAxis, MassOf};
 use crate::real::{eps, lit, Real};
 
 /// One agent of the team: its frame in the team CoM frame `{C}`.
@@ -86,16 +86,17 @@ impl<T: Real> AgentLimits<T> {
         sigma_omega: T,
     ) -> Result<Self, ConfigError> {
         for (value, field) in [
-            (rho, "limits.rho"),
-            (d, "limits.d"),
-            (c_l, "limits.c_l"),
-            (sigma_omega, "limits.sigma_omega"),
+            (rho, ConfigField::Rho),
+            (d, ConfigField::RotorDiameter),
+            (c_l, ConfigField::LiftCoefficient),
+            (sigma_omega, ConfigField::MaxRotorSpeed),
         ] {
             if !value.is_finite() {
                 return Err(ConfigError::NonFinite { field });
             }
             if value <= T::zero() {
                 return Err(ConfigError::NonPositiveThrust {
+                    field,
                     value: crate::real::to_f64(value),
                 });
             }
@@ -123,8 +124,8 @@ impl<T: Real> AgentLimits<T> {
     pub fn validate(&self) -> Result<(), ConfigError> {
         let half_pi = T::frac_pi_2();
         for (value, axis, field) in [
-            (self.sigma_x, GimbalAxis::X, "limits.sigma_x"),
-            (self.sigma_y, GimbalAxis::Y, "limits.sigma_y"),
+            (self.sigma_x, GimbalAxis::X, ConfigField::SigmaX),
+            (self.sigma_y, GimbalAxis::Y, ConfigField::SigmaY),
         ] {
             if !value.is_finite() {
                 return Err(ConfigError::NonFinite { field });
@@ -137,17 +138,21 @@ impl<T: Real> AgentLimits<T> {
             }
         }
         for (value, field) in [
-            (self.max_thrust, "limits.max_thrust"),
-            (self.thrust_coefficient, "limits.thrust_coefficient"),
-            (self.min_thrust, "limits.min_thrust"),
+            (self.max_thrust, ConfigField::MaxThrust),
+            (self.thrust_coefficient, ConfigField::ThrustCoefficient),
+            (self.min_thrust, ConfigField::MinThrust),
         ] {
             if !value.is_finite() {
                 return Err(ConfigError::NonFinite { field });
             }
         }
-        for value in [self.max_thrust, self.thrust_coefficient] {
+        for (value, field) in [
+            (self.max_thrust, ConfigField::MaxThrust),
+            (self.thrust_coefficient, ConfigField::ThrustCoefficient),
+        ] {
             if value <= T::zero() {
                 return Err(ConfigError::NonPositiveThrust {
+                    field,
                     value: crate::real::to_f64(value),
                 });
             }
@@ -296,17 +301,17 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         for (i, (slot, agent)) in storage.iter_mut().zip(agents).enumerate() {
             if !agent.position.iter().all(|x| x.is_finite()) {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.position",
+                    field: ConfigField::AgentPosition,
                 });
             }
             if !agent.mass.is_finite() {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.mass",
+                    field: ConfigField::AgentMass,
                 });
             }
             if !agent.inertia.iter().all(|x| x.is_finite()) {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.inertia",
+                    field: ConfigField::AgentInertia,
                 });
             }
             if agent.mass <= T::zero() {
@@ -434,12 +439,12 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
 fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigError> {
     if !navigator.mass.is_finite() {
         return Err(ConfigError::NonFinite {
-            field: "navigator.mass",
+            field: ConfigField::NavigatorMass,
         });
     }
     if !navigator.inertia.iter().all(|x| x.is_finite()) {
         return Err(ConfigError::NonFinite {
-            field: "navigator.inertia",
+            field: ConfigField::NavigatorInertia,
         });
     }
     if navigator.mass < T::zero() {

@@ -7,6 +7,7 @@ use nalgebra::{Vector3, Vector6};
 use proptest::prelude::*;
 use tvmd_core::admissible::RateLimits;
 use tvmd_core::allocation::{ClarabelAllocator, ClarabelStatus, FallbackReason};
+use tvmd_core::error::ConfigField;
 use tvmd_core::team::presets;
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, ConfigError, FailureMask,
@@ -78,7 +79,7 @@ fn configuration_is_validated() {
         assert_eq!(
             ClarabelAllocator::<f64, 4>::new(bad, None).unwrap_err(),
             ConfigError::Parameter {
-                name: "clarabel.lambda"
+                field: ConfigField::ClarabelLambda
             }
         );
     }
@@ -87,7 +88,7 @@ fn configuration_is_validated() {
     assert_eq!(
         e,
         ConfigError::Parameter {
-            name: "clarabel.weights"
+            field: ConfigField::ClarabelWeights
         }
     );
     let e = ClarabelAllocator::<f64, 4>::default()
@@ -96,7 +97,7 @@ fn configuration_is_validated() {
     assert_eq!(
         e,
         ConfigError::Parameter {
-            name: "clarabel.tolerance"
+            field: ConfigField::ClarabelTolerance
         }
     );
     let a = ClarabelAllocator::<f64, 4>::new(2e-3, Some([2.0; 6])).unwrap();

@@ -19,11 +19,10 @@
 use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
-use tvmd_core::error::{ConfigError, GimbalAxis};
+use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, ControllerSettings, FailureMask, Gains, Navigator,
-    PlannerStatus, PseudoInverse, RateLimits, RedistributedPseudoInverse, Relaxation, TeamConfig,
-    WeightedPseudoInverse,
+    PlannerStatus, RateLimits, Relaxation, TeamConfig,
 };
 
 use crate::actuators::ActuatorCommand;
@@ -67,36 +66,42 @@ fn invalid(field: &str, reason: impl Into<String>) -> SimError {
 /// The scenario field a core configuration error refers to.
 fn config_field(e: &ConfigError) -> &'static str {
     match e {
-        ConfigError::GimbalLimit {
-            axis: GimbalAxis::X,
-            ..
-        } => "limits.sigma_x",
-        ConfigError::GimbalLimit {
-            axis: GimbalAxis::Y,
-            ..
-        } => "limits.sigma_y",
-        ConfigError::NonPositiveThrust { .. } | ConfigError::IdleThrust { .. } => {
-            "limits.max_thrust"
+        ConfigError::TooManyAgents { .. } => return "team.agents",
+        ConfigError::UnknownAllocator | ConfigError::AllocatorUnavailable { .. } => {
+            return "allocator"
         }
-        ConfigError::Relaxation { .. } => "relaxation",
-        ConfigError::TooManyAgents { .. } => "team.agents",
-        ConfigError::NavigatorInertia => "team.navigator_inertia",
-        ConfigError::Parameter { name } => match *name {
-            "gains.k_x" => "gains.k_x",
-            "gains.k_r" => "gains.k_r",
-            "gains.k_omega" | "gains.k_v" => "gains.k_xi",
-            "rate_limits" => "controller_rate_limits",
-            "period" => "controller_period",
-            "gravity" => "physics.gravity",
-            _ => "allocator",
-        },
-        ConfigError::NonFinite { field } => match *field {
-            "relaxation" => "relaxation",
-            "limits.sigma_x" => "limits.sigma_x",
-            "limits.sigma_y" => "limits.sigma_y",
-            f if f.starts_with("limits.") => "limits.max_thrust",
-            _ => "team",
-        },
+        _ => {}
+    }
+    match e.field() {
+        Some(ConfigField::SigmaX) => "limits.sigma_x",
+        Some(ConfigField::SigmaY) => "limits.sigma_y",
+        Some(
+            ConfigField::MaxThrust
+            | ConfigField::MinThrust
+            | ConfigField::ThrustCoefficient
+            | ConfigField::Rho
+            | ConfigField::RotorDiameter
+            | ConfigField::LiftCoefficient
+            | ConfigField::MaxRotorSpeed,
+        ) => "limits.max_thrust",
+        Some(ConfigField::Relaxation) => "relaxation",
+        Some(ConfigField::NavigatorInertia) if matches!(e, ConfigError::NavigatorInertia) => {
+            "team.navigator_inertia"
+        }
+        Some(ConfigField::GainKx) => "gains.k_x",
+        Some(ConfigField::GainKr) => "gains.k_r",
+        Some(ConfigField::GainKomega | ConfigField::GainKv) => "gains.k_xi",
+        Some(ConfigField::RateLimits) => "controller_rate_limits",
+        Some(ConfigField::Period) => "controller_period",
+        Some(ConfigField::Gravity) => "physics.gravity",
+        Some(
+            ConfigField::AllocatorWeights
+            | ConfigField::ClarabelLambda
+            | ConfigField::ClarabelWeights
+            | ConfigField::ClarabelTolerance
+            | ConfigField::PlannerTolerance
+            | ConfigField::PlannerMaxIterations,
+        ) => "allocator",
         _ => "team",
     }
 }
@@ -107,15 +112,6 @@ fn config_error(e: ConfigError) -> SimError {
 
 fn v3(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
-}
-
-fn status_name(s: PlannerStatus) -> &'static str {
-    match s {
-        PlannerStatus::AlreadyFeasible => "already-feasible",
-        PlannerStatus::Planned => "planned",
-        PlannerStatus::ZeroForce => "zero-force",
-        PlannerStatus::Unreachable => "unreachable",
-    }
 }
 
 /// The core's team configuration of a scenario: agents in the scenario's order, with their
@@ -171,41 +167,21 @@ pub fn controller_settings(scenario: &Scenario) -> Result<ControllerSettings<f64
 
 /// The allocator named by `scenario.allocator`.
 pub fn allocator(name: &str) -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Ok(match name {
-        "redistributed-pseudo-inverse" => {
-            AnyAllocator::RedistributedPseudoInverse(RedistributedPseudoInverse)
-        }
-        "pseudo-inverse" => AnyAllocator::PseudoInverse(PseudoInverse),
-        "weighted-pseudo-inverse" => AnyAllocator::WeightedPseudoInverse(
-            WeightedPseudoInverse::new([1.0; MAX_AGENTS]).map_err(config_error)?,
+    AnyAllocator::from_name(name, &Default::default()).map_err(|e| match e {
+        ConfigError::UnknownAllocator => invalid(
+            "allocator",
+            format!(
+                "unknown allocator `{name}` (known: {})",
+                crate::scenario::ALLOCATOR_NAMES.join(", ")
+            ),
         ),
-        "clarabel" => clarabel_allocator()?,
-        other => {
-            return Err(invalid(
-                "allocator",
-                format!(
-                    "unknown allocator `{other}` (known: {})",
-                    crate::scenario::ALLOCATOR_NAMES.join(", ")
-                ),
-            ))
-        }
+        ConfigError::AllocatorUnavailable { .. } => invalid(
+            "allocator",
+            "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
+             (cargo build --features clarabel)",
+        ),
+        e => config_error(e),
     })
-}
-
-#[cfg(feature = "clarabel")]
-fn clarabel_allocator() -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Ok(AnyAllocator::Clarabel(
-        tvmd_core::allocation::ClarabelAllocator::new(1e-6, None).map_err(config_error)?,
-    ))
-}
-
-#[cfg(not(feature = "clarabel"))]
-fn clarabel_allocator() -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Err(invalid(
-        "allocator",
-        "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
-         (cargo build --features clarabel)",
-    ))
 }
 
 /// The core's state: `v = R^T x_dot` (body frame), `Omega` as is.
@@ -317,7 +293,7 @@ impl TvmdController {
                 t_eta: out.projection.t_eta,
                 reference_feasible: out.planner.status == PlannerStatus::AlreadyFeasible,
                 planned_roll: planned_roll(&r_d),
-                status: status_name(out.planner.status).to_string(),
+                status: out.planner.status.as_str().to_string(),
                 iterations: out.planner.iterations,
             }),
             control: Some(ControlDiagnostics {

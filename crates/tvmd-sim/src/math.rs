@@ -46,9 +46,10 @@ pub fn from_rows(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
     )
 }
 
-/// The planned roll `phi_d = atan2(R_d[2,1], R_d[2,2])` (rad).
+/// The planned roll `phi_d = atan2(R_d[2,1], R_d[2,2])` (rad): the core's
+/// [`tvmd_core::rotation::roll_angle`].
 pub fn planned_roll(r_d: &Matrix3<f64>) -> f64 {
-    r_d[(2, 1)].atan2(r_d[(2, 2)])
+    tvmd_core::rotation::roll_angle(r_d)
 }
 
 /// Tilt of a rotation: angle between body z and world z (rad).

@@ -3,7 +3,7 @@
 use nalgebra::Vector3;
 
 use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
 
@@ -19,7 +19,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for PseudoInverse {
     }
 
     fn name(&self) -> &'static str {
-        "pseudo-inverse"
+        super::any::PSEUDO_INVERSE
     }
 }
 
@@ -35,7 +35,7 @@ impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
     pub fn new(weights: [T; N]) -> Result<Self, ConfigError> {
         if weights.iter().any(|w| !w.is_finite() || *w <= T::zero()) {
             return Err(ConfigError::Parameter {
-                name: "allocation.weights",
+                field: ConfigField::AllocatorWeights,
             });
         }
         Ok(Self { weights })
@@ -53,7 +53,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for WeightedPseudoInverse<T, N> {
     }
 
     fn name(&self) -> &'static str {
-        "weighted-pseudo-inverse"
+        super::any::WEIGHTED_PSEUDO_INVERSE
     }
 }
 

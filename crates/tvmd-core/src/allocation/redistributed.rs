@@ -73,6 +73,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
     }
 
     fn name(&self) -> &'static str {
-        "redistributed-pseudo-inverse"
+        super::any::REDISTRIBUTED_PSEUDO_INVERSE
     }
 }

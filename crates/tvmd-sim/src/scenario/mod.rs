@@ -68,13 +68,9 @@ pub use builtin::BUILTIN_NAMES;
 pub use overrides::Overrides;
 use validate::invalid;
 
-/// Allocator names a scenario may give (`"clarabel"` needs the `clarabel` feature at run time).
-pub const ALLOCATOR_NAMES: &[&str] = &[
-    "redistributed-pseudo-inverse",
-    "pseudo-inverse",
-    "weighted-pseudo-inverse",
-    "clarabel",
-];
+/// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
+/// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
+pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
 
 /// The team: a preset or explicit agents.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

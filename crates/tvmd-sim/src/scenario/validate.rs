@@ -64,7 +64,9 @@ impl Scenario {
         if let Some(t) = self.limits.max_thrust {
             check_pos("limits.max_thrust", t)?;
         }
-        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str()) {
+        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str())
+            && self.allocator != tvmd_core::allocation::CLARABEL
+        {
             return Err(invalid(
                 "allocator",
                 format!(
