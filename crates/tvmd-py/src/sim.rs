@@ -6,7 +6,7 @@
 //! Thin like the rest of the bindings: scenarios are loaded (`Scenario::load`, the CLI's
 //! name-or-file rule), overridden (`Overrides`) and run by `tvmd-sim` (`runner::run_many` on
 //! its one worker pool, `runner::sweep_specs`); the metrics come from `RunSummary` and
-//! `metrics::PaperMetrics`; this module converts arguments and results. Runs release the GIL
+//! `sim::PaperMetrics`; this module converts arguments and results. Runs release the GIL
 //! (`Python::detach`) and come back in input order.
 //!
 //! Errors: a scenario, TOML text or override that cannot be used raises `ValueError` (the
@@ -23,12 +23,11 @@ use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use tvmd_sim::actuators::AgentCommand;
+use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::metrics::PaperMetrics;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{RunResult, RunSummary, Sample};
+use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
 use crate::convert::{array1, bool_array, scalars};
@@ -500,7 +499,7 @@ impl SimData {
     fn agents<'py>(
         &self,
         py: Python<'py>,
-        f: impl Fn(&Sample) -> &[AgentCommand],
+        f: impl Fn(&Sample) -> &[ActuatorCommand],
     ) -> Bound<'py, PyArray3<f64>> {
         let a = Array3::from_shape_fn((self.samples.len(), self.n, 3), |(k, i, j)| {
             self.samples

@@ -18,23 +18,23 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, ControllerSettings, FailureMask, Gains, Navigator,
     PlannerStatus, RateLimits, Relaxation, TeamConfig,
 };
 
-use crate::actuators::AgentCommand;
-use crate::error::BoxedError;
-use crate::math::{from_rows, to_rows};
-use crate::physics::RigidState;
-use crate::reference::Reference;
-use crate::scenario::Scenario;
-use crate::sim::{
-    AllocationDiagnostics, ControlDiagnostics, ControlOutput, Diagnostics, FlightController,
-    LyapunovDiagnostics, PlannerDiagnostics,
+use crate::actuators::ActuatorCommand;
+use crate::diagnostics::{
+    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics, PlannerDiagnostics,
 };
+use crate::error::BoxedError;
+use crate::flight::{FlightController, FlightOutput};
+use crate::math::{from_rows, planned_roll, to_rows};
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
+use crate::scenario::Scenario;
 use crate::SimError;
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
@@ -185,7 +185,7 @@ pub fn allocator(name: &str) -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> 
 }
 
 /// The core's state: `v = R^T x_dot` (body frame), `Omega` as is.
-pub fn core_state(s: &RigidState) -> tvmd_core::RigidState<f64> {
+pub fn core_state(s: &PlantState) -> tvmd_core::RigidState<f64> {
     tvmd_core::RigidState {
         position: s.position,
         attitude: s.rotation,
@@ -195,7 +195,7 @@ pub fn core_state(s: &RigidState) -> tvmd_core::RigidState<f64> {
 }
 
 /// The core's reference.
-pub fn core_reference(r: &Reference) -> tvmd_core::Reference<f64> {
+pub fn core_reference(r: &ReferenceSample) -> tvmd_core::Reference<f64> {
     tvmd_core::Reference {
         position: r.position,
         velocity: r.velocity,
@@ -206,8 +206,8 @@ pub fn core_reference(r: &Reference) -> tvmd_core::Reference<f64> {
     }
 }
 
-fn sim_command(c: &tvmd_core::AgentCommand<f64>) -> AgentCommand {
-    AgentCommand {
+fn sim_command(c: &tvmd_core::AgentCommand<f64>) -> ActuatorCommand {
+    ActuatorCommand {
         eta_x: c.eta_x,
         eta_y: c.eta_y,
         thrust: c.thrust,
@@ -327,20 +327,14 @@ impl TvmdController {
     }
 }
 
-/// The planned roll `atan2(R_d[2,1], R_d[2,2])` (rad), the core's
-/// [`tvmd_core::rotation::roll_angle`].
-pub fn planned_roll(r_d: &Matrix3<f64>) -> f64 {
-    tvmd_core::rotation::roll_angle(r_d)
-}
-
 impl FlightController for TvmdController {
     fn step(
         &mut self,
         _t: f64,
-        state: &RigidState,
-        reference: &Reference,
+        state: &PlantState,
+        reference: &ReferenceSample,
         failed: &[bool],
-    ) -> Result<ControlOutput, BoxedError> {
+    ) -> Result<FlightOutput, BoxedError> {
         self.update_failures(failed);
         match self
             .inner
@@ -350,12 +344,12 @@ impl FlightController for TvmdController {
                 let diagnostics = self.diagnostics(&out);
                 let commands = out.commands[..self.n].iter().map(sim_command).collect();
                 self.last = Some(out);
-                Ok(ControlOutput {
+                Ok(FlightOutput {
                     commands,
                     diagnostics,
                 })
             }
-            Err(e) => Ok(ControlOutput {
+            Err(e) => Ok(FlightOutput {
                 commands: e.commands[..self.n].iter().map(sim_command).collect(),
                 diagnostics: Diagnostics {
                     cycle_error: Some(e.to_string()),
@@ -368,7 +362,7 @@ impl FlightController for TvmdController {
 }
 
 /// `atan(c_y(1, s))`: the planned roll at which the planner saturates in hover for the
-/// scenario's team, limits and relaxation `s` (the SPEC's reproduction target).
+/// scenario's team, limits and relaxation `s` (a reproduction target, see `docs/method.md`).
 pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
     let team = team_config(scenario)?;
     let afs = team.afs(&FailureMask::none()).map_err(config_error)?;

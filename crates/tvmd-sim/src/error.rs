@@ -1,6 +1,6 @@
 //! Error type of the simulator.
 
-/// Boxed error returned by a [`crate::sim::FlightController`].
+/// Boxed error returned by a flight controller.
 pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// Errors of the simulator.

@@ -18,11 +18,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::metrics::PaperMetrics;
 use tvmd_sim::plot::{self, PlotSeries};
 use tvmd_sim::runner::{run_many, run_scenario, sweep_specs};
 use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::RunSummary;
+use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;
 
 /// Simulator of thrust-vectoring modular team UAVs with the tvmd controller in the loop.

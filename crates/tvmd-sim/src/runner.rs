@@ -11,11 +11,12 @@ use std::sync::Mutex;
 
 use crate::control::TvmdController;
 use crate::error::BoxedError;
+use crate::flight::{FlightController, FlightOutput};
 use crate::log::{McapLog, METADATA_SCENARIO};
-use crate::physics::RigidState;
-use crate::reference::Reference;
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
 use crate::scenario::Scenario;
-use crate::sim::{ControlOutput, FlightController, RunResult, SimOptions, Simulation};
+use crate::sim::{RunResult, SimOptions, Simulation};
 use crate::SimError;
 
 /// A controller that reports the time of every call to a callback (for progress bars).
@@ -35,10 +36,10 @@ impl FlightController for WithProgress<'_> {
     fn step(
         &mut self,
         t: f64,
-        state: &RigidState,
-        reference: &Reference,
+        state: &PlantState,
+        reference: &ReferenceSample,
         failed: &[bool],
-    ) -> Result<ControlOutput, BoxedError> {
+    ) -> Result<FlightOutput, BoxedError> {
         (self.progress)(t);
         self.inner.step(t, state, reference, failed)
     }
