@@ -78,7 +78,7 @@ impl<T: Real> AttainableForceSpace<T> {
         if n_x > n {
             return Err(ConfigError::AgentCount { n, n_x });
         }
-        crate::team::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
+        crate::limits::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
         Ok(Self {
             n,
             n_x,

@@ -3,6 +3,7 @@
 use nalgebra::Vector3;
 
 use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
+use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
 
@@ -15,6 +16,9 @@ use crate::real::Real;
 pub struct RedistributedPseudoInverse;
 
 impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
+    /// Nothing to do: the factor of `M M^T` is kept by the [`Effectiveness`] itself.
+    fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {}
+
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
         let e = request.effectiveness;
         let mut free = working_mask(e);
@@ -30,7 +34,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
                     fixed_wrench -= b * f;
                 }
             }
-            pseudo_inverse_forces(e, &free, None, &fixed_wrench, &mut forces);
+            // Round 1 inverts every working agent: the effectiveness's own factor of `M M^T`.
+            let factor = (rounds == 1).then(|| e.gram_solver());
+            pseudo_inverse_forces(e, &free, None, factor, &fixed_wrench, &mut forces);
             let worst = forces
                 .iter()
                 .zip(request.sets)
