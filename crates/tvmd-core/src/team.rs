@@ -80,6 +80,20 @@ pub enum Arrangement {
 ///
 /// Fixed-capacity storage: up to `N` agents, no allocation. Mass `m_C = m_0 + sum m_i` and
 /// inertia `J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)` are derived once.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector3;
+/// use tvmd_core::{AgentLimits, AgentSpec, ConfigError, Navigator, TeamConfig};
+/// let limits = AgentLimits::new(0.5, 0.7, 14.0)?;
+/// let agents = [(1.0, 0.0, 0), (0.0, 1.0, 1), (-1.0, 0.0, 0), (0.0, -1.0, 1)]
+///     .map(|(x, y, m)| AgentSpec::new(Vector3::new(x, y, 0.0), m, 0.7));
+/// let team = TeamConfig::<f64, 8>::new(&agents, limits, Navigator::default())?;
+/// assert_eq!(team.len(), 4);
+/// // Two agents on a line cannot produce every wrench.
+/// let e = TeamConfig::<f64, 8>::new(&agents[..2], limits, Navigator::default()).unwrap_err();
+/// assert!(matches!(e, ConfigError::RankDeficient { .. }));
+/// # Ok::<(), ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TeamConfig<T: Real, const N: usize> {
     agents: [AgentSpec<T>; N],
@@ -341,6 +355,16 @@ pub mod presets {
 
     /// The paper's simulated team "A4 inc, 1 navigator": `psi = [pi/2, pi/2, 0, 0]`,
     /// `m_i = 0.7` kg, navigator mass 0, [`paper_limits`].
+    ///
+    /// ```
+    /// use tvmd_core::team::presets;
+    /// use tvmd_core::{Arrangement, FailureMask, TeamConfig};
+    /// let team: TeamConfig<f64, 4> = presets::a4_inc()?;
+    /// assert_eq!((team.len(), team.n_x(&FailureMask::none())), (4, 2));
+    /// assert_eq!(team.arrangement(), Arrangement::Inc);
+    /// assert!((team.mass() - 2.8).abs() < 1e-12);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
     pub fn a4_inc<T: Real, const N: usize>() -> Result<TeamConfig<T, N>, ConfigError> {
         square([1, 1, 0, 0], paper_limits())
     }

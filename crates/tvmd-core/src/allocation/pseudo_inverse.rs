@@ -14,6 +14,22 @@ use crate::real::Real;
 /// `f = M^T (M M^T)^-1 u_d` through the 6x6 Gram matrix (`O(n)`), then each agent outside its
 /// admissible set is clamped onto it (so the result is admissible but the wrench may be off;
 /// [`super::RedistributedPseudoInverse`] redistributes what the clamp loses).
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::PseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = PseudoInverse;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PseudoInverse;
 
@@ -33,6 +49,22 @@ impl<T: Real, const N: usize> Allocator<T, N> for PseudoInverse {
 
 /// The weighted pseudo-inverse: minimizes `sum_i w_i ||f_i||^2` subject to `M f = u_d`, then
 /// clamps as [`PseudoInverse`]. A larger `w_i` makes agent `i` work less.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::WeightedPseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = WeightedPseudoInverse::new([1.0, 1.0, 2.0, 2.0])?;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WeightedPseudoInverse<T: Real, const N: usize> {
     weights: [T; N],

@@ -12,6 +12,22 @@ use crate::real::Real;
 /// furthest (largest normalized excess, see [`crate::admissible::AdmissibleSet::violation`]),
 /// fix it, and redistribute the remaining wrench over the others. At most `n` rounds; agents
 /// still outside after the last round are clamped. Failed agents never take part.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::RedistributedPseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = RedistributedPseudoInverse;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RedistributedPseudoInverse;
 
