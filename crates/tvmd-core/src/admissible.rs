@@ -3,6 +3,7 @@
 
 use nalgebra::Vector3;
 
+use crate::error::{ConfigError, ConfigField};
 use crate::gimbal::GimbalCommand;
 use crate::limits::AgentLimits;
 /// The interval and rate limits, at their old paths (now in [`crate::limits`]).
@@ -30,15 +31,60 @@ pub fn admissible_sets<T: Real, const N: usize>(
 /// One agent's admissible set: `eta_x in eta_x`, `eta_y in eta_y`, `T in thrust`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdmissibleSet<T: Real> {
-    /// Range of `eta_x` (rad).
-    pub eta_x: Interval<T>,
-    /// Range of `eta_y` (rad).
-    pub eta_y: Interval<T>,
-    /// Range of the thrust (N).
-    pub thrust: Interval<T>,
+    eta_x: Interval<T>,
+    eta_y: Interval<T>,
+    thrust: Interval<T>,
 }
 
 impl<T: Real> AdmissibleSet<T> {
+    /// A set from its three ranges: finite, `lo <= hi`, angles within `[-pi/2, pi/2]`, thrust
+    /// `>= 0`. Errors name the range ([`ConfigField::SigmaX`], [`ConfigField::SigmaY`],
+    /// [`ConfigField::MaxThrust`]).
+    pub fn new(
+        eta_x: Interval<T>,
+        eta_y: Interval<T>,
+        thrust: Interval<T>,
+    ) -> Result<Self, ConfigError> {
+        let half_pi = T::frac_pi_2();
+        for (range, field, lo, hi) in [
+            (eta_x, ConfigField::SigmaX, -half_pi, half_pi),
+            (eta_y, ConfigField::SigmaY, -half_pi, half_pi),
+            (
+                thrust,
+                ConfigField::MaxThrust,
+                T::zero(),
+                T::one() / T::zero(),
+            ),
+        ] {
+            if !range.lo.is_finite() || !range.hi.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if range.lo > range.hi || range.lo < lo || range.hi > hi {
+                return Err(ConfigError::Parameter { field });
+            }
+        }
+        Ok(Self {
+            eta_x,
+            eta_y,
+            thrust,
+        })
+    }
+
+    /// Range of `eta_x` (rad).
+    pub fn eta_x(&self) -> Interval<T> {
+        self.eta_x
+    }
+
+    /// Range of `eta_y` (rad).
+    pub fn eta_y(&self) -> Interval<T> {
+        self.eta_y
+    }
+
+    /// Range of the thrust (N).
+    pub fn thrust(&self) -> Interval<T> {
+        self.thrust
+    }
+
     /// `E_f` of eq. (6): `|eta_x| <= sigma_x`, `|eta_y| <= sigma_y`, `T in [T_idle, sigma_Tf]`.
     pub fn from_limits(limits: &AgentLimits<T>) -> Self {
         Self {

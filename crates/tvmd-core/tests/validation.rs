@@ -358,3 +358,40 @@ fn planner_status_spelling() {
     );
     assert_eq!(PlannerStatus::Planned.to_string(), "planned");
 }
+
+#[test]
+fn admissible_sets_are_validated() {
+    use tvmd_core::admissible::{AdmissibleSet, Interval};
+    let ok = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval { lo: -0.2, hi: 0.3 },
+        Interval { lo: 0.0, hi: 10.0 },
+    )
+    .unwrap();
+    assert_eq!(ok.eta_y(), Interval { lo: -0.2, hi: 0.3 });
+    let reversed = AdmissibleSet::new(
+        Interval { lo: 0.5, hi: -0.5 },
+        Interval::symmetric(0.5),
+        Interval { lo: 0.0, hi: 10.0 },
+    );
+    assert_eq!(
+        reversed,
+        Err(ConfigError::Parameter {
+            field: ConfigField::SigmaX
+        })
+    );
+    let nan = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval::symmetric(0.5),
+        Interval {
+            lo: 0.0,
+            hi: f64::NAN,
+        },
+    );
+    assert_eq!(
+        nan,
+        Err(ConfigError::NonFinite {
+            field: ConfigField::MaxThrust
+        })
+    );
+}
