@@ -5,7 +5,8 @@
 //!
 //! Pipeline of one control period, each stage a pure function of explicit inputs:
 //!
-//! 1. [`team`]: the configuration `Xi`, limits, presets and failures.
+//! 1. [`team`]: the configuration `Xi` and presets, over [`limits`] and [`failure`] masks
+//!    ([`rotation`] holds the shared rotations).
 //! 2. [`effectiveness`]: `M(Xi)`, the wrench the agents produce (eq. 4).
 //! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8).
 //! 4. [`projection`]: the force projection `K_f` (eqs. 12-13).
@@ -43,8 +44,10 @@ pub mod command;
 pub mod controller;
 pub mod effectiveness;
 pub mod error;
+pub mod failure;
 pub mod gimbal;
 pub mod law;
+pub mod limits;
 mod linalg;
 pub mod planner;
 pub mod projection;

@@ -122,9 +122,9 @@ fn team_repr(t: &TeamConfig<f64, CAPACITY>) -> String {
         arrangement(t),
         t.n_x(&FailureMask::none()),
         t.mass(),
-        l.sigma_x,
-        l.sigma_y,
-        l.max_thrust
+        l.sigma_x(),
+        l.sigma_y(),
+        l.max_thrust()
     )
 }
 
@@ -180,15 +180,15 @@ record! {
         /// "Con" if every `m_i` is even (all gimbal axes aligned with the team's), else "Inc".
         arrangement => arrangement(o),
         /// `sigma_x` (rad), the limit of `|eta_x|`.
-        sigma_x => o.limits().sigma_x,
+        sigma_x => o.limits().sigma_x(),
         /// `sigma_y` (rad), the limit of `|eta_y|`.
-        sigma_y => o.limits().sigma_y,
+        sigma_y => o.limits().sigma_y(),
         /// `sigma_Tf` (N), the maximum thrust of one agent.
-        max_thrust => o.limits().max_thrust,
+        max_thrust => o.limits().max_thrust(),
         /// The idle thrust (N).
-        min_thrust => o.limits().min_thrust,
+        min_thrust => o.limits().min_thrust(),
         /// `rho d^4 c_l` of eq. (5) (N s^2/rad^2); equals `max_thrust` for normalized speeds.
-        thrust_coefficient => o.limits().thrust_coefficient,
+        thrust_coefficient => o.limits().thrust_coefficient(),
         /// `m_0` (kg).
         navigator_mass => o.navigator().mass,
         /// `J_0` (3, 3) (kg m^2).
@@ -338,9 +338,9 @@ record! {
         let limits = self.inner.limits();
         Ok(PyAfs::from_parts(
             inner,
-            limits.sigma_x,
-            limits.sigma_y,
-            limits.max_thrust,
+            limits.sigma_x(),
+            limits.sigma_y(),
+            limits.max_thrust(),
         ))
     }
 
