@@ -9,6 +9,29 @@ step() { printf '\n==> %s\n' "$*"; }
 # tvmd-py is a Python extension: never link it against libpython in plain cargo builds.
 export PYO3_BUILD_EXTENSION_MODULE=1
 
+step "self-contained: no tracked file refers to a directory beside the checkout"
+# Bracketed patterns, so that this file does not match itself.
+outside='\.\./shar[e]d|TVMD_SHAR[E]D'
+paths=()
+for p in crates src examples benches scripts embedded docs .ci README.md BENCHMARKS.md; do
+  [ -e "$p" ] && paths+=("$p")
+done
+status=0
+if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+  hits=$(git grep -nIE "$outside" -- "${paths[@]}") || status=$?
+else
+  hits=$(grep -rnIE --exclude-dir=target --exclude-dir=.venv "$outside" "${paths[@]}") || status=$?
+fi
+if [ "$status" -gt 1 ]; then
+  echo "error: the search for outside references failed (status $status)" >&2
+  exit 1
+fi
+if [ -n "$hits" ]; then
+  printf '%s\n' "$hits"
+  echo "error: the lines above refer outside the repository (the vectors live in crates/tvmd-core/tests/data, the method in docs/method.md)" >&2
+  exit 1
+fi
+
 step "toolchain components"
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 rustup target add thumbv7em-none-eabihf
@@ -33,6 +56,10 @@ cargo bench --workspace --no-run
 
 step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
 cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
+
+step "cargo package -p tvmd-core (the core packages and builds alone)"
+# --allow-dirty: the test command also runs on uncommitted work (a CI checkout is clean).
+cargo package -p tvmd-core --locked --allow-dirty
 
 step "panic-free link check: f32 control cycle on thumbv7em with an undefined panic handler"
 # Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).

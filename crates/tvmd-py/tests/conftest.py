@@ -1,8 +1,9 @@
 """Shared pytest setup: import path for the helper modules and the agreement report.
 
-``reference_impl`` (the NumPy reference) and ``vectors`` (the shared test vectors) live beside
-the tests. The ``agreement`` fixture records the largest differences between the bindings and
-the reference; they are printed in the terminal summary (no ``-s`` needed).
+``reference_impl`` (the NumPy reference) and ``vectors`` (the loader of the reference vectors in
+``crates/tvmd-core/tests/data/``, or of ``$TVMD_REFERENCE_VECTORS``) live beside the tests. The
+``agreement`` fixture records the largest differences between the bindings and the reference;
+they are printed in the terminal summary (no ``-s`` needed).
 """
 
 from __future__ import annotations

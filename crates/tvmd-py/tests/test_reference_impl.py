@@ -1,12 +1,13 @@
 """Tests of the pure-NumPy reference implementation (``reference_impl.py``).
 
-The reference is checked against every case of the shared test vectors
-(``shared/reference/core_vectors.json``, computed with the paper authors' MATLAB code), against
-closed-form consequences of the paper (hover saturation law, hover equilibrium, SPEC's reduced
-control law) and, finally, in a short closed-loop run of the paper's scenario.
+The reference is checked against every case of the reference vectors
+(``crates/tvmd-core/tests/data/core_vectors.json``, computed with the paper authors' MATLAB code;
+provenance in the README beside it), against closed-form consequences of the paper (hover
+saturation law, hover equilibrium, the reduced control law of ``docs/method.md``) and, finally,
+in a short closed-loop run of the paper's scenario.
 
-The vectors are looked up in ``$TVMD_SHARED/reference/`` if the environment variable is set,
-else in the ``shared`` directory beside the repository checkout.
+The vectors are loaded by ``vectors.py``: the repository's file, or the file named by
+``$TVMD_REFERENCE_VECTORS`` when that variable is set.
 """
 
 from __future__ import annotations

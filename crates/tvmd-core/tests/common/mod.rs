@@ -1,24 +1,60 @@
-//! Shared fixtures: the reference vectors of `../shared/reference/core_vectors.json`.
+//! Shared fixtures: the reference vectors of `tests/data/core_vectors.json` (provenance and
+//! format in `tests/data/README.md`), or the file named by `$TVMD_REFERENCE_VECTORS`.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-/// `../shared` beside the checkout, or `$TVMD_SHARED`.
-pub fn shared_dir() -> PathBuf {
-    if let Ok(dir) = std::env::var("TVMD_SHARED") {
-        return PathBuf::from(dir);
-    }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
+/// Names another vector file of the same format for the Rust and the Python suites.
+pub const VECTORS_ENV: &str = "TVMD_REFERENCE_VECTORS";
+
+/// The vector families every file must hold, each a non-empty array of cases.
+pub const FAMILIES: [&str; 5] = [
+    "gimbal",
+    "effectiveness",
+    "afs_semi_axes",
+    "force_projection",
+    "attitude_planner",
+];
+
+/// The vectors kept in the repository.
+pub fn default_vectors_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/core_vectors.json")
 }
 
-/// The parsed reference vectors.
+/// `$TVMD_REFERENCE_VECTORS` when set and not empty, else [`default_vectors_path`].
+pub fn vectors_path() -> PathBuf {
+    match std::env::var_os(VECTORS_ENV) {
+        Some(p) if !p.is_empty() => PathBuf::from(p),
+        _ => default_vectors_path(),
+    }
+}
+
+/// Reads and checks a vector file; the error names the file.
+pub fn load_vectors(path: &Path) -> Result<Value, String> {
+    let what = format!("reference vectors {}", path.display());
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {what}: {e}"))?;
+    let v: Value =
+        serde_json::from_str(&text).map_err(|e| format!("{what} are not valid JSON: {e}"))?;
+    for key in FAMILIES {
+        match v.get(key).and_then(Value::as_array) {
+            Some(a) if !a.is_empty() => {}
+            _ => return Err(format!("{what}: `{key}` is not a non-empty array of cases")),
+        }
+    }
+    Ok(v)
+}
+
+/// The parsed vectors of [`vectors_path`]; panics with the loader's message.
 pub fn vectors() -> Value {
-    let path = shared_dir().join("reference/core_vectors.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    serde_json::from_str(&text).expect("core_vectors.json is valid JSON")
+    let path = vectors_path();
+    let source = if path == default_vectors_path() {
+        format!("the repository's file; {VECTORS_ENV} may name another")
+    } else {
+        format!("named by {VECTORS_ENV}")
+    };
+    load_vectors(&path).unwrap_or_else(|e| panic!("{e} ({source})"))
 }
 
 /// The cases under `key`.
