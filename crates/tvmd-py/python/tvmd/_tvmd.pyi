@@ -3,6 +3,13 @@
 Array arguments accept any real array-like (read as float64); returned arrays are fresh
 float64 (or bool / int64) NumPy arrays. Shapes are given in the docstrings. Checked against the
 built module by ``mypy.stubtest`` (``tests/test_stubs.py``).
+
+Conventions: ``f64`` throughout, at most ``CAPACITY`` = 64 agents. Array inputs may be NumPy
+arrays of any real dtype, nested lists or Python numbers (integers are converted; booleans,
+complex numbers, strings and objects raise ``TypeError``). Wrong shapes raise ``ValueError``
+naming the argument and the expected shape; NaN/inf inputs raise ``ValueError``; the core's
+configuration and input errors become ``ConfigError`` / ``InputError`` (both ``ValueError``s)
+with the core's message. No code path panics.
 """
 
 from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, Union, final, overload
@@ -35,7 +42,10 @@ Arrangement = Literal["Con", "Inc"]
 """Consistent (every gimbal axis aligned with the team's) or inconsistent team."""
 
 class ConfigError(ValueError):
-    """A team, limit, gain, setting or failure mask that cannot be used."""
+    """A team, limit, gain, setting or failure mask that cannot be used (``tvmd_core::ConfigError``).
+
+    ``field``: the offending field (e.g. ``'gains.k_x'``), or None.
+    """
 
     field: Optional[str]
 
@@ -43,14 +53,43 @@ class InputError(ValueError):
     """A control-cycle input that cannot be used: not finite, or not a rotation."""
 
 class CycleError(InputError):
-    """``Controller.step`` rejected its input; ``commands`` (n, 4) are the commands to hold."""
+    """``Controller.step`` rejected its input.
+
+    ``commands``: (n, 4) float64, the previous period's commands to hold (columns ``eta_x, eta_y,
+    thrust, omega``; idle before the first period). ``field``: the offending input (e.g.
+    ``'state.position'``).
+    """
 
     commands: _F64
     field: str
 
 @final
 class Team:
-    """The team configuration ``Xi`` (eqs. 3-6), up to 64 agents."""
+    """The team configuration ``Xi = {(p_i, psi_i)}`` with agent limits, masses and navigator
+    (paper, "Modeling"; eqs. 3-6), validated. Up to 64 agents.
+
+    Args:
+        positions: (n, 3) agent positions ``p_i`` in the team CoM frame {C} (m).
+        quarter_turns: (n,) integers ``m_i``, the agent yaws ``psi_i = m_i pi/2``.
+        masses: (n,) agent masses ``m_i`` (kg), or one mass for every agent.
+        sigma_x: gimbal limit ``sigma_x`` of ``|eta_x|`` (rad), in (0, pi/2] (eq. 6).
+        sigma_y: gimbal limit ``sigma_y`` of ``|eta_y|`` (rad), in (0, pi/2] (eq. 6).
+        max_thrust: ``sigma_Tf``, the maximum thrust of one agent (N). Rotor speeds are then
+            normalized (``omega = 1`` at maximum thrust); see ``Team.from_rotor`` for eq. (5).
+        min_thrust: idle thrust (N) in [0, max_thrust), the smallest thrust allocated.
+        navigator_mass: ``m_0`` (kg), >= 0.
+        navigator_inertia: ``J_0`` (3, 3), symmetric positive semi-definite; default 0.
+        agent_inertias: optional (n, 3, 3) inertias of the agents about their own CoM, in {C}
+            axes (extension of the paper's point-mass model).
+
+    Team mass ``m_C = m_0 + sum m_i``, inertia ``J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)``.
+
+    Raises:
+        ConfigError (a ValueError): the core's validation failed (no agents, more than 64,
+            non-finite values, gimbal limits outside (0, pi/2], non-positive masses or thrust,
+            a bad navigator inertia, or ``M(Xi)`` not of rank 6).
+        ValueError / TypeError: wrong shapes or dtypes.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
 
@@ -83,10 +122,23 @@ class Team:
         navigator_inertia: Optional[ArrayLike] = None,
         agent_inertias: Optional[ArrayLike] = None,
     ) -> "Team":
-        """A team whose maximum thrust follows from the rotor constants of eq. (5)."""
+        """A team whose maximum thrust follows from the rotor constants of eq. (5):
+        ``T = rho d^4 c_l omega^2``, ``sigma_Tf = T(sigma_omega)``. Rotor speeds ``omega`` of the
+        commands are then in rad/s.
+
+        Args:
+            positions, quarter_turns, masses, sigma_x, sigma_y: as for ``Team(...)``.
+            rho: air density (kg/m^3). d: rotor diameter (m). c_l: lift coefficient.
+            sigma_omega: maximum rotor speed (rad/s).
+            min_thrust, navigator_mass, navigator_inertia, agent_inertias: as for ``Team(...)``.
+        """
     @staticmethod
     def a4_inc() -> "Team":
-        """The paper's simulated team "A4 inc, 1 navigator"."""
+        """The paper's simulated team "A4 inc, 1 navigator": four agents at ``(+-a, +-a, 0)``,
+        ``a = 0.5 sqrt(2)/2`` m, in the order (+a,+a), (+a,-a), (-a,-a), (-a,+a) with
+        ``psi = [pi/2, pi/2, 0, 0]``; ``m_i = 0.7`` kg, navigator mass 0, ``sigma_x = pi/6``,
+        ``sigma_y = pi/4``, ``sigma_Tf = 2 m_i g``.
+        """
     @staticmethod
     def a4_con() -> "Team":
         """As ``a4_inc()`` with every agent aligned: the consistent A4 team."""
@@ -99,7 +151,10 @@ class Team:
         sigma_y: float = ...,
         max_thrust: float = ...,
     ) -> "Team":
-        """``n`` agents of 0.7 kg on a circle of ``radius`` (m)."""
+        """``n`` agents of the paper's mass (0.7 kg) on a circle of ``radius`` (m) in the x-y plane,
+        agent ``i`` at phase ``2 pi i / n``; every second agent turned a quarter turn when
+        ``inconsistent`` (A3..A10-like layouts).
+        """
     @property
     def n(self) -> int:
         """The number of agents."""
@@ -149,11 +204,26 @@ class Team:
     def navigator_inertia(self) -> _F64:
         """``J_0`` (3, 3) (kg m^2)."""
     def effectiveness(self, failed: _Failed = None) -> _F64:
-        """``M(Xi)`` (6, 3n) of eq. (4); columns of failed agents are zero."""
+        """``M(Xi)``, the (6, 3n) effectiveness matrix of eq. (4), rows ``[torque; force]``: block ``i``
+        is ``[[p_i]x R_z(psi_i); R_z(psi_i)]``, so the wrench is ``u = M f`` for the stacked
+        agent-frame forces ``f = [f_1; ...; f_n]``. Columns of failed agents are zero.
+
+        Args:
+            failed: None or an iterable of failed agent indices.
+        """
     def wrench(self, forces: ArrayLike, failed: _Failed = None) -> _F64:
-        """``u = M(Xi) f`` (6,) of the (n, 3) agent-frame forces."""
+        """``u = M(Xi) f`` (eq. 4): the (6,) wrench ``[u_tau; u_f]`` of the (n, 3) agent-frame forces
+        ``f_i``. Forces of failed agents are ignored.
+
+        Raises:
+            ValueError: wrong shape, or NaN/inf forces.
+        """
     def afs(self, failed: _Failed = None) -> "AttainableForceSpace":
-        """The AFS approximation (eqs. 7-8) of the working agents."""
+        """The attainable-force-space approximation (eqs. 7-8) of the working agents.
+
+        Raises:
+            ConfigError: every agent failed, or a failure index the team does not have.
+        """
     def plant(self, gravity: float = ...) -> "Plant":
         """The rigid-body parameters of the control law."""
     def to_dict(self) -> dict[str, Any]:
@@ -161,7 +231,23 @@ class Team:
 
 @final
 class AttainableForceSpace:
-    """The elliptic-cone AFS approximation (eqs. 7-8)."""
+    """The elliptic-cone approximation of the attainable force space (AFS) of ``n`` working agents,
+    ``n_x`` of them with even quarter turns (eqs. 7-8):
+
+    ``u_f in AFS  <=>  u_f^T C(u_fz) u_f <= 1  and  ||u_f|| <= n sigma_Tf``,
+    ``C = diag(1/c_x^2, 1/c_y^2, 0)``,
+    ``c_x(z, s) = g(n_x, s sigma_y, z) + g(n_y, s sigma_x, z)``,
+    ``c_y(z, s) = g(n_x, s sigma_x, z) + g(n_y, s sigma_y, z)``,
+    ``g(n_k, sigma, z) = n_k sigma_Tf`` if ``sigma >= pi/2``, else ``(n_k/n)(1 - delta(n_k)) |z| tan(sigma)``.
+
+    A force with ``z <= 0`` is outside unless a semi-axis comes from the ``sigma >= pi/2`` branch;
+    the thrust bound is closed (``<=``). ``s`` in (0, 1] is the relaxation of the planner.
+
+    Also available from a team: ``team.afs(failed=None)``.
+
+    Raises:
+        ConfigError: ``n = 0``, ``n_x > n``, or invalid limits.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
 
@@ -193,28 +279,72 @@ class AttainableForceSpace:
     def semi_axes(
         self, z: float, relaxation: Optional[float] = None, *, s: Optional[float] = None
     ) -> Tuple[float, float]:
-        """The semi-axes ``(c_x, c_y)`` of eq. (8) at height ``z`` (relaxation default 1)."""
+        """The semi-axes ``(c_x(z, s), c_y(z, s))`` of eq. (8) at height ``z``.
+
+        Args:
+            z: a float or an array of heights (N).
+            relaxation: ``s`` in (0, 1], default 1 (``s=`` is an alias).
+
+        Returns:
+            ``(c_x, c_y)``: floats for a scalar ``z``, else arrays of ``z``'s shape.
+        """
     @overload
     def semi_axes(
         self, z: ArrayLike, relaxation: Optional[float] = None, *, s: Optional[float] = None
     ) -> Tuple[Any, Any]:
-        """The semi-axes for an array of heights."""
+        """The semi-axes for an array of heights (arrays of ``z``'s shape)."""
     def quadratic_form(
         self, u: ArrayLike, relaxation: Optional[float] = None, *, s: Optional[float] = None
     ) -> Any:
-        """``u^T C(u_z) u`` (eq. 7): a float for (3,), an (N,) array for (N, 3)."""
+        """``u^T C(u_z) u = (u_x/c_x)^2 + (u_y/c_y)^2`` (eq. 7); a zero semi-axis gives 0 for a zero
+        component and ``inf`` otherwise.
+
+        Args:
+            u: (3,) force or (N, 3) forces in the team frame (N).
+            relaxation: ``s`` in (0, 1], default 1 (``s=`` is an alias).
+
+        Returns:
+            a float for (3,) input, else an (N,) array.
+        """
     def contains(
         self, u: ArrayLike, relaxation: Optional[float] = None, *, s: Optional[float] = None
     ) -> Any:
-        """Membership in the AFS (eq. 7): a bool for (3,), an (N,) bool array for (N, 3)."""
+        """Membership in the approximated AFS (eq. 7) with relaxation ``s``.
+
+        Args:
+            u: (3,) force or (N, 3) forces in the team frame (N).
+            relaxation: ``s`` in (0, 1], default 1 (``s=`` is an alias).
+
+        Returns:
+            a bool for (3,) input, else an (N,) bool array.
+
+        Raises:
+            ValueError: NaN/inf in ``u``, or ``s`` outside (0, 1].
+        """
     def project(self, u: ArrayLike) -> Tuple[_F64, Any, Any]:
-        """``(K_f u, t_Tf, t_eta)`` of eqs. (12)-(13)."""
+        """The force projection ``K_f`` of eqs. (12)-(13) (with ``s = 1``):
+        ``t_Tf = min(1, n sigma_Tf / ||u||)``, ``u' = t_Tf u``,
+        ``t_eta = min(1, sqrt(1 / (u'^T C(u'_z) u')))``, ``K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)``.
+
+        Args:
+            u: (3,) requested force ``u_fr`` or (N, 3) forces in the team frame (N).
+
+        Returns:
+            ``(K_f u, t_Tf, t_eta)``: a (3,) array and two floats for (3,) input, else (N, 3),
+            (N,) and (N,) arrays.
+        """
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
 
 @final
 class ForceProjection:
-    """The force projection ``K_f`` of eqs. (12)-(13)."""
+    """The force projection of eqs. (12)-(13): ``K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)``.
+
+    Attributes:
+        force: (3,) ``K_f u_fr``.
+        t_Tf: ``min(1, n sigma_Tf / ||u_fr||)``.
+        t_eta: ``min(1, sqrt(1 / (u'^T C(u'_z) u')))``, ``u' = t_Tf u_fr``.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property
@@ -230,17 +360,58 @@ class ForceProjection:
         """The fields as a dict."""
 
 def gimbal_force(eta_x: ArrayLike, eta_y: ArrayLike, thrust: ArrayLike) -> _F64:
-    """``f = T a_hat(eta_x, eta_y)`` (eqs. 1 and 5), broadcast like NumPy."""
+    """``f = T a_hat(eta_x, eta_y)``, ``a_hat = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]``
+    (eqs. 1 and 5): the agent-frame force of a gimbal command.
+
+    Args:
+        eta_x: inner gimbal angle(s) (rad).
+        eta_y: outer gimbal angle(s) (rad).
+        thrust: thrust(s) ``T`` (N).
+
+    The arguments broadcast like NumPy's.
+
+    Returns:
+        an array of shape ``broadcast_shape + (3,)``: (3,) for scalars.
+    """
 
 def thrust_direction(eta_x: ArrayLike, eta_y: ArrayLike) -> _F64:
-    """``a_hat(eta_x, eta_y)`` of eq. (1)."""
+    """``a_hat(eta_x, eta_y)`` of eq. (1), the unit thrust direction in the agent frame.
+
+    Returns:
+        an array of shape ``broadcast_shape + (3,)``.
+    """
 
 def gimbal_inverse(force: ArrayLike) -> Tuple[Any, Any, Any]:
-    """``(eta_x, eta_y, thrust)`` of agent-frame force(s)."""
+    """The allocation inverse of an agent force (paper, "Control Allocation"):
+    ``T = ||f||``, ``eta_x = asin(-f_y / T)``,
+    ``eta_y = atan2(f_x / sgn(cos eta_x), f_z / sgn(cos eta_x))`` (a zero force gives zeros).
+
+    Args:
+        force: (3,) or (N, 3) agent-frame force(s) (N).
+
+    Returns:
+        ``(eta_x, eta_y, thrust)``, floats for (3,) input, else (N,) arrays, so that
+        ``gimbal_force(*gimbal_inverse(f))`` reproduces ``f``.
+    """
 
 @final
 class AttitudePlanner:
-    """The bisection attitude planner (eqs. 9-11)."""
+    """The bisection attitude planner of eqs. (9)-(11): the smallest tilt ``theta`` of the reference
+    attitude ``R_r`` toward the force request ``f_r`` that makes ``R_d^T f_r`` attainable (in the AFS
+    with relaxation ``s``). ``b_zd = rot(b_zr, k, theta)``, ``k = (b_zr x f_r)/||.||``,
+    ``b_yd = (b_zd x b_xr)/||.||``, ``b_xd = b_yd x b_zd``.
+
+    Returns the last *feasible* bisection point, stops on ``tolerance`` or ``max_iterations``,
+    and rolls about ``b_xr`` when ``f_r`` is (anti)parallel to ``b_zr``.
+
+    Args:
+        relaxation: AFS relaxation ``s`` in (0, 1] (``s=`` is an alias).
+        tolerance: bisection tolerance on ``theta`` (rad); default ``max(1e-10, 8 eps)``.
+        max_iterations: bisection iteration cap (>= 1); default 64.
+
+    Raises:
+        ConfigError: ``s`` outside (0, 1], a non-positive tolerance or a zero iteration cap.
+    """
 
     def __new__(
         cls,
@@ -260,11 +431,33 @@ class AttitudePlanner:
     def max_iterations(self) -> int:
         """The bisection iteration cap."""
     def plan(self, afs: AttainableForceSpace, R_r: ArrayLike, f_r: ArrayLike) -> "PlannerResult":
-        """Plans ``R_d`` for ``R_r`` and the inertial force request ``f_r`` (eq. 9)."""
+        """Plans ``R_d`` for the reference attitude ``R_r`` and the inertial force request
+        ``f_r = t_Tf R u_fr`` (eq. 9).
+
+        Args:
+            afs: the team's ``AttainableForceSpace``.
+            R_r: (3, 3) reference attitude (body to inertial).
+            f_r: (3,) inertial force request (N).
+
+        Returns:
+            PlannerResult(R_d, theta, iterations, status).
+
+        Raises:
+            ValueError: wrong shapes, or NaN/inf inputs.
+        """
 
 @final
 class PlannerResult:
-    """The planner's output."""
+    """The planner's output (eqs. 9-11).
+
+    Attributes:
+        R_d: (3, 3) planned attitude ``[b_xd b_yd b_zd]``.
+        theta: the tilt ``theta*`` from ``b_zr`` toward ``f_r`` (rad).
+        iterations: bisection iterations used (0 unless status is "planned").
+        status: "already-feasible" (``R_d = R_r``), "planned" (bisection), "zero-force"
+            (``f_r = 0``, ``R_d = R_r``) or "unreachable" (``||f_r|| > n sigma_Tf``: ``b_zd`` along
+            ``f_r``).
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property
@@ -284,14 +477,27 @@ class PlannerResult:
 
 @final
 class Gains:
-    """Gains ``K_x``, ``K_R``, ``K_xi = blockdiag(K_Omega, K_v)`` of eq. (12)."""
+    """Gains of the control law (eq. 12): ``K_x``, ``K_R`` and ``K_xi = blockdiag(K_Omega, K_v)``
+    (twist order ``[Omega; v]``). Not scaled by mass or inertia.
+
+    Args:
+        k_x: ``K_x``, (3,) diagonal or (3, 3) symmetric with a positive diagonal.
+        k_r: ``K_R``, (3,) diagonal or (3, 3).
+        k_xi: ``K_xi``, (6,) diagonal or a block-diagonal (6, 6) matrix ``blockdiag(K_Omega, K_v)``.
+
+    Raises:
+        ConfigError: a gain is not finite, not symmetric or has a non-positive diagonal entry.
+        ValueError: wrong shapes, or a (6, 6) ``k_xi`` with non-zero off-diagonal blocks.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
 
     def __new__(cls, k_x: ArrayLike, k_r: ArrayLike, k_xi: ArrayLike) -> "Gains": ...
     @staticmethod
     def paper() -> "Gains":
-        """The paper's gains."""
+        """The paper's gains: ``K_x = diag(0.4, 0.4, 1)``, ``K_R = diag(12, 12, 1)``,
+        ``K_xi = diag(8, 8, 1.5, 0.8, 0.8, 2)``.
+        """
     @property
     def k_x(self) -> _F64:
         """``K_x`` (3, 3)."""
@@ -312,7 +518,18 @@ class Gains:
 
 @final
 class State:
-    """The measured state (pose and body-frame twist)."""
+    """The measured state: pose and body-frame twist ``xi = [Omega; v]``.
+
+    Args:
+        position: ``x`` (3,), CoM position in the inertial frame (m), z up.
+        attitude: ``R`` (3, 3), body-to-inertial rotation; default identity.
+        angular_velocity: ``Omega`` (3,), body frame (rad/s); default 0.
+        velocity: ``v`` (3,), body frame, ``x_dot = R v`` (m/s); default 0.
+
+    Wherever a state is expected a dict with these keys is accepted too. Values are not
+    validated here: ``Controller.step`` reports NaN/inf or a non-rotation attitude as a
+    ``CycleError``, the law functions as an ``InputError``.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     def __new__(
@@ -339,7 +556,18 @@ class State:
 
 @final
 class Reference:
-    """The reference pose and its derivatives."""
+    """The reference pose and its derivatives (feed-forward); unknown derivatives are zero.
+
+    Args:
+        position: ``x_r`` (3,) (m).
+        velocity: ``x_r_dot`` (3,), inertial (m/s); default 0.
+        acceleration: ``x_r_ddot`` (3,), inertial (m/s^2); default 0.
+        attitude: ``R_r`` (3, 3), the reference attitude; default identity.
+        angular_velocity: ``Omega_d`` (3,), body frame of the reference (rad/s); default 0.
+        angular_acceleration: ``Omega_d_dot`` (3,) (rad/s^2); default 0.
+
+    Wherever a reference is expected a dict with these keys is accepted too.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     def __new__(
@@ -377,7 +605,17 @@ class Reference:
 
 @final
 class Plant:
-    """Rigid-body parameters ``m_C``, ``J_C`` and gravity ``g``."""
+    """Rigid-body parameters of the law: ``G = blockdiag(J_C, m_C I)`` and gravity ``g`` along ``-e_3``
+    (eqs. 2-3). ``team.plant(gravity=9.81)`` builds it from a team.
+
+    Args:
+        mass: ``m_C`` (kg).
+        inertia: ``J_C`` (3, 3) (kg m^2).
+        gravity: ``g`` (m/s^2).
+
+    Raises:
+        ValueError: NaN/inf values or a wrong shape.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
 
@@ -396,7 +634,17 @@ class Plant:
 
 @final
 class LawOutput:
-    """Everything the control law computes in one period."""
+    """Everything the control law computes in one period (eq. 12).
+
+    Attributes:
+        e_x: (3,) ``x - x_r``.
+        e_R: (3,) ``1/2 (R_d^T R - R^T R_d)^vee``.
+        e_xi: (6,) ``xi - xi_d = [e_Omega; e_v]``.
+        u_r: (6,) ``[u_tau_r; u_fr]``.
+        u_d: (6,) ``blockdiag(I, K_f) u_r``.
+        V_R: ``Psi + ||e_Omega||_{K_Omega}``.
+        V_x: ``||e_x||_{K_x} + ||e_v||_{K_v}``.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property
@@ -426,7 +674,23 @@ class LawOutput:
 def force_request(
     plant: Plant, gains: Gains, state: _StateLike, reference: _ReferenceLike
 ) -> _F64:
-    """``u_fr`` (3,), the force part of ``u_r`` (eq. 12)."""
+    """``u_fr``, the force part of ``u_r`` in the team frame, which does not depend on ``R_d``
+    (eq. 12 with ``g_C = [0; -m g R^T e_3]``):
+    ``u_fr = m R^T x_r_ddot - K_v e_v - R^T K_x e_x + m g R^T e_3``, ``e_x = x - x_r``,
+    ``e_v = v - R^T x_r_dot``.
+
+    Args:
+        plant: ``Plant`` (or ``team.plant()``).
+        gains: ``Gains``.
+        state: ``State`` or dict.
+        reference: ``Reference`` or dict.
+
+    Returns:
+        (3,) array.
+
+    Raises:
+        InputError (a ValueError): NaN/inf input or a non-rotation attitude.
+    """
 
 def control_wrench(
     plant: Plant,
@@ -437,11 +701,42 @@ def control_wrench(
     u_fr: ArrayLike,
     K_f: ArrayLike,
 ) -> LawOutput:
-    """The torque part of eq. (12) with the planned ``R_d``, and ``u_r``, ``u_d``."""
+    """The torque part of eq. (12) with the planned ``R_d``, and the full ``u_r``, ``u_d``:
+    ``e_R = 1/2 (R_d^T R - R^T R_d)^vee``, ``e_xi = xi - [R^T R_d Omega_d; R^T x_r_dot]``,
+    ``u_tau_r = J xi_dot_dOmega - [J Omega]x Omega_d' - K_Omega e_Omega - K_R e_R``,
+    ``u_r = [u_tau_r; u_fr]``, ``u_d = blockdiag(I, K_f) u_r``, and the Lyapunov values
+    ``V_R = Psi + ||e_Omega||_{K_Omega}``, ``Psi = 1/2 tr(K_R (I - R_d^T R))``,
+    ``V_x = ||e_x||_{K_x} + ||e_v||_{K_v}`` with ``||a||_K = 1/2 a^T K a``.
+
+    Args:
+        plant, gains, state, reference: as for ``force_request``.
+        R_d: (3, 3) planned attitude (from ``AttitudePlanner.plan``).
+        u_fr: (3,) force request (from ``force_request``).
+        K_f: (3, 3) force projection ``diag(t_eta t_Tf, t_eta t_Tf, t_Tf)``, or its (3,) diagonal.
+
+    Returns:
+        LawOutput(e_x, e_R, e_xi, u_r, u_d, V_R, V_x).
+
+    Raises:
+        InputError / ValueError: NaN/inf input, a non-rotation attitude or wrong shapes.
+    """
 
 @final
 class Allocation:
-    """The result of one allocation."""
+    """The result of one allocation.
+
+    Attributes:
+        forces: (n, 3) agent-frame forces ``f_i``, each inside its admissible set (zero for
+            failed agents).
+        wrench: (6,) ``u = M f``, the wrench they produce.
+        e_f: ``||u_fd - u_f||``, the paper's allocation error (force part).
+        wrench_error: ``||u_d - M f||`` over the whole wrench.
+        rounds: solve rounds (pseudo-inverse 1, redistribution up to n, Clarabel iterations).
+        saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
+        fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
+        method: the allocator's name.
+        report: Clarabel's solve report (text), None for the other allocators.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property
@@ -485,11 +780,68 @@ def allocate(
     dt: Optional[float] = None,
     regularization: Optional[float] = None,
 ) -> Allocation:
-    """Allocates a desired wrench ``u_d`` over the working agents (eqs. 4 and 6)."""
+    """Allocates a desired wrench ``u_d`` over the team's working agents: inverts ``u_d = M f``
+    (eq. 4) into agent-frame forces inside each agent's admissible set ``E_f`` (eq. 6).
+
+    Methods:
+        "pseudo-inverse": ``f = M^T (M M^T)^-1 u_d``, then each agent outside ``E_f`` is clamped.
+        "weighted-pseudo-inverse": minimizes ``sum_i w_i ||f_i||^2`` s.t. ``M f = u_d``, clamped;
+            ``weights`` (n,) positive per-agent weights are required.
+        "redistributed-pseudo-inverse" (default): Jin 2005 redistribution: the agent leaving
+            ``E_f`` furthest is saturated and fixed, the rest of the wrench is redistributed.
+        "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
+            ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
+            diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).
+
+    Args:
+        team: the ``Team``.
+        wrench: (6,) desired wrench ``u_d = [u_tau; u_f]`` in the team frame.
+        method: the allocator name (see ``tvmd.ALLOCATORS``).
+        weights: see the methods.
+        failed: None or failed agent indices (they get zero force).
+        previous: (n, 2..4) previous commands, columns ``eta_x, eta_y[, thrust, omega]``; only
+            with ``rate_limits`` (default: centred gimbals).
+        rate_limits: ``(eta_x_rate, eta_y_rate)`` (rad/s): narrows each gimbal range to
+            ``|eta - eta_prev| <= rate dt``.
+        dt: the control period (s), required with ``rate_limits``.
+        regularization: ``lambda`` of "clarabel".
+
+    Returns:
+        Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
+
+    Raises:
+        ValueError: an unknown method, "clarabel" without the feature, options that do not
+            apply to the method, wrong shapes, NaN/inf input.
+        ConfigError: a degraded team that cannot produce every wrench, bad weights or rates.
+    """
 
 @final
 class Controller:
-    """The full-pose controller: one ``step`` per control period."""
+    """The full-pose controller of a team (``tvmd_core::Controller``): per control period, the force
+    request ``u_fr``, the projection ``t_Tf``, the attitude planner (``R_d``, eqs. 9-11), ``K_f`` and the
+    torque part of the law (eq. 12), the allocation and the inversion into gimbal angles and
+    rotor speeds inside ``E_f`` (eq. 6).
+
+    Args:
+        team: the ``Team``.
+        gains: ``Gains``; None for the paper's (``Gains.paper()``).
+        relaxation: AFS relaxation ``s`` of the planner, in (0, 1]; default 0.5 (``s=`` is an
+            alias).
+        gravity: ``g`` (m/s^2).
+        period: control period ``dt`` (s) (used by the rate limits).
+        allocator: allocator name (see ``tvmd.ALLOCATORS`` and ``tvmd.allocate``).
+        rate_limits: optional ``(eta_x_rate, eta_y_rate)`` gimbal rate limits (rad/s).
+        failed: None or failed agent indices.
+        weights: allocator weights (see ``tvmd.allocate``).
+        regularization: ``lambda`` of the "clarabel" allocator.
+        planner_tolerance: bisection tolerance (rad); default ``max(1e-10, 8 eps)``.
+        planner_max_iterations: bisection iteration cap; default 64.
+
+    Raises:
+        ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
+            produce every wrench.
+        ValueError: unknown allocator, "clarabel" without the cargo feature, wrong shapes.
+    """
 
     def __new__(
         cls,
@@ -509,11 +861,34 @@ class Controller:
         s: Optional[float] = None,
     ) -> "Controller": ...
     def set_failures(self, failed: _Failed = None) -> None:
-        """Marks agents failed (None or [] for none)."""
+        """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``
+        and is commanded idle.
+
+        Raises:
+            ConfigError: an index the team does not have, or a remaining team that cannot
+                produce every wrench (the previous mask is kept).
+        """
     def reset(self) -> None:
-        """Forgets the previous command."""
+        """Forgets the previous command (rate limits restart from centred gimbals; a rejected
+        cycle then holds idle commands).
+        """
     def step(self, state: _StateLike, reference: _ReferenceLike) -> "StepOutput":
-        """One control period."""
+        """One control period.
+
+        Args:
+            state: ``State`` or dict with keys position (3,), attitude (3, 3),
+                angular_velocity (3,), velocity (3,) (only ``position`` required).
+            reference: ``Reference`` or dict with keys position, velocity, acceleration,
+                attitude, angular_velocity, angular_acceleration (only ``position`` required).
+
+        Returns:
+            StepOutput.
+
+        Raises:
+            CycleError (a ValueError): NaN/inf input or a non-rotation attitude; the exception's
+                ``commands`` (n, 4) are the previous period's commands to hold.
+            ValueError / TypeError: wrong shapes or argument types.
+        """
     @property
     def team(self) -> Team:
         """The team."""
@@ -550,7 +925,19 @@ class Controller:
 
 @final
 class StepOutput:
-    """Everything one ``Controller.step`` computed, nested like the core's ``ControlOutput``."""
+    """Everything one ``Controller.step`` computed, nested like the core's ``ControlOutput``
+    (read-only; each access returns fresh arrays).
+
+    Attributes:
+        planner: PlannerResult (``R_d``, ``theta``, ``iterations``, ``status``).
+        projection: ForceProjection (``force = K_f u_fr``, ``t_Tf``, ``t_eta``).
+        f_r: (3,) ``t_Tf R u_fr``, the inertial force the planner aligns with.
+        law: LawOutput (``e_x``, ``e_R``, ``e_xi``, ``u_r``, ``u_d``, ``V_R``, ``V_x``).
+        allocation: Allocation (``forces``, ``wrench`` = ``M f``, ``e_f``, ``wrench_error``, ``rounds``,
+            ``saturated``, ``fallback``, ``method``, ``report``).
+        commands: (n, 4) columns ``eta_x, eta_y, thrust, omega`` (idle for failed agents).
+        command_clamp: the largest clamp the command inversion applied (normalized).
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property

@@ -2,6 +2,15 @@
 
 Time series are fresh NumPy arrays with ``K`` samples (one per controller tick) and ``n``
 agents; SI units, z up, angles in rad. Values the controller did not report are NaN.
+
+Scenarios are loaded (the CLI's name-or-file rule), overridden and run by ``tvmd-sim`` on its
+one worker pool; runs release the GIL and come back in input order.
+
+Errors: a scenario, TOML text or override that cannot be used raises ``ValueError`` (the message
+is tvmd-sim's, naming the field), wrong argument types ``TypeError``, I/O errors ``OSError`` (its
+errno subclass, e.g. ``FileNotFoundError``, with the file name), a run that fails while flying
+(divergence, controller error) ``RuntimeError``. A panic inside tvmd-sim is raised as
+``RuntimeError`` too, never as ``PanicException``.
 """
 
 import os
@@ -19,7 +28,34 @@ _RunItem = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 
 @final
 class SimResult:
-    """One simulated run: time series (NumPy) and the summary dicts."""
+    """The result of one simulated run (read-only; every array access returns a fresh float64
+    copy, so bind it to a name before indexing in a loop).
+
+    ``K`` samples, one per controller tick (``t_k = k controller_period``, true state before the
+    tick's commands act); ``n`` agents. SI units, z up, angles in rad. Values a controller did
+    not report at a tick (a skipped cycle) are NaN.
+
+    Attributes:
+        scenario_name, relaxation (``s``), allocator, mcap_path (str or None), n_agents,
+        mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
+        planned roll at which the planner saturates in hover).
+        t: (K,) time (s).
+        position, velocity, reference_position: (K, 3) ``x`` (m), ``x_dot`` (m/s), ``x_r`` (m).
+        attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of ``R``, ``R_r``
+            and the planned ``R_d``.
+        reference_roll: (K,) ``phi_r``. planned_roll: (K,) ``phi_d = atan2(R_d[2,1], R_d[2,2])``.
+        attitude_error: (K,) angle between ``R`` and ``R_d``. theta: (K,) planner angle ``theta*``.
+        e_f: (K,) allocation error ``||u_fd - u_f||`` (N). saturated_agents: (K,) int64, agents
+            the allocator saturated (-1 if not reported).
+        V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
+        commands, actual: (K, n, 3) commanded and actual actuator values, columns
+            ``eta_x, eta_y`` (rad), ``thrust`` (N). failed: (K, n) bool, true failure flags.
+        summary: dict, every field of tvmd-sim's ``RunSummary`` (``max_planned_roll``, ``max_e_f``,
+            ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...).
+        paper_metrics: dict, tvmd-sim's ``PaperMetrics`` (horizontal errors at 4 and 12 s,
+            stage-B attitude settling, ``e_f`` onset, ``V_x`` rise, ...).
+        scenario_toml: the scenario that ran, as TOML.
+    """
 
     FIELDS: ClassVar[Tuple[str, ...]]
     @property
@@ -45,7 +81,9 @@ class SimResult:
         """Gravity ``g`` (m/s^2)."""
     @property
     def hover_roll_limit(self) -> Optional[float]:
-        """``atan(c_y(1, s))`` (rad), the planned roll at which the planner saturates in hover."""
+        """``atan(c_y(1, s))`` (rad): the planned roll at which the planner saturates in hover for
+        this team, limits and ``s``.
+        """
     @property
     def t(self) -> _F64:
         """(K,) time (s)."""
@@ -90,7 +128,9 @@ class SimResult:
         """(K,) Lyapunov candidate ``V_x``."""
     @property
     def V_R(self) -> _F64:
-        """(K,) Lyapunov candidate ``V_R``."""
+        """(K,) Lyapunov candidate ``V_R = Psi(R, R_d) + ||e_Omega||_{K_Omega}``; NaN if not
+        reported.
+        """
     @property
     def cycle_error(self) -> NDArray[np.bool_]:
         """(K,) the controller skipped the cycle."""
@@ -118,10 +158,17 @@ class SimResult:
         """The number of samples ``K``."""
 
 def builtin_scenarios() -> list[str]:
-    """The names of the built-in scenarios."""
+    """The names of the built-in scenarios (``"paper-tilt"`` is the paper's simulation, see
+    docs/method.md; ``"relaxation-<s>"`` the relaxation study; failures, A4-Con, ...).
+    """
 
 def scenario_toml(name: str) -> str:
-    """A built-in scenario as TOML text (every field)."""
+    """A built-in scenario as TOML text: every field, a starting point for a scenario file (or for
+    ``run(toml=...)``).
+
+    Raises:
+        ValueError: unknown name.
+    """
 
 def run(
     scenario: Optional[_ScenarioArg] = None,
@@ -131,10 +178,48 @@ def run(
     relaxation: Optional[float] = None,
     allocator: Optional[AllocatorName] = None,
 ) -> SimResult:
-    """Runs one scenario with the tvmd controller in the loop (GIL released)."""
+    """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
+    ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
+    time series. The GIL is released during the run.
+
+    Args:
+        scenario: a built-in name (see ``builtin_scenarios()``), or a TOML scenario file (a path
+            ending in ``.toml`` or naming an existing file, or any ``os.PathLike``). Default
+            ``"paper-tilt"``: the paper's simulation (A4-Inc, ascent, roll tilt towards the
+            infeasible ``pi/3``, descent; ``s = 0.5``).
+        toml: inline TOML scenario text instead of ``scenario`` (fields left out take the
+            paper-tilt defaults; see ``scenario_toml("paper-tilt")``).
+        mcap: write an MCAP log there (parent directories are created; open it in Foxglove).
+        relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
+        allocator: override the allocator ("redistributed-pseudo-inverse", "pseudo-inverse",
+            "weighted-pseudo-inverse", "clarabel" with the cargo feature).
+
+    Raises:
+        ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
+            message names the field, e.g. ``physics.dt``), a bad override, both ``scenario`` and
+            ``toml``.
+        TypeError: an argument of the wrong type.
+        OSError: the scenario file cannot be read or the log cannot be written.
+        RuntimeError: the run failed while flying (the state diverged, the controller failed).
+    """
 
 def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[SimResult]:
-    """Runs many scenarios on parallel threads; results in input order."""
+    """Runs many scenarios in parallel threads (GIL released) and returns their results in input
+    order.
+
+    Args:
+        runs: a sequence whose items are each a scenario (a built-in name or a TOML file, as
+            ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
+            ``{"scenario": "a4-con", "relaxation": 1.0}`` or ``{"toml": text, "mcap": "x.mcap"}``.
+        jobs: worker threads (default: the available cores), at most ``len(runs)``.
+
+    Every item is loaded and validated before any run starts. If runs fail, the first failure
+    in input order is raised, its message prefixed with ``runs[k]``.
+
+    Raises:
+        ValueError, TypeError, OSError, RuntimeError: as ``run``; ``ValueError`` also for an
+            unknown dict key or ``jobs < 1``.
+    """
 
 def relaxation_sweep(
     relaxations: Optional[ArrayLike] = None,
@@ -145,7 +230,24 @@ def relaxation_sweep(
     mcap_dir: Optional[_PathArg] = None,
     jobs: Optional[int] = None,
 ) -> list[SimResult]:
-    """The relaxation study: one scenario flown once per ``s``; results in input order."""
+    """The paper's relaxation study: one scenario flown once per relaxation ``s`` (in parallel
+    threads, GIL released), results in the order of ``relaxations``. The planner's roll limit in
+    hover is ``atan(c_y(1, s))``, so the largest planned roll grows with ``s``.
+
+    Each run's ``scenario_name`` is ``"<name>-s<s>"`` (as ``tvmd-sim sweep``).
+
+    Args:
+        relaxations: the values of ``s``, each in (0, 1].
+        scenario: as ``run`` (default ``"paper-tilt"``).
+        toml: inline TOML text instead of ``scenario``.
+        allocator: override the scenario's allocator.
+        mcap_dir: write one MCAP log per run there, ``<name>-s<s>.mcap``.
+        jobs: worker threads (default: the available cores).
+
+    Raises:
+        ValueError: as ``run``; an ``s`` outside (0, 1] or not finite, ``relaxations`` not 1-D.
+        TypeError, OSError, RuntimeError: as ``run``.
+    """
 
 
 __all__ = [
