@@ -1,25 +1,17 @@
 //! Control allocation: `tvmd.allocate` and `tvmd.Allocation`, over the core's allocators
 //! chosen by name at run time (`tvmd_core::AnyAllocator`).
 
-use nalgebra::{Vector3, Vector6};
-use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use tvmd_core::admissible::admissible_sets;
-use tvmd_core::allocation::{
-    AllocatorOptions as CoreAllocatorOptions, CLARABEL, WEIGHTED_PSEUDO_INVERSE,
-};
-use tvmd_core::{
-    AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator, ConfigError,
-    ConfigField, GimbalCommand, RateLimits,
-};
+use tvmd_core::allocation::{AllocatorOptions, CLARABEL, WEIGHTED_PSEUDO_INVERSE};
+use tvmd_core::{AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator};
+use tvmd_core::{ConfigError, ConfigField, GimbalCommand, RateLimits};
 
-use crate::convert::{
-    array1, bool_array, check_finite, class_arg, finite_scalar, float_array, rows_array,
-    shape_error, shape_str, vector6,
-};
-use crate::errors::OrRaise;
+use crate::convert::{arg, array, check_finite, class_arg, finite, finite_scalar, matrix};
+use crate::convert::{shape_error, shaped};
+use crate::errors::{config_error, OrRaise};
 use crate::record::record;
 use crate::team::{failure_mask, PyTeam};
 use crate::CAPACITY;
@@ -27,54 +19,41 @@ use crate::CAPACITY;
 /// Names of the allocators this build provides (the core's one table).
 pub(crate) const ALLOCATORS: &[&str] = AnyAllocator::<f64, CAPACITY>::NAMES;
 
-/// Options of the allocators that take any.
-pub(crate) struct AllocatorOptions<'a, 'py> {
-    /// Per-agent weights `w_i` (n,) of "weighted-pseudo-inverse", or the wrench weights `W`
-    /// (6,) of "clarabel".
-    pub(crate) weights: Option<&'a Bound<'py, PyAny>>,
-    /// `lambda` of "clarabel".
-    pub(crate) regularization: Option<f64>,
-}
-
-/// Builds the allocator named `method` for a team of `n` agents
-/// ([`AnyAllocator::from_name`]); returns it with its name.
+/// The allocator named `method` for a team of `n` agents ([`AnyAllocator::from_name`]).
+/// `weights` are per-agent weights (n,) or wrench weights (6,), depending on the allocator.
 pub(crate) fn make_allocator(
     method: &str,
-    options: &AllocatorOptions<'_, '_>,
+    weights: Option<&Bound<'_, PyAny>>,
+    regularization: Option<f64>,
     n: usize,
-) -> PyResult<(AnyAllocator<f64, CAPACITY>, &'static str)> {
-    let weights = options.weights.filter(|w| !w.is_none());
-    let mut core_options = CoreAllocatorOptions::<f64, CAPACITY> {
-        regularization: options.regularization,
+) -> PyResult<AnyAllocator<f64, CAPACITY>> {
+    let mut options = AllocatorOptions::<f64, CAPACITY> {
+        regularization,
         ..Default::default()
     };
-    // `weights` means per-agent weights or wrench weights depending on the allocator.
-    match (method, weights) {
+    match (method, weights.filter(|w| !w.is_none())) {
         (WEIGHTED_PSEUDO_INVERSE, None) => {
             return Err(PyValueError::new_err(format!(
                 "allocator '{WEIGHTED_PSEUDO_INVERSE}' needs `weights`, shape ({n},)"
             )))
         }
         (WEIGHTED_PSEUDO_INVERSE, Some(weights)) => {
-            let view = float_array(weights, "weights")?;
-            let array = view.as_array();
-            if array.shape() != [n] {
-                return Err(shape_error("weights", &shape_str(&[n]), array.shape()));
+            let w = array(weights, "weights")?;
+            if w.shape() != [n] {
+                return Err(shape_error("weights", &format!("({n},)"), w.shape()));
             }
             let mut padded = [1.0; CAPACITY];
-            for (slot, w) in padded.iter_mut().zip(array.iter()) {
-                *slot = *w;
-            }
-            core_options.agent_weights = Some(padded);
+            padded.iter_mut().zip(&w).for_each(|(slot, w)| *slot = *w);
+            options.agent_weights = Some(padded);
         }
         (CLARABEL, Some(weights)) if cfg!(feature = "clarabel") => {
-            core_options.wrench_weights = Some(vector6(weights, "weights")?);
+            options.wrench_weights = Some(arg::<6, 1>(weights, "weights")?.into());
         }
         // Any other allocator refuses them (the core says so).
-        (_, Some(_)) => core_options.agent_weights = Some([1.0; CAPACITY]),
+        (_, Some(_)) => options.agent_weights = Some([1.0; CAPACITY]),
         (_, None) => {}
     }
-    let allocator = AnyAllocator::from_name(method, &core_options).map_err(|e| match e {
+    AnyAllocator::from_name(method, &options).map_err(|e| match e {
         ConfigError::UnknownAllocator => PyValueError::new_err(format!(
             "unknown allocator '{method}'; expected one of: {}",
             ALLOCATORS.join(", ")
@@ -83,108 +62,65 @@ pub(crate) fn make_allocator(
             "allocator 'clarabel' is not available: tvmd was built without the cargo feature \
 `clarabel` (rebuild with `maturin build --features clarabel`)",
         ),
-        ConfigError::UnusedOption { field } => PyValueError::new_err(format!(
-            "allocator '{method}' takes no `{}`",
-            if field == ConfigField::ClarabelLambda {
-                "regularization"
-            } else {
-                "weights"
-            }
-        )),
-        e => crate::errors::ConfigError::new_err(e.to_string()),
-    })?;
-    let name = allocator.name();
-    Ok((allocator, name))
+        ConfigError::UnusedOption { field } => {
+            let option = match field {
+                ConfigField::ClarabelLambda => "regularization",
+                _ => "weights",
+            };
+            PyValueError::new_err(format!("allocator '{method}' takes no `{option}`"))
+        }
+        e => config_error(e),
+    })
 }
 
 /// The last solve report of a Clarabel allocator, as text.
-#[cfg(feature = "clarabel")]
 pub(crate) fn report(allocator: &AnyAllocator<f64, CAPACITY>) -> Option<String> {
-    match allocator {
-        AnyAllocator::Clarabel(a) => a.last_report().map(ToString::to_string),
-        _ => None,
+    #[cfg(feature = "clarabel")]
+    if let AnyAllocator::Clarabel(a) = allocator {
+        return a.last_report().map(ToString::to_string);
     }
-}
-
-/// The last solve report of a Clarabel allocator, as text (none in this build).
-#[cfg(not(feature = "clarabel"))]
-pub(crate) fn report(_allocator: &AnyAllocator<f64, CAPACITY>) -> Option<String> {
+    let _ = allocator;
     None
 }
 
-/// Per-agent previous gimbal commands: `(n, k)`, `k` in 2..=4, columns `eta_x, eta_y[, thrust,
-/// omega]` (so `StepOutput.commands` can be passed as it is).
+/// Previous commands `(n, k)`, `k` in 2..=4, columns `eta_x, eta_y[, thrust, omega]` (so
+/// `StepOutput.commands` can be passed as it is).
 fn previous_commands(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<GimbalCommand<f64>>> {
-    let view = float_array(obj, "previous")?;
-    let array = view.as_array();
-    let k = match array.shape() {
+    let a = array(obj, "previous")?;
+    let k = match a.shape() {
         [rows, k] if *rows == n && (2..=4).contains(k) => *k,
         other => {
-            return Err(shape_error(
-                "previous",
-                &format!(
-                    "({n}, 2), ({n}, 3) or ({n}, 4) with columns eta_x, eta_y[, thrust, omega]"
-                ),
-                other,
-            ))
+            let expected = format!(
+                "({n}, 2), ({n}, 3) or ({n}, 4) with columns eta_x, eta_y[, thrust, omega]"
+            );
+            return Err(shape_error("previous", &expected, other));
         }
     };
-    check_finite(array.iter(), "previous")?;
-    let values: Vec<f64> = array.iter().copied().collect();
-    Ok(values
-        .chunks_exact(k)
-        .map(|row| GimbalCommand {
-            eta_x: row.first().copied().unwrap_or(0.0),
-            eta_y: row.get(1).copied().unwrap_or(0.0),
-            thrust: row.get(2).copied().unwrap_or(0.0),
-        })
-        .collect())
+    check_finite(a.iter(), "previous")?;
+    let values: Vec<f64> = a.iter().copied().collect();
+    let command = |row: &[f64]| match *row {
+        [eta_x, eta_y, ref rest @ ..] => GimbalCommand {
+            eta_x,
+            eta_y,
+            thrust: rest.first().copied().unwrap_or(0.0),
+        },
+        _ => GimbalCommand::idle(),
+    };
+    Ok(values.chunks_exact(k).map(command).collect())
 }
 
 /// The rate-limit argument `(eta_x_rate, eta_y_rate)` (rad/s).
 pub(crate) fn rate_limits_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<RateLimits<f64>>> {
-    match obj {
-        Some(o) if !o.is_none() => {
-            let [x, y] = crate::convert::fixed::<2>(o, "rate_limits", &[2])?;
-            RateLimits::new(x, y).or_raise().map(Some)
+    match obj.filter(|o| !o.is_none()) {
+        Some(o) => {
+            let r = arg::<2, 1>(o, "rate_limits")?;
+            RateLimits::new(r.x, r.y).or_raise().map(Some)
         }
-        _ => Ok(None),
+        None => Ok(None),
     }
 }
 
-/// Allocates a desired wrench `u_d` over the team's working agents: inverts `u_d = M f`
-/// (eq. 4) into agent-frame forces inside each agent's admissible set `E_f` (eq. 6).
-///
-/// Methods:
-///     "pseudo-inverse": `f = M^T (M M^T)^-1 u_d`, then each agent outside `E_f` is clamped.
-///     "weighted-pseudo-inverse": minimizes `sum_i w_i ||f_i||^2` s.t. `M f = u_d`, clamped;
-///         `weights` (n,) positive per-agent weights are required.
-///     "redistributed-pseudo-inverse" (default): Jin 2005 redistribution: the agent leaving
-///         `E_f` furthest is saturated and fixed, the rest of the wrench is redistributed.
-///     "clarabel": `min ||W (M f - u_d)||^2 + lambda ||f||^2` over a convex inner bound of
-///         `E_f` (SOC-constrained QP); needs the cargo feature `clarabel`. `weights` (6,) is the
-///         diagonal of `W`, `regularization` is `lambda` (default 1e-6).
-///
-/// Args:
-///     team: the `Team`.
-///     wrench: (6,) desired wrench `u_d = [u_tau; u_f]` in the team frame.
-///     method: the allocator name (see `tvmd.ALLOCATORS`).
-///     weights: see the methods.
-///     failed: None or failed agent indices (they get zero force).
-///     previous: (n, 2..4) previous commands, columns `eta_x, eta_y[, thrust, omega]`; only
-///         with `rate_limits` (default: centred gimbals).
-///     rate_limits: `(eta_x_rate, eta_y_rate)` (rad/s): narrows each gimbal range to
-///         `|eta - eta_prev| <= rate dt`.
-///     dt: the control period (s), required with `rate_limits`.
-///     regularization: `lambda` of "clarabel".
-///
-/// Returns:
-///     Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
-///
-/// Raises:
-///     ValueError: an unknown method, "clarabel" without the feature, options that do not
-///         apply to the method, wrong shapes, NaN/inf input.
-///     ConfigError: a degraded team that cannot produce every wrench, bad weights or rates.
+/// Allocates a desired wrench `u_d` over the working agents (eqs. 4 and 6). See the stub.
 #[pyfunction]
 #[pyo3(signature = (team, wrench, method = "redistributed-pseudo-inverse", weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None))]
 #[allow(clippy::too_many_arguments)]
@@ -201,24 +137,17 @@ pub(crate) fn allocate(
 ) -> PyResult<PyAllocation> {
     let team = &class_arg::<PyTeam>(team, "team")?.get().inner;
     let n = team.len();
-    let options = AllocatorOptions {
-        weights,
-        regularization,
-    };
-    let (mut allocator, name) = make_allocator(method, &options, n)?;
-    let u_d = vector6(wrench, "wrench")?;
-    check_finite(u_d.iter(), "wrench")?;
+    let mut allocator = make_allocator(method, weights, regularization, n)?;
+    let wrench = finite::<6, 1>(wrench, "wrench")?;
     let mask = failure_mask(team, failed)?;
     team.validate_failures(&mask).or_raise()?;
 
     let base = AdmissibleSet::from_limits(team.limits());
-    let mut sets = [base; CAPACITY];
     let previous = previous.filter(|p| !p.is_none());
-    match rate_limits_arg(rate_limits)? {
-        Some(rates) => {
-            let dt = dt.ok_or_else(|| PyValueError::new_err("`rate_limits` needs `dt`"))?;
-            finite_scalar(dt, "dt")?;
-            if dt <= 0.0 {
+    let sets = match (rate_limits_arg(rate_limits)?, dt) {
+        (Some(_), None) => return Err(PyValueError::new_err("`rate_limits` needs `dt`")),
+        (Some(rates), Some(dt)) => {
+            if finite_scalar(dt, "dt")? <= 0.0 {
                 return Err(crate::errors::ConfigError::new_err(
                     "`dt` must be positive and finite",
                 ));
@@ -227,82 +156,71 @@ pub(crate) fn allocate(
                 Some(p) => previous_commands(p, n)?,
                 None => vec![GimbalCommand::idle(); n],
             };
-            sets = admissible_sets(&base, Some((&rates, dt)), previous);
+            admissible_sets(&base, Some((&rates, dt)), previous)
         }
-        None => {
-            if previous.is_some() || dt.is_some() {
-                return Err(PyValueError::new_err(
-                    "`previous` and `dt` only apply with `rate_limits`",
-                ));
-            }
-        }
-    }
+        (None, Some(_)) => return Err(only_with_rate_limits()),
+        (None, None) if previous.is_some() => return Err(only_with_rate_limits()),
+        (None, None) => [base; CAPACITY],
+    };
 
     let effectiveness = team.effectiveness(&mask);
     allocator.configure(&effectiveness);
     let request = AllocationRequest {
         effectiveness: &effectiveness,
         sets: &sets,
-        wrench: Vector6::from(u_d),
+        wrench,
     };
     let allocation = allocator.allocate(&request);
     Ok(PyAllocation {
-        inner: AllocationData {
-            allocation,
-            n,
-            method: name,
-            report: report(&allocator),
-        },
+        inner: AllocationData::new(allocation, n, &allocator),
     })
 }
 
-/// A core allocation with what the bindings add: the agent count, the allocator's name and
-/// Clarabel's report.
-pub(crate) struct AllocationData {
-    pub(crate) allocation: Allocation<f64, CAPACITY>,
-    pub(crate) n: usize,
-    pub(crate) method: &'static str,
-    pub(crate) report: Option<String>,
+fn only_with_rate_limits() -> PyErr {
+    PyValueError::new_err("`previous` and `dt` only apply with `rate_limits`")
 }
 
-/// The forces of the first `n` agents as `(n, 3)`.
-pub(crate) fn forces_array<'py>(
-    py: Python<'py>,
-    forces: &[Vector3<f64>],
+/// A core allocation with the agent count, the allocator's name and Clarabel's report.
+#[derive(Clone)]
+pub(crate) struct AllocationData {
+    allocation: Allocation<f64, CAPACITY>,
     n: usize,
-) -> Bound<'py, PyArray2<f64>> {
-    let rows: Vec<[f64; 3]> = forces.iter().take(n).map(|f| [f.x, f.y, f.z]).collect();
-    rows_array(py, &rows)
+    method: &'static str,
+    report: Option<String>,
+}
+
+impl AllocationData {
+    pub(crate) fn new(
+        allocation: Allocation<f64, CAPACITY>,
+        n: usize,
+        allocator: &AnyAllocator<f64, CAPACITY>,
+    ) -> Self {
+        let (method, report) = (allocator.name(), report(allocator));
+        Self {
+            allocation,
+            n,
+            method,
+            report,
+        }
+    }
 }
 
 record! {
     /// The result of one allocation.
-    ///
-    /// Attributes:
-    ///     forces: (n, 3) agent-frame forces `f_i`, each inside its admissible set (zero for
-    ///         failed agents).
-    ///     wrench: (6,) `u = M f`, the wrench they produce.
-    ///     e_f: `||u_fd - u_f||`, the paper's allocation error (force part).
-    ///     wrench_error: `||u_d - M f||` over the whole wrench.
-    ///     rounds: solve rounds (pseudo-inverse 1, redistribution up to n, Clarabel iterations).
-    ///     saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
-    ///     fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
-    ///     method: the allocator's name.
-    ///     report: Clarabel's solve report (text), None for the other allocators.
     "Allocation" in "tvmd" => PyAllocation(AllocationData) |py, o| {
         /// (n, 3) agent-frame forces.
-        forces => forces_array(py, &o.allocation.forces, o.n),
-        /// (6,) `u = M f`.
-        wrench => array1(py, o.allocation.wrench.as_slice()),
-        /// `e_f = ||u_fd - u_f||`.
+        forces => shaped(py, o.allocation.forces.iter().take(o.n).flat_map(|f| f.iter().copied()).collect(), &[o.n, 3])?,
+        /// (6,) `M f`.
+        wrench => matrix(py, &o.allocation.wrench)?,
+        /// `||u_fd - u_f||`.
         e_f => o.allocation.e_f,
         /// `||u_d - M f||`.
         wrench_error => o.allocation.wrench_error,
         /// Solve rounds.
         rounds => o.allocation.rounds,
         /// (n,) saturated agents.
-        saturated => bool_array(py, o.allocation.saturated.get(..o.n).unwrap_or_default()),
-        /// Whether the allocator fell back to the redistributed pseudo-inverse.
+        saturated => shaped(py, o.allocation.saturated.iter().take(o.n).copied().collect(), &[o.n])?,
+        /// The allocator fell back to the redistributed pseudo-inverse.
         fallback => o.allocation.fallback,
         /// The allocator's name.
         method => o.method,

@@ -1,13 +1,4 @@
-//! Python exceptions of the bindings and the mapping of the core's error types onto them.
-//!
-//! Every exception is a subclass of `ValueError`, so `except ValueError` catches them all:
-//!
-//! - [`ConfigError`]: a `tvmd_core::ConfigError` (team, limits, gains, settings, failures),
-//! - [`InputError`]: a `tvmd_core::InputError` (a non-finite or non-rotation cycle input),
-//! - [`CycleError`] (an `InputError`): `Controller.step` rejected its input; the exception
-//!   carries the commands to hold as `commands` (n, 4) and the offending input as `field`.
-//!
-//! The message is always the core's `Display` text.
+//! The Python exceptions (all `ValueError`s) and the one mapping of the core's errors onto them.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -18,44 +9,44 @@ pyo3::create_exception!(
     tvmd,
     ConfigError,
     PyValueError,
-    "A team, limit, gain, setting or failure mask that cannot be used (tvmd_core::ConfigError). \
-Attribute `field`: the offending field (e.g. 'gains.k_x'), or None."
+    "A team, limit, gain, setting or failure mask that cannot be used. See the stub."
 );
 
 pyo3::create_exception!(
     tvmd,
     InputError,
     PyValueError,
-    "A control-cycle input that cannot be used: not finite, or not a rotation (tvmd_core::InputError)."
+    "A control-cycle input that cannot be used: not finite, or not a rotation."
 );
 
 pyo3::create_exception!(
     tvmd,
     CycleError,
     InputError,
-    "Controller.step rejected its input. Attributes: `commands` (n, 4) float64, the previous \
-period's commands to hold (columns eta_x, eta_y, thrust, omega; idle before the first period), \
-and `field`, the offending input (e.g. 'state.position')."
+    "Controller.step rejected its input; `commands` (n, 4) are the commands to hold."
 );
 
-/// Raises the core's errors as the matching Python exception.
+/// Raises the core's errors as the matching Python exception with the core's message.
 pub(crate) trait OrRaise<T> {
-    /// `Err(e)` becomes the Python exception of `e` with `e`'s `Display` message.
+    /// `Err(e)` becomes the Python exception of `e`.
     fn or_raise(self) -> PyResult<T>;
+}
+
+/// A `tvmd.ConfigError` with the core's message and its typed field as `field` (or None).
+pub(crate) fn config_error(e: tvmd_core::ConfigError) -> PyErr {
+    let err = ConfigError::new_err(e.to_string());
+    // Setting an attribute of a fresh exception cannot fail; if it did, the message stays.
+    Python::attach(|py| {
+        let _ = err
+            .value(py)
+            .setattr("field", e.field().map(|f| f.as_str()));
+    });
+    err
 }
 
 impl<T> OrRaise<T> for Result<T, tvmd_core::ConfigError> {
     fn or_raise(self) -> PyResult<T> {
-        self.map_err(|e| {
-            let err = ConfigError::new_err(e.to_string());
-            // The core's typed field (e.g. "gains.k_x"), None when the error names none.
-            Python::attach(|py| {
-                let _ = err
-                    .value(py)
-                    .setattr("field", e.field().map(|f| f.as_str()));
-            });
-            err
-        })
+        self.map_err(config_error)
     }
 }
 
@@ -65,31 +56,23 @@ impl<T> OrRaise<T> for Result<T, tvmd_core::InputError> {
     }
 }
 
-/// The field named by an input error.
-fn input_field(e: &tvmd_core::InputError) -> &'static str {
-    match *e {
-        tvmd_core::InputError::NonFinite { field }
-        | tvmd_core::InputError::NotRotation { field } => field,
-    }
-}
-
-/// A [`CycleError`] exception with the held commands of the first `n` agents attached.
+/// A [`CycleError`] with the held commands of the first `n` agents and the offending field.
 pub(crate) fn cycle_error(
     py: Python<'_>,
     error: &tvmd_core::CycleError<f64, CAPACITY>,
     n: usize,
 ) -> PyErr {
     let err = CycleError::new_err(error.to_string());
-    let commands = crate::convert::commands_array(py, &error.commands, n);
     let value = err.value(py);
-    // Attaching the attributes cannot fail on a fresh exception instance; if it somehow did,
-    // the exception is still raised with its message.
-    let _ = value.setattr("commands", commands);
-    let _ = value.setattr("field", input_field(&error.error));
+    let (tvmd_core::InputError::NonFinite { field } | tvmd_core::InputError::NotRotation { field }) =
+        error.error;
+    let _ = crate::convert::commands_array(py, &error.commands, n)
+        .map(|c| value.setattr("commands", c));
+    let _ = value.setattr("field", field);
     err
 }
 
-/// Registers the exceptions in the module.
+/// Registers the exceptions.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("ConfigError", py.get_type::<ConfigError>())?;

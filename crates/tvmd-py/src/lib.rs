@@ -1,25 +1,7 @@
-//! # tvmd-py
-//!
-//! Python bindings of [`tvmd_core`] (PyO3 + rust-numpy), built by maturin into the extension
-//! module `tvmd._tvmd` of the Python package `tvmd` (see `pyproject.toml` and
-//! `python/tvmd/__init__.py`, which re-exports everything listed in `python/tvmd/_tvmd.pyi`).
-//!
-//! The bindings are thin: they convert types at the boundary and call the core; there is no
-//! control logic here. Conventions:
-//!
-//! - `f64` throughout, fixed capacity [`CAPACITY`] = 64 agents (`TeamConfig<f64, 64>`).
-//! - Inputs: NumPy arrays of any real dtype, nested lists or Python numbers (read as float64);
-//!   outputs: fresh float64 (or bool / int64) NumPy arrays.
-//! - Wrong shapes raise `ValueError` (wrong dtypes `TypeError`) naming the argument and the
-//!   expected shape; NaN/inf inputs raise `ValueError`; the core's `ConfigError` / `InputError`
-//!   become `tvmd.ConfigError` / `tvmd.InputError` (both `ValueError`s) with the core's message.
-//!   No code path panics (the crate denies `unwrap`, `expect`, `panic!` and indexing).
-//!
-//! Layout: one Rust module per core area ([`team`], [`afs`], [`planner`], [`law`],
-//! [`allocation`], [`controller`]), each with a `register` function called by the module
-//! initializer. The simulator `tvmd-sim` is the submodule `_tvmd.sim` ([`sim`], added with
-//! `m.add_submodule`), re-exported by `python/tvmd/sim.py` so that `import tvmd.sim` works
-//! (stubs in `python/tvmd/sim.pyi`).
+//! Python bindings of [`tvmd_core`] and `tvmd-sim` (PyO3 + rust-numpy): the extension module
+//! `tvmd._tvmd`, one Rust module per core area, each with a `register` function; the simulator
+//! is the submodule `_tvmd.sim`. The bindings only convert types at the boundary and call the
+//! core. The Python API is documented in the stubs `python/tvmd/_tvmd.pyi` and `sim.pyi`.
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,

@@ -7,21 +7,9 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Declares a record class:
-///
-/// ```ignore
-/// record! {
-///     /// Class docstring.
-///     "LawOutput" in "tvmd" => PyLawOutput(LawOutput<f64>) |py, o| {  // or `repr path::to_fn`
-///         /// Field docstring.
-///         e_r as "e_R" => array1(py, o.e_r.as_slice()),
-///     }
-///     methods { /* more #[pymethods] items */ }
-/// }
-/// ```
-///
-/// `py` and `o` name the interpreter token and `&inner` inside the field expressions; each
-/// expression returns anything convertible into a Python object.
+/// Declares a record class: `"Name" in "module" => PyName(Inner) [repr path] |py, o| { field
+/// [as "py_name"] => expression, ... } [methods { ... }]`, where `o` is `&inner` and each
+/// expression returns anything convertible into a Python object (`?` allowed).
 macro_rules! record {
     (@name $field:ident) => { stringify!($field) };
     (@name $field:ident $py_name:literal) => { $py_name };
