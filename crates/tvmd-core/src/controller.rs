@@ -241,6 +241,28 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     ///
     /// A non-finite or non-rotation input is rejected with a [`CycleError`] that carries the
     /// previous commands to hold.
+    ///
+    /// ```
+    /// use tvmd_core::nalgebra::Vector3;
+    /// use tvmd_core::rotation::roll;
+    /// use tvmd_core::{team::presets, Controller, ControllerSettings, RedistributedPseudoInverse};
+    /// use tvmd_core::{PlannerStatus, Reference, RigidState};
+    /// let team = presets::a4_inc::<f32, 4>()?;
+    /// let mut controller =
+    ///     Controller::new(team, ControllerSettings::paper(), RedistributedPseudoInverse)?;
+    /// let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
+    /// reference.attitude = roll(1.0); // beyond what the team can hold
+    /// let state = RigidState::at_rest(Vector3::new(0.2, 0.0, 1.5));
+    /// let out = controller.step(&state, &reference).unwrap();
+    /// assert_eq!(out.planner.status, PlannerStatus::Planned);
+    /// assert!(out.command_clamp <= tvmd_core::command::command_tolerance());
+    /// // A NaN state is refused; the previous (admissible) commands are held.
+    /// let mut bad = state;
+    /// bad.position.x = f32::NAN;
+    /// let held = controller.step(&bad, &reference).unwrap_err();
+    /// assert_eq!(held.commands, out.commands);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
     pub fn step(
         &mut self,
         state: &RigidState<T>,

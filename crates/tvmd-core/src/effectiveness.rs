@@ -5,9 +5,8 @@
 use nalgebra::{Matrix6, Matrix6x3, Vector3, Vector6};
 
 use crate::error::ConfigError;
-use crate::linalg::{max_diagonal, weighted_gram, Ldlt};
+use crate::linalg::{max_diagonal, weighted_gram, GramSolver, Ldlt};
 use crate::real::{eps, lit, to_f64, Real};
-use crate::team::{FailureMask, TeamConfig};
 
 /// `R_z(m pi/2)`, at its old path (now in [`crate::rotation`]).
 pub use crate::rotation::quarter_turn;
@@ -28,18 +27,40 @@ pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Effectiveness<T: Real, const N: usize> {
     blocks: [Option<Matrix6x3<T>>; N],
+    /// The factor of `M M^T`, computed once here and reused by the pseudo-inverses.
+    gram: GramSolver<T>,
 }
 
 impl<T: Real, const N: usize> Effectiveness<T, N> {
-    /// Blocks of the team's working agents.
-    pub fn new(team: &TeamConfig<T, N>, failures: &FailureMask<N>) -> Self {
+    /// The blocks of the working agents, given as `(slot, p_i, m_i)` (slot `< N`; others are
+    /// ignored). [`crate::TeamConfig::effectiveness`] builds it from a team and failure mask.
+    ///
+    /// ```
+    /// use tvmd_core::{team::presets, FailureMask, TeamConfig};
+    /// let team: TeamConfig<f64, 4> = presets::a4_inc()?;
+    /// let m = team.effectiveness(&FailureMask::with_failed(&[2])?);
+    /// assert_eq!(m.working_count(), 3);
+    /// assert!(m.block(2).is_none());
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn new<'a>(agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>) -> Self {
         let mut blocks = [None; N];
-        for (i, agent) in team.working(failures) {
+        for (i, position, quarter_turns) in agents {
             if let Some(slot) = blocks.get_mut(i) {
-                *slot = Some(agent_block(&agent.position, agent.quarter_turns));
+                *slot = Some(agent_block(position, quarter_turns));
             }
         }
-        Self { blocks }
+        let mut m = Self {
+            blocks,
+            gram: GramSolver::Zero,
+        };
+        m.gram = GramSolver::new(&m.gram());
+        m
+    }
+
+    /// The factor of `M M^T` for the pseudo-inverses.
+    pub(crate) fn gram_solver(&self) -> &GramSolver<T> {
+        &self.gram
     }
 
     /// Block of agent `i`, `None` if it failed or does not exist.

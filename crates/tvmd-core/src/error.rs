@@ -298,16 +298,9 @@ impl fmt::Display for ConfigError {
             Self::FailureIndex { agent } => {
                 write!(f, "failure mask names agent {agent}, which the team does not have")
             }
-            Self::UnknownAllocator => {
-                f.write_str("unknown allocator (known: ")?;
-                for (i, name) in crate::AnyAllocator::<f64, 1>::NAMES.iter().enumerate() {
-                    if i > 0 {
-                        f.write_str(", ")?;
-                    }
-                    f.write_str(name)?;
-                }
-                f.write_str(")")
-            }
+            Self::UnknownAllocator => f.write_str(
+                "unknown allocator name (the known ones are tvmd_core::AnyAllocator::NAMES)",
+            ),
             Self::AllocatorUnavailable { name } => write!(
                 f,
                 "allocator `{name}` needs the cargo feature `{name}`, which this build lacks"

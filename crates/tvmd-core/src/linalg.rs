@@ -10,6 +10,7 @@ use crate::real::{eps, lit, Real};
 
 /// `A = L D L^T` of a symmetric 6x6 matrix, without pivoting. `None` unless every pivot is
 /// above `tol` (so `A` is numerically positive definite).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Ldlt<T: Real> {
     l: [[T; 6]; 6],
     d: [T; 6],
@@ -95,17 +96,42 @@ pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
 /// (damped least squares: a rank-deficient free set in the redistribution still gets the
 /// nearest wrench it can make). Zero when `A = 0` or the input is not finite.
 pub(crate) fn solve_gram<T: Real>(a: &Matrix6<T>, r: &Vector6<T>) -> Vector6<T> {
-    let scale = max_diagonal(a);
-    if scale <= T::zero() || !scale.is_finite() {
-        return Vector6::zeros();
+    GramSolver::new(a).solve(r)
+}
+
+/// The factorization [`solve_gram`] uses, kept so a Gram matrix that changes only with the
+/// team or its failures is factored once ([`crate::Allocator::configure`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum GramSolver<T: Real> {
+    /// `A = L D L^T`, definite.
+    Exact(Ldlt<T>),
+    /// `A + delta I = L D L^T` (Tikhonov damping).
+    Damped(Ldlt<T>),
+    /// `A = 0`, not finite, or not factorable: every solve gives zero.
+    Zero,
+}
+
+impl<T: Real> GramSolver<T> {
+    pub(crate) fn new(a: &Matrix6<T>) -> Self {
+        let scale = max_diagonal(a);
+        if scale <= T::zero() || !scale.is_finite() {
+            return Self::Zero;
+        }
+        let tol = scale * eps::<T>() * lit(1e3);
+        if let Some(f) = Ldlt::new(a, tol) {
+            return Self::Exact(f);
+        }
+        let damped = a + Matrix6::identity() * (scale * eps::<T>().sqrt());
+        match Ldlt::new(&damped, T::zero()) {
+            Some(f) => Self::Damped(f),
+            None => Self::Zero,
+        }
     }
-    let tol = scale * eps::<T>() * lit(1e3);
-    if let Some(f) = Ldlt::new(a, tol) {
-        return f.solve(r);
-    }
-    let damped = a + Matrix6::identity() * (scale * eps::<T>().sqrt());
-    match Ldlt::new(&damped, T::zero()) {
-        Some(f) => f.solve(r),
-        None => Vector6::zeros(),
+
+    pub(crate) fn solve(&self, r: &Vector6<T>) -> Vector6<T> {
+        match self {
+            Self::Exact(f) | Self::Damped(f) => f.solve(r),
+            Self::Zero => Vector6::zeros(),
+        }
     }
 }

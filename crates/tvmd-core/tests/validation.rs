@@ -202,7 +202,7 @@ fn non_positive_thrust() {
 fn rotor_model_round_trip() {
     let l = AgentLimits::from_rotor(0.5, 0.7, 1.225, 0.2, 0.1, 900.0).unwrap();
     let k = 1.225 * 0.2f64.powi(4) * 0.1;
-    assert!((l.max_thrust - k * 900.0 * 900.0).abs() < 1e-9);
+    assert!((l.max_thrust() - k * 900.0 * 900.0).abs() < 1e-9);
     assert!((l.max_speed() - 900.0).abs() < 1e-9);
     assert!((l.thrust_for_speed(l.speed_for_thrust(3.0)) - 3.0).abs() < 1e-12);
     // Without rotor constants, speed is normalized to 1 at maximum thrust.
@@ -322,7 +322,7 @@ fn allocators_by_name() {
     assert_eq!(Any::default().name(), Any::DEFAULT_NAME);
     let e = Any::from_name("magic", &options).unwrap_err();
     assert_eq!(e, ConfigError::UnknownAllocator);
-    assert_message(e, "redistributed-pseudo-inverse");
+    assert_message(e, "unknown allocator");
     let weighted = AllocatorOptions {
         agent_weights: Some([1.0, 2.0, 3.0, 4.0]),
         ..AllocatorOptions::default()
@@ -357,4 +357,41 @@ fn planner_status_spelling() {
         ["already-feasible", "planned", "zero-force", "unreachable"]
     );
     assert_eq!(PlannerStatus::Planned.to_string(), "planned");
+}
+
+#[test]
+fn admissible_sets_are_validated() {
+    use tvmd_core::admissible::{AdmissibleSet, Interval};
+    let ok = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval { lo: -0.2, hi: 0.3 },
+        Interval { lo: 0.0, hi: 10.0 },
+    )
+    .unwrap();
+    assert_eq!(ok.eta_y(), Interval { lo: -0.2, hi: 0.3 });
+    let reversed = AdmissibleSet::new(
+        Interval { lo: 0.5, hi: -0.5 },
+        Interval::symmetric(0.5),
+        Interval { lo: 0.0, hi: 10.0 },
+    );
+    assert_eq!(
+        reversed,
+        Err(ConfigError::Parameter {
+            field: ConfigField::SigmaX
+        })
+    );
+    let nan = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval::symmetric(0.5),
+        Interval {
+            lo: 0.0,
+            hi: f64::NAN,
+        },
+    );
+    assert_eq!(
+        nan,
+        Err(ConfigError::NonFinite {
+            field: ConfigField::MaxThrust
+        })
+    );
 }

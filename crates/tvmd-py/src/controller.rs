@@ -226,9 +226,9 @@ impl PyController {
         let limits = self.inner.team().limits();
         PyAfs::from_parts(
             *self.inner.afs(),
-            limits.sigma_x,
-            limits.sigma_y,
-            limits.max_thrust,
+            limits.sigma_x(),
+            limits.sigma_y(),
+            limits.max_thrust(),
         )
     }
 

@@ -24,7 +24,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
-use crate::linalg::{solve_gram, weighted_gram};
+use crate::linalg::{solve_gram, weighted_gram, GramSolver};
 use crate::real::Real;
 
 /// What an allocator is asked to do.
@@ -107,20 +107,15 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
     effectiveness: &Effectiveness<T, N>,
     free: &[bool; N],
     weights: Option<&[T; N]>,
+    factor: Option<&GramSolver<T>>,
     rhs: &Vector6<T>,
     out: &mut [Vector3<T>; N],
 ) {
     let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
-    let gram = weighted_gram(
-        Matrix6::zeros(),
-        effectiveness
-            .blocks()
-            .iter()
-            .zip(free)
-            .enumerate()
-            .filter_map(|(i, (block, f))| block.as_ref().filter(|_| *f).map(|b| (b, weight(i)))),
-    );
-    let lambda = solve_gram(&gram, rhs);
+    let lambda = match factor {
+        Some(f) => f.solve(rhs),
+        None => solve_gram(&gram_of(effectiveness, free, weights), rhs),
+    };
     for (i, ((block, f), slot)) in effectiveness
         .blocks()
         .iter()
@@ -132,6 +127,24 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
             *slot = b.tr_mul(&lambda) / weight(i);
         }
     }
+}
+
+/// `sum_{i free} M_i M_i^T / w_i`.
+pub(crate) fn gram_of<T: Real, const N: usize>(
+    effectiveness: &Effectiveness<T, N>,
+    free: &[bool; N],
+    weights: Option<&[T; N]>,
+) -> Matrix6<T> {
+    let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+    weighted_gram(
+        Matrix6::zeros(),
+        effectiveness
+            .blocks()
+            .iter()
+            .zip(free)
+            .enumerate()
+            .filter_map(|(i, (block, f))| block.as_ref().filter(|_| *f).map(|b| (b, weight(i)))),
+    )
 }
 
 /// Working agents as a mask.

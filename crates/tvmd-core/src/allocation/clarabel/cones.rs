@@ -37,8 +37,8 @@ pub(super) struct Bounds {
 impl Bounds {
     pub(super) fn new<T: Real>(set: &AdmissibleSet<T>) -> Option<Self> {
         let capped = |a: T| to_f64(a).clamp(-MAX_TAN_ANGLE, MAX_TAN_ANGLE);
-        let (lo_x, hi_x) = (capped(set.eta_x.lo), capped(set.eta_x.hi));
-        let (lo_y, hi_y) = (capped(set.eta_y.lo), capped(set.eta_y.hi));
+        let (lo_x, hi_x) = (capped(set.eta_x().lo), capped(set.eta_x().hi));
+        let (lo_y, hi_y) = (capped(set.eta_y().lo), capped(set.eta_y().hi));
         let bounds = Self {
             tan_y_lo: lo_y.tan(),
             tan_y_hi: hi_y.tan(),
@@ -54,8 +54,8 @@ impl Bounds {
             } else {
                 XBound::Cone(1.0 / lo_x.sin())
             },
-            thrust_lo: to_f64(set.thrust.lo).max(0.0),
-            thrust_hi: to_f64(set.thrust.hi),
+            thrust_lo: to_f64(set.thrust().lo).max(0.0),
+            thrust_hi: to_f64(set.thrust().hi),
         };
         let finite = [
             bounds.tan_y_lo,
@@ -184,12 +184,12 @@ pub(super) mod tests {
 
     /// `E_f` of eq. (6) with `sigma_x = pi/6`, `sigma_y = pi/4`, `T in [0, 10]`.
     pub(in crate::allocation::clarabel) fn symmetric() -> Bounds {
-        Bounds::new(&AdmissibleSet {
-            eta_x: Interval::symmetric(core::f64::consts::FRAC_PI_6),
-            eta_y: Interval::symmetric(core::f64::consts::FRAC_PI_4),
-            thrust: Interval { lo: 0.0, hi: 10.0 },
-        })
-        .unwrap()
+        let set = AdmissibleSet::new(
+            Interval::symmetric(core::f64::consts::FRAC_PI_6),
+            Interval::symmetric(core::f64::consts::FRAC_PI_4),
+            Interval { lo: 0.0, hi: 10.0 },
+        );
+        Bounds::new(&set.unwrap()).unwrap()
     }
 
     #[test]
@@ -213,12 +213,12 @@ pub(super) mod tests {
     #[test]
     fn window_excluding_zero_becomes_a_cone() {
         let lo = 0.2_f64;
-        let b = Bounds::new(&AdmissibleSet {
-            eta_x: Interval { lo, hi: 0.4 },
-            eta_y: Interval::symmetric(0.5),
-            thrust: Interval { lo: 1.0, hi: 10.0 },
-        })
-        .unwrap();
+        let set = AdmissibleSet::new(
+            Interval { lo, hi: 0.4 },
+            Interval::symmetric(0.5),
+            Interval { lo: 1.0, hi: 10.0 },
+        );
+        let b = Bounds::new(&set.unwrap()).unwrap();
         assert_eq!(b.x_lo, XBound::Cone(1.0 / lo.sin()));
         assert_eq!((b.shape().linear_rows(), b.shape().cones()), (4, 2));
         // eta_x = 0.3 lies inside, eta_x = 0.1 outside.

@@ -30,7 +30,7 @@ use qp::Problem;
 pub use report::{ClarabelStatus, FallbackReason, SolveReport};
 use settings::{default_settings, DEFAULT_LAMBDA};
 
-/// The constrained allocator of the SPEC ("Allocation"): a QP with second-order cones solved by
+/// The constrained allocator of `docs/method.md` ("Allocation"): a QP with second-order cones solved by
 /// [Clarabel](https://clarabel.org) over the working agents' forces `f` (agent frames):
 ///
 /// ```text
@@ -42,7 +42,7 @@ use settings::{default_settings, DEFAULT_LAMBDA};
 /// ```
 ///
 /// per agent, from its [`AdmissibleSet`] `{eta_x in [lo_x, hi_x], eta_y in [lo_y, hi_y], T in
-/// [T_lo, T_hi]}`. In the symmetric case of eq. (6) this is the SPEC's pyramid `|f_x| <= f_z
+/// [T_lo, T_hi]}`. In the symmetric case of eq. (6) this is the method's pyramid `|f_x| <= f_z
 /// tan(sigma_y)`, `|f_y| <= f_z tan(sigma_x)`, `f_z >= 0`, `||f|| <= sigma_Tf`.
 ///
 /// # Why the constraints lie inside the admissible set
@@ -95,6 +95,22 @@ use settings::{default_settings, DEFAULT_LAMBDA};
 ///
 /// Cloning copies the configuration and the last report but not the solver, which the clone
 /// rebuilds on its first call.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::ClarabelAllocator;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = ClarabelAllocator::new(0.0, None)?;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 pub struct ClarabelAllocator<T: Real, const N: usize> {
     lambda: f64,
     weights: [f64; 6],

@@ -3,6 +3,11 @@
 use core::fmt;
 use std::time::Duration;
 
+#[cfg(doc)]
+use super::ClarabelAllocator;
+#[cfg(doc)]
+use crate::allocation::Allocator;
+
 /// Clarabel's termination status (re-exported from `clarabel::solver::SolverStatus`).
 pub use ::clarabel::solver::SolverStatus as ClarabelStatus;
 
@@ -33,7 +38,7 @@ impl fmt::Display for FallbackReason {
     }
 }
 
-/// What happened in the last [`ClarabelAllocator::allocate`] call.
+/// What happened in the last [`Allocator::allocate`] call.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveReport {
     /// Clarabel's status (`Unsolved` when the solver did not run).
