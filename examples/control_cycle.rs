@@ -70,7 +70,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let limits = team.limits();
     println!(
         "limits: |eta_x| <= {:.4}, |eta_y| <= {:.4}, thrust <= {:.3} N",
-        limits.sigma_x, limits.sigma_y, limits.max_thrust
+        limits.sigma_x(),
+        limits.sigma_y(),
+        limits.max_thrust()
     );
     Ok(())
 }

@@ -3,96 +3,96 @@
 
 use nalgebra::Vector3;
 
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
 use crate::gimbal::GimbalCommand;
+use crate::limits::AgentLimits;
+/// The interval and rate limits, at their old paths (now in [`crate::limits`]).
+pub use crate::limits::{Interval, RateLimits};
 use crate::real::Real;
-use crate::team::AgentLimits;
 
-/// A closed interval `[lo, hi]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Interval<T: Real> {
-    /// Lower end.
-    pub lo: T,
-    /// Upper end (`>= lo`).
-    pub hi: T,
-}
-
-impl<T: Real> Interval<T> {
-    /// `[-limit, limit]`.
-    pub fn symmetric(limit: T) -> Self {
-        Self {
-            lo: -limit,
-            hi: limit,
+/// Each agent's admissible set for one period: `base` everywhere, narrowed around each agent's
+/// previous command by `rate_limits = (rates, dt)` when given
+/// ([`AdmissibleSet::with_rate_limit`]). Slots beyond `previous` keep `base`. The one rule the
+/// controller and the bindings share.
+pub fn admissible_sets<T: Real, const N: usize>(
+    base: &AdmissibleSet<T>,
+    rate_limits: Option<(&RateLimits<T>, T)>,
+    previous: impl IntoIterator<Item = GimbalCommand<T>>,
+) -> [AdmissibleSet<T>; N] {
+    let mut sets = [*base; N];
+    if let Some((rates, dt)) = rate_limits {
+        for (set, prev) in sets.iter_mut().zip(previous) {
+            *set = base.with_rate_limit(&prev, rates, dt);
         }
     }
-
-    /// Whether `x` lies within the interval widened by `tol`.
-    pub fn contains(&self, x: T, tol: T) -> bool {
-        x >= self.lo - tol && x <= self.hi + tol
-    }
-
-    /// The nearest point of the interval.
-    pub fn clamp(&self, x: T) -> T {
-        x.max(self.lo).min(self.hi)
-    }
-
-    /// How far `x` lies outside, 0 inside.
-    pub fn excess(&self, x: T) -> T {
-        (self.lo - x).max(x - self.hi).max(T::zero())
-    }
-
-    /// Intersection with `[centre - radius, centre + radius]`; if they do not meet, the end of
-    /// `self` nearest to the window (so the result is never empty and stays inside `self`).
-    fn window(&self, centre: T, radius: T) -> Self {
-        let lo = self.clamp(centre - radius);
-        let hi = self.clamp(centre + radius);
-        Self { lo, hi: hi.max(lo) }
-    }
-}
-
-/// Gimbal rate limits (rad/s) of the rate-constrained allocation.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RateLimits<T: Real> {
-    /// Largest `|d eta_x / dt|`.
-    pub eta_x: T,
-    /// Largest `|d eta_y / dt|`.
-    pub eta_y: T,
-}
-
-impl<T: Real> RateLimits<T> {
-    /// Validated rate limits (positive, finite).
-    pub fn new(eta_x: T, eta_y: T) -> Result<Self, ConfigError> {
-        for value in [eta_x, eta_y] {
-            if !value.is_finite() || value <= T::zero() {
-                return Err(ConfigError::Parameter {
-                    name: "rate_limits",
-                });
-            }
-        }
-        Ok(Self { eta_x, eta_y })
-    }
+    sets
 }
 
 /// One agent's admissible set: `eta_x in eta_x`, `eta_y in eta_y`, `T in thrust`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdmissibleSet<T: Real> {
-    /// Range of `eta_x` (rad).
-    pub eta_x: Interval<T>,
-    /// Range of `eta_y` (rad).
-    pub eta_y: Interval<T>,
-    /// Range of the thrust (N).
-    pub thrust: Interval<T>,
+    eta_x: Interval<T>,
+    eta_y: Interval<T>,
+    thrust: Interval<T>,
 }
 
 impl<T: Real> AdmissibleSet<T> {
+    /// A set from its three ranges: finite, `lo <= hi`, angles within `[-pi/2, pi/2]`, thrust
+    /// `>= 0`. Errors name the range ([`ConfigField::SigmaX`], [`ConfigField::SigmaY`],
+    /// [`ConfigField::MaxThrust`]).
+    pub fn new(
+        eta_x: Interval<T>,
+        eta_y: Interval<T>,
+        thrust: Interval<T>,
+    ) -> Result<Self, ConfigError> {
+        let half_pi = T::frac_pi_2();
+        for (range, field, lo, hi) in [
+            (eta_x, ConfigField::SigmaX, -half_pi, half_pi),
+            (eta_y, ConfigField::SigmaY, -half_pi, half_pi),
+            (
+                thrust,
+                ConfigField::MaxThrust,
+                T::zero(),
+                T::one() / T::zero(),
+            ),
+        ] {
+            if !range.lo.is_finite() || !range.hi.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if range.lo > range.hi || range.lo < lo || range.hi > hi {
+                return Err(ConfigError::Parameter { field });
+            }
+        }
+        Ok(Self {
+            eta_x,
+            eta_y,
+            thrust,
+        })
+    }
+
+    /// Range of `eta_x` (rad).
+    pub fn eta_x(&self) -> Interval<T> {
+        self.eta_x
+    }
+
+    /// Range of `eta_y` (rad).
+    pub fn eta_y(&self) -> Interval<T> {
+        self.eta_y
+    }
+
+    /// Range of the thrust (N).
+    pub fn thrust(&self) -> Interval<T> {
+        self.thrust
+    }
+
     /// `E_f` of eq. (6): `|eta_x| <= sigma_x`, `|eta_y| <= sigma_y`, `T in [T_idle, sigma_Tf]`.
     pub fn from_limits(limits: &AgentLimits<T>) -> Self {
         Self {
-            eta_x: Interval::symmetric(limits.sigma_x),
-            eta_y: Interval::symmetric(limits.sigma_y),
+            eta_x: Interval::symmetric(limits.sigma_x()),
+            eta_y: Interval::symmetric(limits.sigma_y()),
             thrust: Interval {
-                lo: limits.min_thrust,
-                hi: limits.max_thrust,
+                lo: limits.min_thrust(),
+                hi: limits.max_thrust(),
             },
         }
     }

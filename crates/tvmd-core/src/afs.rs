@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ConfigField};
 use crate::real::{count, to_f64, Real};
 
 /// The AFS relaxation `s in (0, 1]`: gimbal limits are shrunk to `s sigma` when planning, which
@@ -15,7 +15,7 @@ impl<T: Real> Relaxation<T> {
     pub fn new(s: T) -> Result<Self, ConfigError> {
         if !s.is_finite() {
             return Err(ConfigError::NonFinite {
-                field: "relaxation",
+                field: ConfigField::Relaxation,
             });
         }
         if s <= T::zero() || s > T::one() {
@@ -52,8 +52,22 @@ pub struct SemiAxes<T: Real> {
 /// with `C = diag(1/c_x^2, 1/c_y^2, 0)` and `c_x, c_y` from eq. (8).
 ///
 /// A force with `z <= 0` is outside unless a semi-axis comes from the `sigma >= pi/2` branch
-/// (SPEC reading; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
+/// (the reading of `docs/method.md`; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
 /// paper writes `<`, so that the projection's output `t_Tf u` is a member.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector3;
+/// use tvmd_core::{team::presets, FailureMask, Relaxation};
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let afs = team.afs(&FailureMask::none())?;
+/// let s = Relaxation::new(0.5)?;
+/// // Hover is inside; a large sideways force at the same height is not.
+/// assert!(afs.contains(&Vector3::new(0.0, 0.0, 27.5), s));
+/// assert!(!afs.contains(&Vector3::new(0.0, 20.0, 27.5), s));
+/// let axes = afs.semi_axes(1.0, s);
+/// assert!((axes.c_y.atan() - 0.328708).abs() < 1e-6); // the hover saturation roll
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttainableForceSpace<T: Real> {
     n: usize,
@@ -78,7 +92,7 @@ impl<T: Real> AttainableForceSpace<T> {
         if n_x > n {
             return Err(ConfigError::AgentCount { n, n_x });
         }
-        crate::team::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
+        crate::limits::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
         Ok(Self {
             n,
             n_x,

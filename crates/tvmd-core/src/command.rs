@@ -4,8 +4,8 @@ use nalgebra::Vector3;
 
 use crate::admissible::AdmissibleSet;
 use crate::gimbal::GimbalCommand;
+use crate::limits::AgentLimits;
 use crate::real::{eps, lit, Real};
-use crate::team::AgentLimits;
 
 /// One agent's actuator command.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,14 +1,17 @@
 //! The control cycle: planner, projection, law, allocation and inversion composed into one
 //! `step` per control period.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
-use crate::admissible::{AdmissibleSet, RateLimits};
+/// The roll `R_x(phi)`, at its old path (now in [`crate::rotation`]).
+pub use crate::rotation::roll;
+
+use crate::admissible::{admissible_sets, AdmissibleSet, RateLimits};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::allocation::{Allocation, AllocationRequest, Allocator};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, InputError};
+use crate::error::{ConfigError, ConfigField, InputError};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::{project_force_in, ForceProjection};
@@ -50,9 +53,12 @@ impl<T: Real> ControllerSettings<T> {
             self.gains.k_v,
         )?;
         Relaxation::new(self.relaxation.get())?;
-        for (value, name) in [(self.gravity, "gravity"), (self.period, "period")] {
+        for (value, field) in [
+            (self.gravity, ConfigField::Gravity),
+            (self.period, ConfigField::Period),
+        ] {
             if !value.is_finite() || value <= T::zero() {
-                return Err(ConfigError::Parameter { name });
+                return Err(ConfigError::Parameter { field });
             }
         }
         if let Some(r) = self.rate_limits {
@@ -134,6 +140,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         settings.validate()?;
         let failures = FailureMask::none();
         let afs = team.afs(&failures)?;
+        let effectiveness = team.effectiveness(&failures);
+        let mut allocator = allocator;
+        allocator.configure(&effectiveness);
         Ok(Self {
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
@@ -144,7 +153,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                 gravity: settings.gravity,
             },
             planner: AttitudePlanner::new(settings.relaxation),
-            effectiveness: team.effectiveness(&failures),
+            effectiveness,
             admissible: AdmissibleSet::from_limits(team.limits()),
             team,
             settings,
@@ -162,6 +171,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.full_cone = self.afs.cone(Relaxation::none());
         self.planner_cone = self.afs.cone(self.settings.relaxation);
         self.effectiveness = self.team.effectiveness(&failures);
+        self.allocator.configure(&self.effectiveness);
         self.failures = failures;
         Ok(())
     }
@@ -216,15 +226,14 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Each agent's admissible set this period (rate-limited around the previous command when
     /// rate limits are set).
     pub fn admissible_sets(&self) -> [AdmissibleSet<T>; N] {
-        let mut sets = [self.admissible; N];
-        if let Some(rates) = &self.settings.rate_limits {
-            for (set, prev) in sets.iter_mut().zip(&self.previous) {
-                *set = self
-                    .admissible
-                    .with_rate_limit(&prev.gimbal(), rates, self.settings.period);
-            }
-        }
-        sets
+        admissible_sets(
+            &self.admissible,
+            self.settings
+                .rate_limits
+                .as_ref()
+                .map(|r| (r, self.settings.period)),
+            self.previous.iter().map(AgentCommand::gimbal),
+        )
     }
 
     /// One control period: `u_fr`, projection `t_Tf`, planner (`R_d`), `K_f` and the torque part,
@@ -232,6 +241,28 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     ///
     /// A non-finite or non-rotation input is rejected with a [`CycleError`] that carries the
     /// previous commands to hold.
+    ///
+    /// ```
+    /// use tvmd_core::nalgebra::Vector3;
+    /// use tvmd_core::rotation::roll;
+    /// use tvmd_core::{team::presets, Controller, ControllerSettings, RedistributedPseudoInverse};
+    /// use tvmd_core::{PlannerStatus, Reference, RigidState};
+    /// let team = presets::a4_inc::<f32, 4>()?;
+    /// let mut controller =
+    ///     Controller::new(team, ControllerSettings::paper(), RedistributedPseudoInverse)?;
+    /// let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
+    /// reference.attitude = roll(1.0); // beyond what the team can hold
+    /// let state = RigidState::at_rest(Vector3::new(0.2, 0.0, 1.5));
+    /// let out = controller.step(&state, &reference).unwrap();
+    /// assert_eq!(out.planner.status, PlannerStatus::Planned);
+    /// assert!(out.command_clamp <= tvmd_core::command::command_tolerance());
+    /// // A NaN state is refused; the previous (admissible) commands are held.
+    /// let mut bad = state;
+    /// bad.position.x = f32::NAN;
+    /// let held = controller.step(&bad, &reference).unwrap_err();
+    /// assert_eq!(held.commands, out.commands);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
     pub fn step(
         &mut self,
         state: &RigidState<T>,
@@ -291,11 +322,4 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             command_clamp,
         })
     }
-}
-
-/// `R_x(phi)`, a roll about the body `x` axis (the paper's stage-B reference).
-pub fn roll<T: Real>(phi: T) -> Matrix3<T> {
-    let (s, c) = phi.sin_cos();
-    let (o, i) = (T::zero(), T::one());
-    Matrix3::new(i, o, o, o, c, -s, o, s, c)
 }

@@ -2,23 +2,14 @@
 //!
 //! Stored as one 6x3 block per agent, never as a heap matrix, so every product is `O(n)`.
 
-use nalgebra::{Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
+use nalgebra::{Matrix6, Matrix6x3, Vector3, Vector6};
 
 use crate::error::ConfigError;
-use crate::linalg::{max_diagonal, Ldlt};
+use crate::linalg::{max_diagonal, weighted_gram, GramSolver, Ldlt};
 use crate::real::{eps, lit, to_f64, Real};
-use crate::team::{FailureMask, TeamConfig};
 
-/// `R_z(m pi/2)`, exact for whole quarter turns.
-pub fn quarter_turn<T: Real>(quarter_turns: i32) -> Matrix3<T> {
-    let (o, i) = (T::zero(), T::one());
-    match quarter_turns.rem_euclid(4) {
-        0 => Matrix3::identity(),
-        1 => Matrix3::new(o, -i, o, i, o, o, o, o, i),
-        2 => Matrix3::new(-i, o, o, o, -i, o, o, o, i),
-        _ => Matrix3::new(o, i, o, -i, o, o, o, o, i),
-    }
-}
+/// `R_z(m pi/2)`, at its old path (now in [`crate::rotation`]).
+pub use crate::rotation::quarter_turn;
 
 /// `M_i = [[p_i]x R_z(psi_i); R_z(psi_i)]`, agent `i`'s block of eq. (4), rows `[torque; force]`.
 pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix6x3<T> {
@@ -36,18 +27,40 @@ pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Effectiveness<T: Real, const N: usize> {
     blocks: [Option<Matrix6x3<T>>; N],
+    /// The factor of `M M^T`, computed once here and reused by the pseudo-inverses.
+    gram: GramSolver<T>,
 }
 
 impl<T: Real, const N: usize> Effectiveness<T, N> {
-    /// Blocks of the team's working agents.
-    pub fn new(team: &TeamConfig<T, N>, failures: &FailureMask<N>) -> Self {
+    /// The blocks of the working agents, given as `(slot, p_i, m_i)` (slot `< N`; others are
+    /// ignored). [`crate::TeamConfig::effectiveness`] builds it from a team and failure mask.
+    ///
+    /// ```
+    /// use tvmd_core::{team::presets, FailureMask, TeamConfig};
+    /// let team: TeamConfig<f64, 4> = presets::a4_inc()?;
+    /// let m = team.effectiveness(&FailureMask::with_failed(&[2])?);
+    /// assert_eq!(m.working_count(), 3);
+    /// assert!(m.block(2).is_none());
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn new<'a>(agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>) -> Self {
         let mut blocks = [None; N];
-        for (i, agent) in team.working(failures) {
+        for (i, position, quarter_turns) in agents {
             if let Some(slot) = blocks.get_mut(i) {
-                *slot = Some(agent_block(&agent.position, agent.quarter_turns));
+                *slot = Some(agent_block(position, quarter_turns));
             }
         }
-        Self { blocks }
+        let mut m = Self {
+            blocks,
+            gram: GramSolver::Zero,
+        };
+        m.gram = GramSolver::new(&m.gram());
+        m
+    }
+
+    /// The factor of `M M^T` for the pseudo-inverses.
+    pub(crate) fn gram_solver(&self) -> &GramSolver<T> {
+        &self.gram
     }
 
     /// Block of agent `i`, `None` if it failed or does not exist.
@@ -77,14 +90,14 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
     /// `M W^-1 M^T = sum_i M_i M_i^T / w_i` (with `w_i = 1`: `M M^T`), the 6x6 Gram matrix of the
     /// pseudo-inverse. `weights[i] > 0` is agent `i`'s cost weight.
     pub fn weighted_gram(&self, weights: Option<&[T; N]>) -> Matrix6<T> {
-        let mut gram = Matrix6::zeros();
-        for (i, block) in self.blocks.iter().enumerate() {
-            if let Some(b) = block {
-                let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
-                gram += b * b.transpose() / w;
-            }
-        }
-        gram
+        let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+        weighted_gram(
+            Matrix6::zeros(),
+            self.blocks
+                .iter()
+                .enumerate()
+                .filter_map(|(i, b)| b.as_ref().map(|b| (b, weight(i)))),
+        )
     }
 
     /// `M M^T`.

@@ -24,6 +24,111 @@ pub enum GimbalAxis {
     Y,
 }
 
+/// The setting a [`ConfigError`] names: one variant per validated field, so callers (the
+/// simulator's scenario checks, the Python bindings) map it to their own field names without
+/// matching strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ConfigField {
+    /// `p_i` of an agent.
+    AgentPosition,
+    /// `m_i` of an agent.
+    AgentMass,
+    /// `J_i` of an agent.
+    AgentInertia,
+    /// `m_0`.
+    NavigatorMass,
+    /// `J_0`.
+    NavigatorInertia,
+    /// `sigma_x`.
+    SigmaX,
+    /// `sigma_y`.
+    SigmaY,
+    /// `sigma_Tf`.
+    MaxThrust,
+    /// The idle thrust.
+    MinThrust,
+    /// `rho d^4 c_l`.
+    ThrustCoefficient,
+    /// Air density `rho` (eq. 5).
+    Rho,
+    /// Rotor diameter `d` (eq. 5).
+    RotorDiameter,
+    /// Lift coefficient `c_l` (eq. 5).
+    LiftCoefficient,
+    /// `sigma_omega` (eq. 5).
+    MaxRotorSpeed,
+    /// The AFS relaxation `s`.
+    Relaxation,
+    /// `K_x`.
+    GainKx,
+    /// `K_R`.
+    GainKr,
+    /// `K_Omega`.
+    GainKomega,
+    /// `K_v`.
+    GainKv,
+    /// `g`.
+    Gravity,
+    /// The control period `dt`.
+    Period,
+    /// The gimbal rate limits.
+    RateLimits,
+    /// The planner's bisection tolerance.
+    PlannerTolerance,
+    /// The planner's iteration cap.
+    PlannerMaxIterations,
+    /// The per-agent weights of the weighted pseudo-inverse.
+    AllocatorWeights,
+    /// Clarabel's regularisation `lambda`.
+    ClarabelLambda,
+    /// Clarabel's wrench weights `W`.
+    ClarabelWeights,
+    /// Clarabel's tolerance.
+    ClarabelTolerance,
+}
+
+impl ConfigField {
+    /// The dotted name used in messages, e.g. `"limits.sigma_x"` or `"gains.k_x"`.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::AgentPosition => "agent.position",
+            Self::AgentMass => "agent.mass",
+            Self::AgentInertia => "agent.inertia",
+            Self::NavigatorMass => "navigator.mass",
+            Self::NavigatorInertia => "navigator.inertia",
+            Self::SigmaX => "limits.sigma_x",
+            Self::SigmaY => "limits.sigma_y",
+            Self::MaxThrust => "limits.max_thrust",
+            Self::MinThrust => "limits.min_thrust",
+            Self::ThrustCoefficient => "limits.thrust_coefficient",
+            Self::Rho => "limits.rho",
+            Self::RotorDiameter => "limits.d",
+            Self::LiftCoefficient => "limits.c_l",
+            Self::MaxRotorSpeed => "limits.sigma_omega",
+            Self::Relaxation => "relaxation",
+            Self::GainKx => "gains.k_x",
+            Self::GainKr => "gains.k_r",
+            Self::GainKomega => "gains.k_omega",
+            Self::GainKv => "gains.k_v",
+            Self::Gravity => "gravity",
+            Self::Period => "period",
+            Self::RateLimits => "rate_limits",
+            Self::PlannerTolerance => "planner.tolerance",
+            Self::PlannerMaxIterations => "planner.max_iterations",
+            Self::AllocatorWeights => "allocation.weights",
+            Self::ClarabelLambda => "clarabel.lambda",
+            Self::ClarabelWeights => "clarabel.weights",
+            Self::ClarabelTolerance => "clarabel.tolerance",
+        }
+    }
+}
+
+impl fmt::Display for ConfigField {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// A configuration that cannot describe a flyable team or a usable controller.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ConfigError {
@@ -38,8 +143,8 @@ pub enum ConfigError {
     },
     /// A NaN or infinite number in the named field.
     NonFinite {
-        /// The field, e.g. `"agent.position"`.
-        field: &'static str,
+        /// The field, e.g. [`ConfigField::AgentPosition`].
+        field: ConfigField,
     },
     /// A gimbal limit outside `(0, pi/2]` (eq. 6).
     GimbalLimit {
@@ -57,6 +162,8 @@ pub enum ConfigError {
     },
     /// The maximum thrust `sigma_Tf` (or a rotor constant it follows from) is not positive.
     NonPositiveThrust {
+        /// Which constant.
+        field: ConfigField,
         /// The rejected value.
         value: f64,
     },
@@ -86,14 +193,66 @@ pub enum ConfigError {
     },
     /// A gain, weight, period or tolerance that must be positive (or positive semi-definite) is not.
     Parameter {
-        /// The parameter, e.g. `"gains.k_x"`.
-        name: &'static str,
+        /// The parameter, e.g. [`ConfigField::GainKx`].
+        field: ConfigField,
     },
     /// A failure mask names an agent the team does not have.
     FailureIndex {
         /// The index.
         agent: usize,
     },
+    /// No allocator has this name (see [`crate::AnyAllocator::NAMES`]).
+    UnknownAllocator,
+    /// The named allocator needs a cargo feature this build does not have.
+    AllocatorUnavailable {
+        /// The allocator, which is also the feature (`"clarabel"`).
+        name: &'static str,
+    },
+    /// An option given to [`crate::AnyAllocator::from_name`] that the named allocator does not
+    /// take.
+    UnusedOption {
+        /// The option.
+        field: ConfigField,
+    },
+}
+
+impl ConfigError {
+    /// The setting the error names, when it names one (`None` for errors about the team as a
+    /// whole, e.g. [`ConfigError::RankDeficient`]).
+    pub fn field(&self) -> Option<ConfigField> {
+        match *self {
+            Self::NonFinite { field }
+            | Self::NonPositiveThrust { field, .. }
+            | Self::Parameter { field }
+            | Self::UnusedOption { field } => Some(field),
+            Self::GimbalLimit {
+                axis: GimbalAxis::X,
+                ..
+            } => Some(ConfigField::SigmaX),
+            Self::GimbalLimit {
+                axis: GimbalAxis::Y,
+                ..
+            } => Some(ConfigField::SigmaY),
+            Self::NonPositiveMass {
+                of: MassOf::Agent(_),
+                ..
+            } => Some(ConfigField::AgentMass),
+            Self::NonPositiveMass {
+                of: MassOf::Navigator,
+                ..
+            } => Some(ConfigField::NavigatorMass),
+            Self::IdleThrust { .. } => Some(ConfigField::MinThrust),
+            Self::NavigatorInertia => Some(ConfigField::NavigatorInertia),
+            Self::Relaxation { .. } => Some(ConfigField::Relaxation),
+            Self::NoAgents
+            | Self::TooManyAgents { .. }
+            | Self::RankDeficient { .. }
+            | Self::AgentCount { .. }
+            | Self::FailureIndex { .. }
+            | Self::UnknownAllocator
+            | Self::AllocatorUnavailable { .. } => None,
+        }
+    }
 }
 
 impl fmt::Display for ConfigError {
@@ -119,7 +278,7 @@ impl fmt::Display for ConfigError {
                     write!(f, "the navigator has mass {value} kg; it must be >= 0")
                 }
             },
-            Self::NonPositiveThrust { value } => {
+            Self::NonPositiveThrust { value, .. } => {
                 write!(f, "maximum thrust (or rotor constant) {value} must be > 0")
             }
             Self::IdleThrust { value } => {
@@ -135,9 +294,19 @@ impl fmt::Display for ConfigError {
             ),
             Self::AgentCount { n, n_x } => write!(f, "n_x = {n_x} exceeds n = {n} (or n = 0)"),
             Self::Relaxation { value } => write!(f, "relaxation s = {value} is outside (0, 1]"),
-            Self::Parameter { name } => write!(f, "`{name}` must be positive and finite"),
+            Self::Parameter { field } => write!(f, "`{field}` must be positive and finite"),
             Self::FailureIndex { agent } => {
                 write!(f, "failure mask names agent {agent}, which the team does not have")
+            }
+            Self::UnknownAllocator => f.write_str(
+                "unknown allocator name (the known ones are tvmd_core::AnyAllocator::NAMES)",
+            ),
+            Self::AllocatorUnavailable { name } => write!(
+                f,
+                "allocator `{name}` needs the cargo feature `{name}`, which this build lacks"
+            ),
+            Self::UnusedOption { field } => {
+                write!(f, "the allocator takes no `{field}` option")
             }
         }
     }

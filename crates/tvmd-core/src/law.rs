@@ -3,11 +3,12 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use crate::error::{ConfigError, InputError};
+use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{lit, Real};
+use crate::rotation::vee;
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
-/// block-diagonal one keeps the force request independent of the planned attitude (SPEC order).
+/// block-diagonal one keeps the force request independent of the planned attitude (the order of `docs/method.md`).
 /// Gains are not scaled by mass or inertia (the paper does not; the authors' MATLAB does).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains<T: Real> {
@@ -41,17 +42,17 @@ impl<T: Real> Gains<T> {
         k_omega: Matrix3<T>,
         k_v: Matrix3<T>,
     ) -> Result<Self, ConfigError> {
-        for (k, name) in [
-            (&k_x, "gains.k_x"),
-            (&k_r, "gains.k_r"),
-            (&k_omega, "gains.k_omega"),
-            (&k_v, "gains.k_v"),
+        for (k, field) in [
+            (&k_x, ConfigField::GainKx),
+            (&k_r, ConfigField::GainKr),
+            (&k_omega, ConfigField::GainKomega),
+            (&k_v, ConfigField::GainKv),
         ] {
             let symmetric =
                 (k - k.transpose()).amax() <= k.amax() * T::default_epsilon() * lit(16.0);
             let positive = k.diagonal().iter().all(|d| *d > T::zero());
             if !k.iter().all(|x| x.is_finite()) || !symmetric || !positive {
-                return Err(ConfigError::Parameter { name });
+                return Err(ConfigError::Parameter { field });
             }
         }
         Ok(Self {
@@ -185,7 +186,7 @@ pub struct Plant<T: Real> {
 }
 
 /// `u_fr`, the force part of `u_r` (team frame), which does not depend on `R_d`:
-/// `u_fr = m R^T x_r_ddot - K_v e_v - R^T K_x e_x + m g R^T e_3` (SPEC, eq. 12 with
+/// `u_fr = m R^T x_r_ddot - K_v e_v - R^T K_x e_x + m g R^T e_3` (`docs/method.md`, eq. 12 with
 /// `g_C = [0; -m g R^T e_3]`), `e_v = v - R^T x_r_dot`.
 pub fn force_request<T: Real>(
     plant: &Plant<T>,
@@ -223,6 +224,23 @@ pub struct LawOutput<T: Real> {
 /// `u_tau_r = J xi_dot_dOmega - [J Omega]x Omega_d' - K_Omega e_Omega - K_R e_R`, with
 /// `Omega_d' = R^T R_d Omega_d`, `xi_dot_dOmega = -Omega x Omega_d' + R^T R_d Omega_d_dot`
 /// (taking `R_d_dot = R_d [Omega_d]x`), and `C(xi) = blockdiag([J Omega]x, -m [Omega]x)`.
+///
+/// ```
+/// use tvmd_core::nalgebra::{Matrix3, Vector3};
+/// use tvmd_core::law::{control_wrench, force_request, Plant};
+/// use tvmd_core::{Gains, Reference, RigidState};
+/// let plant = Plant::<f64> { mass: 2.8, inertia: Matrix3::identity() * 0.1, gravity: 9.81 };
+/// let gains = Gains::paper();
+/// let state = RigidState::at_rest(Vector3::new(0.2, 0.0, 1.5));
+/// let reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
+/// let u_fr = force_request(&plant, &gains, &state, &reference);
+/// // -K_x e_x plus the weight m g.
+/// assert!((u_fr - Vector3::new(-0.08, 0.0, 2.8 * 9.81)).norm() < 1e-12);
+/// let law = control_wrench(&plant, &gains, &state, &reference, &Matrix3::identity(), &u_fr,
+///     &Matrix3::identity());
+/// assert_eq!(law.u_d, law.u_r);
+/// assert!((law.v_x - 0.5 * 0.4 * 0.04).abs() < 1e-15 && law.v_r == 0.0);
+/// ```
 pub fn control_wrench<T: Real>(
     plant: &Plant<T>,
     gains: &Gains<T>,
@@ -258,9 +276,4 @@ pub fn control_wrench<T: Real>(
         v_r: psi + quad(&gains.k_omega, &e_omega),
         v_x: quad(&gains.k_x, &e_x) + quad(&gains.k_v, &e_v),
     }
-}
-
-/// `(A)^vee` of a skew-symmetric matrix.
-fn vee<T: Real>(a: &Matrix3<T>) -> Vector3<T> {
-    Vector3::new(a.m32, a.m13, a.m21)
 }

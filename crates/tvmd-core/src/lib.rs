@@ -5,7 +5,8 @@
 //!
 //! Pipeline of one control period, each stage a pure function of explicit inputs:
 //!
-//! 1. [`team`]: the configuration `Xi`, limits, presets and failures.
+//! 1. [`team`]: the configuration `Xi` and presets, over [`limits`] and [`failure`] masks
+//!    ([`rotation`] holds the shared rotations).
 //! 2. [`effectiveness`]: `M(Xi)`, the wrench the agents produce (eq. 4).
 //! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8).
 //! 4. [`projection`]: the force projection `K_f` (eqs. 12-13).
@@ -16,6 +17,12 @@
 //!    [`gimbal`] (eq. 1).
 //!
 //! [`Controller`] composes them into one `step` per control period.
+//!
+//! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
+//! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
+//! (e.g. [`projection`] and [`planner`] import [`afs`]; [`allocation`] imports [`admissible`]
+//! and [`effectiveness`]); no stage imports [`team`]; only [`team`] and [`controller`] compose
+//! stages. See `docs/architecture.md`.
 //!
 //! `no_std`, no allocator, generic over [`Real`] (`f32` or `f64`), fixed capacity `N` agents.
 #![no_std]
@@ -43,29 +50,34 @@ pub mod command;
 pub mod controller;
 pub mod effectiveness;
 pub mod error;
+pub mod failure;
 pub mod gimbal;
 pub mod law;
+pub mod limits;
 mod linalg;
 pub mod planner;
 pub mod projection;
 pub mod real;
+pub mod rotation;
 pub mod team;
 
-pub use admissible::{AdmissibleSet, RateLimits};
+pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 #[cfg(feature = "clarabel")]
 pub use allocation::ClarabelAllocator;
 pub use allocation::{
-    Allocation, AllocationRequest, Allocator, AnyAllocator, PseudoInverse,
+    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;
-pub use error::{ConfigError, InputError};
+pub use error::{ConfigError, ConfigField, InputError};
 pub use gimbal::GimbalCommand;
 pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 pub use projection::{project_force, project_force_in, ForceProjection};
 pub use real::Real;
-pub use team::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};
+pub use failure::FailureMask;
+pub use limits::{AgentLimits, RateLimits};
+pub use team::{AgentSpec, Arrangement, Navigator, TeamConfig};

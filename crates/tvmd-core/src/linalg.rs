@@ -4,12 +4,13 @@
 // Triangular solves read clearest with index loops over the fixed 6x6 arrays.
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
-use nalgebra::{Matrix6, Vector6};
+use nalgebra::{Matrix6, Matrix6x3, Vector6};
 
 use crate::real::{eps, lit, Real};
 
 /// `A = L D L^T` of a symmetric 6x6 matrix, without pivoting. `None` unless every pivot is
 /// above `tol` (so `A` is numerically positive definite).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Ldlt<T: Real> {
     l: [[T; 6]; 6],
     d: [T; 6],
@@ -70,6 +71,21 @@ impl<T: Real> Ldlt<T> {
     }
 }
 
+/// `initial + sum_i B_i B_i^T / w_i`, the (weighted) Gram matrix `M W^-1 M^T` of the blocks
+/// `B_i` (6x3) with weights `w_i` (`w_i = 1`: `M M^T`). The one Gram matrix of the crate:
+/// [`crate::Effectiveness::weighted_gram`], the pseudo-inverses and Clarabel's least squares
+/// (`initial = lambda I`) all build theirs here, in this order of additions.
+pub(crate) fn weighted_gram<'a, T: Real>(
+    initial: Matrix6<T>,
+    blocks: impl IntoIterator<Item = (&'a Matrix6x3<T>, T)>,
+) -> Matrix6<T> {
+    let mut gram = initial;
+    for (b, w) in blocks {
+        gram += b * b.transpose() / w;
+    }
+    gram
+}
+
 /// Largest diagonal entry (the scale of a Gram matrix).
 pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
     a.diagonal().iter().fold(T::zero(), |m, x| m.max(*x))
@@ -80,17 +96,42 @@ pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
 /// (damped least squares: a rank-deficient free set in the redistribution still gets the
 /// nearest wrench it can make). Zero when `A = 0` or the input is not finite.
 pub(crate) fn solve_gram<T: Real>(a: &Matrix6<T>, r: &Vector6<T>) -> Vector6<T> {
-    let scale = max_diagonal(a);
-    if scale <= T::zero() || !scale.is_finite() {
-        return Vector6::zeros();
+    GramSolver::new(a).solve(r)
+}
+
+/// The factorization [`solve_gram`] uses, kept so a Gram matrix that changes only with the
+/// team or its failures is factored once ([`crate::Allocator::configure`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum GramSolver<T: Real> {
+    /// `A = L D L^T`, definite.
+    Exact(Ldlt<T>),
+    /// `A + delta I = L D L^T` (Tikhonov damping).
+    Damped(Ldlt<T>),
+    /// `A = 0`, not finite, or not factorable: every solve gives zero.
+    Zero,
+}
+
+impl<T: Real> GramSolver<T> {
+    pub(crate) fn new(a: &Matrix6<T>) -> Self {
+        let scale = max_diagonal(a);
+        if scale <= T::zero() || !scale.is_finite() {
+            return Self::Zero;
+        }
+        let tol = scale * eps::<T>() * lit(1e3);
+        if let Some(f) = Ldlt::new(a, tol) {
+            return Self::Exact(f);
+        }
+        let damped = a + Matrix6::identity() * (scale * eps::<T>().sqrt());
+        match Ldlt::new(&damped, T::zero()) {
+            Some(f) => Self::Damped(f),
+            None => Self::Zero,
+        }
     }
-    let tol = scale * eps::<T>() * lit(1e3);
-    if let Some(f) = Ldlt::new(a, tol) {
-        return f.solve(r);
-    }
-    let damped = a + Matrix6::identity() * (scale * eps::<T>().sqrt());
-    match Ldlt::new(&damped, T::zero()) {
-        Some(f) => f.solve(r),
-        None => Vector6::zeros(),
+
+    pub(crate) fn solve(&self, r: &Vector6<T>) -> Vector6<T> {
+        match self {
+            Self::Exact(f) | Self::Damped(f) => f.solve(r),
+            Self::Zero => Vector6::zeros(),
+        }
     }
 }

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::error::{ConfigError, InputError};
+use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{eps, lit, Real};
 
 /// How the planner reached its output.
@@ -21,6 +21,33 @@ pub enum PlannerStatus {
     Unreachable,
 }
 
+impl PlannerStatus {
+    /// Every status, in declaration order.
+    pub const ALL: [Self; 4] = [
+        Self::AlreadyFeasible,
+        Self::Planned,
+        Self::ZeroForce,
+        Self::Unreachable,
+    ];
+
+    /// The one spelling used in logs and bindings: `"already-feasible"`, `"planned"`,
+    /// `"zero-force"`, `"unreachable"` (kebab case, as the allocator names).
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::AlreadyFeasible => "already-feasible",
+            Self::Planned => "planned",
+            Self::ZeroForce => "zero-force",
+            Self::Unreachable => "unreachable",
+        }
+    }
+}
+
+impl core::fmt::Display for PlannerStatus {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// Output of [`AttitudePlanner::plan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlannerOutput<T: Real> {
@@ -34,9 +61,24 @@ pub struct PlannerOutput<T: Real> {
     pub status: PlannerStatus,
 }
 
-/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in SPEC:
+/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in `docs/method.md`:
 /// it returns the last *feasible* bisection point, stops on a tolerance or an iteration cap, and
 /// tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector3;
+/// use tvmd_core::rotation::{roll, roll_angle};
+/// use tvmd_core::{team::presets, AttitudePlanner, FailureMask, PlannerStatus, Relaxation};
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let afs = team.afs(&FailureMask::none())?;
+/// let planner = AttitudePlanner::new(Relaxation::new(0.5)?);
+/// // Hover thrust with a reference roll of pi/3, beyond what the team can hold.
+/// let f_r = Vector3::new(0.0, 0.0, team.mass() * 9.81);
+/// let out = planner.plan(&afs, &roll(std::f64::consts::FRAC_PI_3), &f_r).unwrap();
+/// assert_eq!(out.status, PlannerStatus::Planned);
+/// assert!((roll_angle(&out.r_d) - 0.328708).abs() < 1e-5);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttitudePlanner<T: Real> {
     relaxation: Relaxation<T>,
@@ -62,12 +104,12 @@ impl<T: Real> AttitudePlanner<T> {
     ) -> Result<Self, ConfigError> {
         if !tolerance.is_finite() || tolerance <= T::zero() {
             return Err(ConfigError::Parameter {
-                name: "planner.tolerance",
+                field: ConfigField::PlannerTolerance,
             });
         }
         if max_iterations == 0 {
             return Err(ConfigError::Parameter {
-                name: "planner.max_iterations",
+                field: ConfigField::PlannerMaxIterations,
             });
         }
         self.tolerance = tolerance;

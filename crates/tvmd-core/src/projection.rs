@@ -29,6 +29,19 @@ impl<T: Real> ForceProjection<T> {
 /// part onto the ellipse at the resulting height (eqs. 12-13, `s = 1`).
 ///
 /// A non-finite `u_fr` projects to zero with both factors 0, so the output is never NaN.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector3;
+/// use tvmd_core::{project_force, team::presets, FailureMask};
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let afs = team.afs(&FailureMask::none())?;
+/// // Inside: unchanged. Beyond the thrust ball: scaled by t_Tf.
+/// let hover = project_force(&afs, &Vector3::new(0.0, 0.0, 27.5));
+/// assert_eq!((hover.t_tf, hover.t_eta), (1.0, 1.0));
+/// let big = project_force(&afs, &Vector3::new(0.0, 0.0, 100.0));
+/// assert!((big.force.z - afs.max_force()).abs() < 1e-12);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 pub fn project_force<T: Real>(
     afs: &AttainableForceSpace<T>,
     u_fr: &Vector3<T>,

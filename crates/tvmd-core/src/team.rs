@@ -5,7 +5,11 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::AttainableForceSpace;
 use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, GimbalAxis, MassOf};
+use crate::error::{ConfigError, ConfigField, MassOf};
+/// The failure mask, at its old path (now in [`crate::failure`]).
+pub use crate::failure::FailureMask;
+/// The agent limits, at their old path (now in [`crate::limits`]).
+pub use crate::limits::AgentLimits;
 use crate::real::{eps, lit, Real};
 
 /// One agent of the team: its frame in the team CoM frame `{C}`.
@@ -44,138 +48,6 @@ impl<T: Real> AgentSpec<T> {
     }
 }
 
-/// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
-/// `T = rho d^4 c_l omega^2` (eq. 5).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AgentLimits<T: Real> {
-    /// `sigma_x`: limit of `|eta_x|` (rad), in `(0, pi/2]`.
-    pub sigma_x: T,
-    /// `sigma_y`: limit of `|eta_y|` (rad), in `(0, pi/2]`.
-    pub sigma_y: T,
-    /// `sigma_Tf`: maximum thrust of one agent (N).
-    pub max_thrust: T,
-    /// Idle thrust (N), the smallest thrust the allocator commands; `0` by default.
-    pub min_thrust: T,
-    /// `rho d^4 c_l`: thrust per squared rotor speed (N s^2 / rad^2).
-    pub thrust_coefficient: T,
-}
-
-impl<T: Real> AgentLimits<T> {
-    /// Limits from the gimbal limits and the maximum thrust. Rotor speeds are then normalized:
-    /// `omega = 1` at maximum thrust.
-    pub fn new(sigma_x: T, sigma_y: T, max_thrust: T) -> Result<Self, ConfigError> {
-        let limits = Self {
-            sigma_x,
-            sigma_y,
-            max_thrust,
-            min_thrust: T::zero(),
-            thrust_coefficient: max_thrust,
-        };
-        limits.validate()?;
-        Ok(limits)
-    }
-
-    /// Limits from the rotor constants of eq. (5): air density `rho`, rotor diameter `d`,
-    /// lift coefficient `c_l` and maximum rotor speed `sigma_omega`; `sigma_Tf = T(sigma_omega)`.
-    pub fn from_rotor(
-        sigma_x: T,
-        sigma_y: T,
-        rho: T,
-        d: T,
-        c_l: T,
-        sigma_omega: T,
-    ) -> Result<Self, ConfigError> {
-        for (value, field) in [
-            (rho, "limits.rho"),
-            (d, "limits.d"),
-            (c_l, "limits.c_l"),
-            (sigma_omega, "limits.sigma_omega"),
-        ] {
-            if !value.is_finite() {
-                return Err(ConfigError::NonFinite { field });
-            }
-            if value <= T::zero() {
-                return Err(ConfigError::NonPositiveThrust {
-                    value: crate::real::to_f64(value),
-                });
-            }
-        }
-        let k = rho * d * d * d * d * c_l;
-        let limits = Self {
-            sigma_x,
-            sigma_y,
-            max_thrust: k * sigma_omega * sigma_omega,
-            min_thrust: T::zero(),
-            thrust_coefficient: k,
-        };
-        limits.validate()?;
-        Ok(limits)
-    }
-
-    /// The same limits with an idle thrust `min_thrust` in `[0, sigma_Tf)`.
-    pub fn with_min_thrust(mut self, min_thrust: T) -> Result<Self, ConfigError> {
-        self.min_thrust = min_thrust;
-        self.validate()?;
-        Ok(self)
-    }
-
-    /// Checks every field; [`TeamConfig::new`] calls it.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let half_pi = T::frac_pi_2();
-        for (value, axis, field) in [
-            (self.sigma_x, GimbalAxis::X, "limits.sigma_x"),
-            (self.sigma_y, GimbalAxis::Y, "limits.sigma_y"),
-        ] {
-            if !value.is_finite() {
-                return Err(ConfigError::NonFinite { field });
-            }
-            if value <= T::zero() || value > half_pi {
-                return Err(ConfigError::GimbalLimit {
-                    axis,
-                    value: crate::real::to_f64(value),
-                });
-            }
-        }
-        for (value, field) in [
-            (self.max_thrust, "limits.max_thrust"),
-            (self.thrust_coefficient, "limits.thrust_coefficient"),
-            (self.min_thrust, "limits.min_thrust"),
-        ] {
-            if !value.is_finite() {
-                return Err(ConfigError::NonFinite { field });
-            }
-        }
-        for value in [self.max_thrust, self.thrust_coefficient] {
-            if value <= T::zero() {
-                return Err(ConfigError::NonPositiveThrust {
-                    value: crate::real::to_f64(value),
-                });
-            }
-        }
-        if self.min_thrust < T::zero() || self.min_thrust >= self.max_thrust {
-            return Err(ConfigError::IdleThrust {
-                value: crate::real::to_f64(self.min_thrust),
-            });
-        }
-        Ok(())
-    }
-
-    /// Rotor speed for a thrust (eq. 5 inverted); negative thrust maps to 0.
-    pub fn speed_for_thrust(&self, thrust: T) -> T {
-        (thrust.max(T::zero()) / self.thrust_coefficient).sqrt()
-    }
-
-    /// Thrust for a rotor speed (eq. 5).
-    pub fn thrust_for_speed(&self, omega: T) -> T {
-        self.thrust_coefficient * omega * omega
-    }
-
-    /// `sigma_omega`, the rotor speed at maximum thrust.
-    pub fn max_speed(&self) -> T {
-        self.speed_for_thrust(self.max_thrust)
-    }
-}
-
 /// The navigator module at the team CoM (the paper's "1 navigator").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Navigator<T: Real> {
@@ -204,59 +76,24 @@ pub enum Arrangement {
     Inc,
 }
 
-/// Which agents have failed. A failed agent leaves `n`, `n_x` / `n_y` and `M` (paper's degraded
-/// team); it is commanded to zero thrust.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FailureMask<const N: usize> {
-    failed: [bool; N],
-}
-
-impl<const N: usize> Default for FailureMask<N> {
-    fn default() -> Self {
-        Self::none()
-    }
-}
-
-impl<const N: usize> FailureMask<N> {
-    /// No agent failed.
-    pub const fn none() -> Self {
-        Self { failed: [false; N] }
-    }
-
-    /// Marks agent `i` failed (or working again with `failed = false`).
-    pub fn set(&mut self, agent: usize, failed: bool) -> Result<(), ConfigError> {
-        let slot = self
-            .failed
-            .get_mut(agent)
-            .ok_or(ConfigError::FailureIndex { agent })?;
-        *slot = failed;
-        Ok(())
-    }
-
-    /// A mask with the given agents failed.
-    pub fn with_failed(agents: &[usize]) -> Result<Self, ConfigError> {
-        let mut mask = Self::none();
-        for &i in agents {
-            mask.set(i, true)?;
-        }
-        Ok(mask)
-    }
-
-    /// Whether agent `i` is marked failed (`false` beyond the capacity).
-    pub fn is_failed(&self, agent: usize) -> bool {
-        self.failed.get(agent).copied().unwrap_or(false)
-    }
-
-    /// The flags, one per slot of the capacity.
-    pub fn as_array(&self) -> &[bool; N] {
-        &self.failed
-    }
-}
-
 /// The team configuration `Xi = {(p_i, psi_i)}` with limits, masses and navigator, validated.
 ///
 /// Fixed-capacity storage: up to `N` agents, no allocation. Mass `m_C = m_0 + sum m_i` and
 /// inertia `J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)` are derived once.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector3;
+/// use tvmd_core::{AgentLimits, AgentSpec, ConfigError, Navigator, TeamConfig};
+/// let limits = AgentLimits::new(0.5, 0.7, 14.0)?;
+/// let agents = [(1.0, 0.0, 0), (0.0, 1.0, 1), (-1.0, 0.0, 0), (0.0, -1.0, 1)]
+///     .map(|(x, y, m)| AgentSpec::new(Vector3::new(x, y, 0.0), m, 0.7));
+/// let team = TeamConfig::<f64, 8>::new(&agents, limits, Navigator::default())?;
+/// assert_eq!(team.len(), 4);
+/// // Two agents on a line cannot produce every wrench.
+/// let e = TeamConfig::<f64, 8>::new(&agents[..2], limits, Navigator::default()).unwrap_err();
+/// assert!(matches!(e, ConfigError::RankDeficient { .. }));
+/// # Ok::<(), ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TeamConfig<T: Real, const N: usize> {
     agents: [AgentSpec<T>; N],
@@ -296,17 +133,17 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         for (i, (slot, agent)) in storage.iter_mut().zip(agents).enumerate() {
             if !agent.position.iter().all(|x| x.is_finite()) {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.position",
+                    field: ConfigField::AgentPosition,
                 });
             }
             if !agent.mass.is_finite() {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.mass",
+                    field: ConfigField::AgentMass,
                 });
             }
             if !agent.inertia.iter().all(|x| x.is_finite()) {
                 return Err(ConfigError::NonFinite {
-                    field: "agent.inertia",
+                    field: ConfigField::AgentInertia,
                 });
             }
             if agent.mass <= T::zero() {
@@ -403,7 +240,10 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
 
     /// The effectiveness model `M(Xi)` of the working agents (eq. 4).
     pub fn effectiveness(&self, failures: &FailureMask<N>) -> Effectiveness<T, N> {
-        Effectiveness::new(self, failures)
+        Effectiveness::new(
+            self.working(failures)
+                .map(|(i, a)| (i, &a.position, a.quarter_turns)),
+        )
     }
 
     /// The attainable-force-space approximation of the working agents (eqs. 7-8).
@@ -413,9 +253,9 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         AttainableForceSpace::new(
             n,
             self.n_x(failures),
-            self.limits.sigma_x,
-            self.limits.sigma_y,
-            self.limits.max_thrust,
+            self.limits.sigma_x(),
+            self.limits.sigma_y(),
+            self.limits.max_thrust(),
         )
     }
 
@@ -434,12 +274,12 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
 fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigError> {
     if !navigator.mass.is_finite() {
         return Err(ConfigError::NonFinite {
-            field: "navigator.mass",
+            field: ConfigField::NavigatorMass,
         });
     }
     if !navigator.inertia.iter().all(|x| x.is_finite()) {
         return Err(ConfigError::NonFinite {
-            field: "navigator.inertia",
+            field: ConfigField::NavigatorInertia,
         });
     }
     if navigator.mass < T::zero() {
@@ -492,13 +332,11 @@ pub mod presets {
 
     /// The paper's agent limits: `sigma_x = pi/6`, `sigma_y = pi/4`, `sigma_Tf = 2 m_i g`.
     pub fn paper_limits<T: Real>() -> AgentLimits<T> {
-        AgentLimits {
-            sigma_x: T::pi() / lit(6.0),
-            sigma_y: T::frac_pi_4(),
-            max_thrust: lit(2.0 * PAPER_AGENT_MASS * GRAVITY),
-            min_thrust: T::zero(),
-            thrust_coefficient: lit(2.0 * PAPER_AGENT_MASS * GRAVITY),
-        }
+        AgentLimits::trusted(
+            T::pi() / lit(6.0),
+            T::frac_pi_4(),
+            lit(2.0 * PAPER_AGENT_MASS * GRAVITY),
+        )
     }
 
     /// A square of four agents at `(+a,+a), (+a,-a), (-a,-a), (-a,+a)` with the given quarter turns.
@@ -517,6 +355,16 @@ pub mod presets {
 
     /// The paper's simulated team "A4 inc, 1 navigator": `psi = [pi/2, pi/2, 0, 0]`,
     /// `m_i = 0.7` kg, navigator mass 0, [`paper_limits`].
+    ///
+    /// ```
+    /// use tvmd_core::team::presets;
+    /// use tvmd_core::{Arrangement, FailureMask, TeamConfig};
+    /// let team: TeamConfig<f64, 4> = presets::a4_inc()?;
+    /// assert_eq!((team.len(), team.n_x(&FailureMask::none())), (4, 2));
+    /// assert_eq!(team.arrangement(), Arrangement::Inc);
+    /// assert!((team.mass() - 2.8).abs() < 1e-12);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
     pub fn a4_inc<T: Real, const N: usize>() -> Result<TeamConfig<T, N>, ConfigError> {
         square([1, 1, 0, 0], paper_limits())
     }

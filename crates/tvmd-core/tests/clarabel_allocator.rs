@@ -7,6 +7,7 @@ use nalgebra::{Vector3, Vector6};
 use proptest::prelude::*;
 use tvmd_core::admissible::RateLimits;
 use tvmd_core::allocation::{ClarabelAllocator, ClarabelStatus, FallbackReason};
+use tvmd_core::error::ConfigField;
 use tvmd_core::team::presets;
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, ConfigError, FailureMask,
@@ -34,7 +35,7 @@ fn sets_of(team: &Team) -> [AdmissibleSet<f64>; CAP] {
 
 /// The convex inner bound of the symmetric set, with tolerance `tol`.
 fn assert_in_pyramid(f: &Vector3<f64>, set: &AdmissibleSet<f64>, tol: f64) {
-    let (tx, ty) = (set.eta_x.hi.tan(), set.eta_y.hi.tan());
+    let (tx, ty) = (set.eta_x().hi.tan(), set.eta_y().hi.tan());
     assert!(f.z >= -tol, "f_z = {} < 0", f.z);
     assert!(
         f.x.abs() <= f.z * ty + tol,
@@ -44,7 +45,7 @@ fn assert_in_pyramid(f: &Vector3<f64>, set: &AdmissibleSet<f64>, tol: f64) {
         f.y.abs() <= f.z * tx + tol,
         "|f_y| > f_z tan(sigma_x): {f:?}"
     );
-    assert!(f.norm() <= set.thrust.hi + tol, "||f|| > max: {f:?}");
+    assert!(f.norm() <= set.thrust().hi + tol, "||f|| > max: {f:?}");
     let cmd = GimbalCommand::from_force(f);
     assert!(
         set.contains(&cmd, 1e-9),
@@ -64,11 +65,11 @@ fn weighted_error(a: &Allocation<f64, CAP>, u: &Vector6<f64>, w: &[f64; 6]) -> f
 
 /// Whether the force lies in the allocator's inner bound (so the QP could have chosen it).
 fn in_pyramid(f: &Vector3<f64>, set: &AdmissibleSet<f64>, tol: f64) -> bool {
-    let (tx, ty) = (set.eta_x.hi.tan(), set.eta_y.hi.tan());
+    let (tx, ty) = (set.eta_x().hi.tan(), set.eta_y().hi.tan());
     f.z >= -tol
         && f.x.abs() <= f.z * ty + tol
         && f.y.abs() <= f.z * tx + tol
-        && f.norm() <= set.thrust.hi + tol
+        && f.norm() <= set.thrust().hi + tol
 }
 
 #[test]
@@ -78,7 +79,7 @@ fn configuration_is_validated() {
         assert_eq!(
             ClarabelAllocator::<f64, 4>::new(bad, None).unwrap_err(),
             ConfigError::Parameter {
-                name: "clarabel.lambda"
+                field: ConfigField::ClarabelLambda
             }
         );
     }
@@ -87,7 +88,7 @@ fn configuration_is_validated() {
     assert_eq!(
         e,
         ConfigError::Parameter {
-            name: "clarabel.weights"
+            field: ConfigField::ClarabelWeights
         }
     );
     let e = ClarabelAllocator::<f64, 4>::default()
@@ -96,7 +97,7 @@ fn configuration_is_validated() {
     assert_eq!(
         e,
         ConfigError::Parameter {
-            name: "clarabel.tolerance"
+            field: ConfigField::ClarabelTolerance
         }
     );
     let a = ClarabelAllocator::<f64, 4>::new(2e-3, Some([2.0; 6])).unwrap();

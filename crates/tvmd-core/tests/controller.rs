@@ -365,12 +365,12 @@ fn cycle_ranges_over_random_inputs() {
         max_e_f_rel = max_e_f_rel.max(out.allocation.e_f / weight);
         saturated_cycles += usize::from(out.allocation.saturated_count() > 0);
         for cmd in &out.commands[..n] {
-            assert!(cmd.eta_x.abs() <= limits.sigma_x && cmd.eta_y.abs() <= limits.sigma_y);
-            assert!(cmd.thrust >= 0.0 && cmd.thrust <= limits.max_thrust);
-            max_eta_x = max_eta_x.max(cmd.eta_x.abs() / limits.sigma_x);
-            max_eta_y = max_eta_y.max(cmd.eta_y.abs() / limits.sigma_y);
+            assert!(cmd.eta_x.abs() <= limits.sigma_x() && cmd.eta_y.abs() <= limits.sigma_y());
+            assert!(cmd.thrust >= 0.0 && cmd.thrust <= limits.max_thrust());
+            max_eta_x = max_eta_x.max(cmd.eta_x.abs() / limits.sigma_x());
+            max_eta_y = max_eta_y.max(cmd.eta_y.abs() / limits.sigma_y());
             min_t = min_t.min(cmd.thrust);
-            max_t_rel = max_t_rel.max(cmd.thrust / limits.max_thrust);
+            max_t_rel = max_t_rel.max(cmd.thrust / limits.max_thrust());
         }
     }
     println!(

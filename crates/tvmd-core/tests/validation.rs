@@ -1,11 +1,12 @@
 //! Every configuration error is reachable, typed and explained.
 
 use nalgebra::{Matrix3, Vector3};
-use tvmd_core::error::{GimbalAxis, MassOf};
+use tvmd_core::allocation::AllocatorOptions;
+use tvmd_core::error::{ConfigField, GimbalAxis, MassOf};
 use tvmd_core::team::presets;
 use tvmd_core::{
-    AgentLimits, AgentSpec, AttainableForceSpace, AttitudePlanner, ConfigError, FailureMask,
-    Navigator, Relaxation, TeamConfig,
+    AgentLimits, AgentSpec, AnyAllocator, AttainableForceSpace, AttitudePlanner, ConfigError,
+    FailureMask, Gains, Navigator, PlannerStatus, Relaxation, TeamConfig,
 };
 
 fn square_agents() -> Vec<AgentSpec<f64>> {
@@ -82,7 +83,7 @@ fn non_finite_numbers() {
     assert_eq!(
         build(&agents),
         Err(ConfigError::NonFinite {
-            field: "agent.position"
+            field: ConfigField::AgentPosition
         })
     );
     let mut agents = square_agents();
@@ -90,7 +91,7 @@ fn non_finite_numbers() {
     assert_eq!(
         build(&agents),
         Err(ConfigError::NonFinite {
-            field: "agent.mass"
+            field: ConfigField::AgentMass
         })
     );
     let mut agents = square_agents();
@@ -98,14 +99,14 @@ fn non_finite_numbers() {
     assert_eq!(
         build(&agents),
         Err(ConfigError::NonFinite {
-            field: "agent.inertia"
+            field: ConfigField::AgentInertia
         })
     );
     let e = AgentLimits::new(f64::NAN, 0.5, 10.0).unwrap_err();
     assert_eq!(
         e,
         ConfigError::NonFinite {
-            field: "limits.sigma_x"
+            field: ConfigField::SigmaX
         }
     );
     assert_message(e, "limits.sigma_x");
@@ -113,7 +114,7 @@ fn non_finite_numbers() {
     assert_eq!(
         e,
         ConfigError::NonFinite {
-            field: "limits.max_thrust"
+            field: ConfigField::MaxThrust
         }
     );
     let nav = Navigator {
@@ -123,13 +124,13 @@ fn non_finite_numbers() {
     assert_eq!(
         TeamConfig::<f64, 8>::new(&square_agents(), limits(), nav),
         Err(ConfigError::NonFinite {
-            field: "navigator.mass"
+            field: ConfigField::NavigatorMass
         })
     );
     assert_eq!(
         Relaxation::new(f64::NAN),
         Err(ConfigError::NonFinite {
-            field: "relaxation"
+            field: ConfigField::Relaxation
         })
     );
 }
@@ -180,11 +181,17 @@ fn non_positive_masses() {
 fn non_positive_thrust() {
     assert_eq!(
         AgentLimits::new(0.5, 0.5, 0.0),
-        Err(ConfigError::NonPositiveThrust { value: 0.0 })
+        Err(ConfigError::NonPositiveThrust {
+            field: ConfigField::MaxThrust,
+            value: 0.0
+        })
     );
     assert_eq!(
         AgentLimits::from_rotor(0.5, 0.5, 1.2, -0.2, 0.1, 1000.0),
-        Err(ConfigError::NonPositiveThrust { value: -0.2 })
+        Err(ConfigError::NonPositiveThrust {
+            field: ConfigField::RotorDiameter,
+            value: -0.2
+        })
     );
     let e = limits().with_min_thrust(100.0).unwrap_err();
     assert_eq!(e, ConfigError::IdleThrust { value: 100.0 });
@@ -195,7 +202,7 @@ fn non_positive_thrust() {
 fn rotor_model_round_trip() {
     let l = AgentLimits::from_rotor(0.5, 0.7, 1.225, 0.2, 0.1, 900.0).unwrap();
     let k = 1.225 * 0.2f64.powi(4) * 0.1;
-    assert!((l.max_thrust - k * 900.0 * 900.0).abs() < 1e-9);
+    assert!((l.max_thrust() - k * 900.0 * 900.0).abs() < 1e-9);
     assert!((l.max_speed() - 900.0).abs() < 1e-9);
     assert!((l.thrust_for_speed(l.speed_for_thrust(3.0)) - 3.0).abs() < 1e-12);
     // Without rotor constants, speed is normalized to 1 at maximum thrust.
@@ -267,13 +274,13 @@ fn afs_and_planner_parameters() {
     assert_eq!(
         planner.with_tolerance(0.0, 10),
         Err(ConfigError::Parameter {
-            name: "planner.tolerance"
+            field: ConfigField::PlannerTolerance
         })
     );
     assert_eq!(
         planner.with_tolerance(1e-6, 0),
         Err(ConfigError::Parameter {
-            name: "planner.max_iterations"
+            field: ConfigField::PlannerMaxIterations
         })
     );
 }
@@ -288,5 +295,103 @@ fn failure_mask_indices() {
     assert_eq!(
         team.validate_failures(&FailureMask::with_failed(&[6]).unwrap()),
         Err(ConfigError::FailureIndex { agent: 6 })
+    );
+}
+
+#[test]
+fn errors_name_their_field() {
+    let e = AgentLimits::new(0.5, 2.0, 10.0).unwrap_err();
+    assert_eq!(e.field(), Some(ConfigField::SigmaY));
+    let e = AgentLimits::from_rotor(0.5, 0.5, 1.2, 0.2, -0.1, 1000.0).unwrap_err();
+    assert_eq!(e.field(), Some(ConfigField::LiftCoefficient));
+    assert_eq!(ConfigField::LiftCoefficient.as_str(), "limits.c_l");
+    assert_eq!(ConfigError::NoAgents.field(), None);
+    let e = Gains::diagonal([1.0; 3], [1.0, 0.0, 1.0], [1.0; 6]).unwrap_err();
+    assert_eq!(e.field(), Some(ConfigField::GainKr));
+    assert_message(e, "gains.k_r");
+}
+
+#[test]
+fn allocators_by_name() {
+    type Any = AnyAllocator<f64, 4>;
+    let options = AllocatorOptions::default();
+    for name in Any::NAMES {
+        assert_eq!(Any::from_name(name, &options).unwrap().name(), *name);
+    }
+    assert_eq!(Any::NAMES[0], Any::DEFAULT_NAME);
+    assert_eq!(Any::default().name(), Any::DEFAULT_NAME);
+    let e = Any::from_name("magic", &options).unwrap_err();
+    assert_eq!(e, ConfigError::UnknownAllocator);
+    assert_message(e, "unknown allocator");
+    let weighted = AllocatorOptions {
+        agent_weights: Some([1.0, 2.0, 3.0, 4.0]),
+        ..AllocatorOptions::default()
+    };
+    assert_eq!(
+        Any::from_name("pseudo-inverse", &weighted).unwrap_err(),
+        ConfigError::UnusedOption {
+            field: ConfigField::AllocatorWeights
+        }
+    );
+    match Any::from_name("weighted-pseudo-inverse", &weighted).unwrap() {
+        AnyAllocator::WeightedPseudoInverse(w) => assert_eq!(w.weights(), &[1.0, 2.0, 3.0, 4.0]),
+        other => panic!("{other:?}"),
+    }
+    let clarabel = Any::from_name("clarabel", &options);
+    if cfg!(feature = "clarabel") {
+        assert_eq!(clarabel.unwrap().name(), "clarabel");
+    } else {
+        assert_eq!(
+            clarabel.unwrap_err(),
+            ConfigError::AllocatorUnavailable { name: "clarabel" }
+        );
+        assert!(!Any::NAMES.contains(&"clarabel"));
+    }
+}
+
+#[test]
+fn planner_status_spelling() {
+    let names: Vec<&str> = PlannerStatus::ALL.iter().map(|s| s.as_str()).collect();
+    assert_eq!(
+        names,
+        ["already-feasible", "planned", "zero-force", "unreachable"]
+    );
+    assert_eq!(PlannerStatus::Planned.to_string(), "planned");
+}
+
+#[test]
+fn admissible_sets_are_validated() {
+    use tvmd_core::admissible::{AdmissibleSet, Interval};
+    let ok = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval { lo: -0.2, hi: 0.3 },
+        Interval { lo: 0.0, hi: 10.0 },
+    )
+    .unwrap();
+    assert_eq!(ok.eta_y(), Interval { lo: -0.2, hi: 0.3 });
+    let reversed = AdmissibleSet::new(
+        Interval { lo: 0.5, hi: -0.5 },
+        Interval::symmetric(0.5),
+        Interval { lo: 0.0, hi: 10.0 },
+    );
+    assert_eq!(
+        reversed,
+        Err(ConfigError::Parameter {
+            field: ConfigField::SigmaX
+        })
+    );
+    let nan = AdmissibleSet::new(
+        Interval::symmetric(0.5),
+        Interval::symmetric(0.5),
+        Interval {
+            lo: 0.0,
+            hi: f64::NAN,
+        },
+    );
+    assert_eq!(
+        nan,
+        Err(ConfigError::NonFinite {
+            field: ConfigField::MaxThrust
+        })
     );
 }

@@ -7,9 +7,13 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use tvmd_core::admissible::admissible_sets;
+use tvmd_core::allocation::{
+    AllocatorOptions as CoreAllocatorOptions, CLARABEL, WEIGHTED_PSEUDO_INVERSE,
+};
 use tvmd_core::{
-    AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator, GimbalCommand,
-    PseudoInverse, RateLimits, RedistributedPseudoInverse, WeightedPseudoInverse,
+    AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator, ConfigError,
+    ConfigField, GimbalCommand, RateLimits,
 };
 
 use crate::convert::{
@@ -20,25 +24,11 @@ use crate::errors::OrRaise;
 use crate::team::{failure_mask, PyTeam};
 use crate::CAPACITY;
 
-/// Names of the allocators this build provides.
-#[cfg(feature = "clarabel")]
-pub(crate) const ALLOCATORS: &[&str] = &[
-    "pseudo-inverse",
-    "weighted-pseudo-inverse",
-    "redistributed-pseudo-inverse",
-    "clarabel",
-];
-
-/// Names of the allocators this build provides.
-#[cfg(not(feature = "clarabel"))]
-pub(crate) const ALLOCATORS: &[&str] = &[
-    "pseudo-inverse",
-    "weighted-pseudo-inverse",
-    "redistributed-pseudo-inverse",
-];
+/// Names of the allocators this build provides (the core's one table).
+pub(crate) const ALLOCATORS: &[&str] = AnyAllocator::<f64, CAPACITY>::NAMES;
 
 /// The default allocator (also the controller's).
-pub(crate) const DEFAULT_ALLOCATOR: &str = "redistributed-pseudo-inverse";
+pub(crate) const DEFAULT_ALLOCATOR: &str = AnyAllocator::<f64, CAPACITY>::DEFAULT_NAME;
 
 /// Options of the allocators that take any.
 pub(crate) struct AllocatorOptions<'a, 'py> {
@@ -49,44 +39,26 @@ pub(crate) struct AllocatorOptions<'a, 'py> {
     pub(crate) regularization: Option<f64>,
 }
 
-/// Builds the allocator named `method` for a team of `n` agents.
+/// Builds the allocator named `method` for a team of `n` agents
+/// ([`AnyAllocator::from_name`]); returns it with its name.
 pub(crate) fn make_allocator(
     method: &str,
     options: &AllocatorOptions<'_, '_>,
     n: usize,
 ) -> PyResult<(AnyAllocator<f64, CAPACITY>, &'static str)> {
     let weights = options.weights.filter(|w| !w.is_none());
-    let refuse = |what: &str| -> PyResult<()> {
-        Err(PyValueError::new_err(format!(
-            "allocator '{method}' takes no `{what}`"
-        )))
+    let mut core_options = CoreAllocatorOptions::<f64, CAPACITY> {
+        regularization: options.regularization,
+        ..Default::default()
     };
-    match method {
-        "pseudo-inverse" | "redistributed-pseudo-inverse" => {
-            if weights.is_some() {
-                refuse("weights")?;
-            }
-            if options.regularization.is_some() {
-                refuse("regularization")?;
-            }
-            Ok(if method == "pseudo-inverse" {
-                (AnyAllocator::PseudoInverse(PseudoInverse), "pseudo-inverse")
-            } else {
-                (
-                    AnyAllocator::RedistributedPseudoInverse(RedistributedPseudoInverse),
-                    "redistributed-pseudo-inverse",
-                )
-            })
+    // `weights` means per-agent weights or wrench weights depending on the allocator.
+    match (method, weights) {
+        (WEIGHTED_PSEUDO_INVERSE, None) => {
+            return Err(PyValueError::new_err(format!(
+                "allocator '{WEIGHTED_PSEUDO_INVERSE}' needs `weights`, shape ({n},)"
+            )))
         }
-        "weighted-pseudo-inverse" => {
-            if options.regularization.is_some() {
-                refuse("regularization")?;
-            }
-            let weights = weights.ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "allocator 'weighted-pseudo-inverse' needs `weights`, shape ({n},)"
-                ))
-            })?;
+        (WEIGHTED_PSEUDO_INVERSE, Some(weights)) => {
             let view = float_array(weights, "weights")?;
             let array = view.as_array();
             if array.shape() != [n] {
@@ -96,45 +68,36 @@ pub(crate) fn make_allocator(
             for (slot, w) in padded.iter_mut().zip(array.iter()) {
                 *slot = *w;
             }
-            let allocator = WeightedPseudoInverse::new(padded).or_raise()?;
-            Ok((
-                AnyAllocator::WeightedPseudoInverse(allocator),
-                "weighted-pseudo-inverse",
-            ))
+            core_options.agent_weights = Some(padded);
         }
-        "clarabel" => clarabel(weights, options.regularization),
-        other => Err(PyValueError::new_err(format!(
-            "unknown allocator '{other}'; expected one of: {}",
-            ALLOCATORS.join(", ")
-        ))),
+        (CLARABEL, Some(weights)) if cfg!(feature = "clarabel") => {
+            core_options.wrench_weights = Some(vector6(weights, "weights")?);
+        }
+        // Any other allocator refuses them (the core says so).
+        (_, Some(_)) => core_options.agent_weights = Some([1.0; CAPACITY]),
+        (_, None) => {}
     }
-}
-
-#[cfg(feature = "clarabel")]
-fn clarabel(
-    weights: Option<&Bound<'_, PyAny>>,
-    regularization: Option<f64>,
-) -> PyResult<(AnyAllocator<f64, CAPACITY>, &'static str)> {
-    use tvmd_core::allocation::ClarabelAllocator;
-    let default = ClarabelAllocator::<f64, CAPACITY>::default();
-    let weights = match weights {
-        Some(w) => Some(vector6(w, "weights")?),
-        None => None,
-    };
-    let allocator =
-        ClarabelAllocator::new(regularization.unwrap_or(default.lambda()), weights).or_raise()?;
-    Ok((AnyAllocator::Clarabel(allocator), "clarabel"))
-}
-
-#[cfg(not(feature = "clarabel"))]
-fn clarabel(
-    _weights: Option<&Bound<'_, PyAny>>,
-    _regularization: Option<f64>,
-) -> PyResult<(AnyAllocator<f64, CAPACITY>, &'static str)> {
-    Err(PyValueError::new_err(
-        "allocator 'clarabel' is not available: tvmd was built without the cargo feature \
+    let allocator = AnyAllocator::from_name(method, &core_options).map_err(|e| match e {
+        ConfigError::UnknownAllocator => PyValueError::new_err(format!(
+            "unknown allocator '{method}'; expected one of: {}",
+            ALLOCATORS.join(", ")
+        )),
+        ConfigError::AllocatorUnavailable { .. } => PyValueError::new_err(
+            "allocator 'clarabel' is not available: tvmd was built without the cargo feature \
 `clarabel` (rebuild with `maturin build --features clarabel`)",
-    ))
+        ),
+        ConfigError::UnusedOption { field } => PyValueError::new_err(format!(
+            "allocator '{method}' takes no `{}`",
+            if field == ConfigField::ClarabelLambda {
+                "regularization"
+            } else {
+                "weights"
+            }
+        )),
+        e => crate::errors::ConfigError::new_err(e.to_string()),
+    })?;
+    let name = allocator.name();
+    Ok((allocator, name))
 }
 
 /// The last solve report of a Clarabel allocator, as text.
@@ -259,15 +222,15 @@ pub(crate) fn allocate(
             let dt = dt.ok_or_else(|| PyValueError::new_err("`rate_limits` needs `dt`"))?;
             finite_scalar(dt, "dt")?;
             if dt <= 0.0 {
-                return Err(tvmd_core::ConfigError::Parameter { name: "dt" }).or_raise();
+                return Err(crate::errors::ConfigError::new_err(
+                    "`dt` must be positive and finite",
+                ));
             }
             let previous = match previous {
                 Some(p) => previous_commands(p, n)?,
                 None => vec![GimbalCommand::idle(); n],
             };
-            for (set, prev) in sets.iter_mut().zip(&previous) {
-                *set = base.with_rate_limit(prev, &rates, dt);
-            }
+            sets = admissible_sets(&base, Some((&rates, dt)), previous);
         }
         None => {
             if previous.is_some() || dt.is_some() {
@@ -279,6 +242,7 @@ pub(crate) fn allocate(
     }
 
     let effectiveness = team.effectiveness(&mask);
+    allocator.configure(&effectiveness);
     let request = AllocationRequest {
         effectiveness: &effectiveness,
         sets: &sets,

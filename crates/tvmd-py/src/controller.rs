@@ -19,7 +19,7 @@ use crate::convert::{
 };
 use crate::errors::{cycle_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
-use crate::planner::{iteration_cap, status_name};
+use crate::planner::iteration_cap;
 use crate::team::{failed_list, failure_mask, PyTeam};
 use crate::CAPACITY;
 
@@ -226,9 +226,9 @@ impl PyController {
         let limits = self.inner.team().limits();
         PyAfs::from_parts(
             *self.inner.afs(),
-            limits.sigma_x,
-            limits.sigma_y,
-            limits.max_thrust,
+            limits.sigma_x(),
+            limits.sigma_y(),
+            limits.max_thrust(),
         )
     }
 
@@ -253,7 +253,7 @@ impl PyController {
 ///
 /// Attributes:
 ///     R_d: (3, 3) planned attitude. theta: planned tilt (rad).
-///     planner_status: "already_feasible", "planned", "zero_force" or "unreachable".
+///     planner_status: "already-feasible", "planned", "zero-force" or "unreachable".
 ///     planner_iterations: bisection iterations.
 ///     t_Tf, t_eta: the force-projection factors, `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
 ///     f_r: (3,) `t_Tf R u_fr`, the inertial force the planner aligns with.
@@ -307,7 +307,7 @@ impl PyStepOutput {
         Ok(match name {
             "R_d" => self.r_d(py).into_any(),
             "theta" => any(py, o.planner.theta)?,
-            "planner_status" => any(py, status_name(o.planner.status))?,
+            "planner_status" => any(py, o.planner.status.as_str())?,
             "planner_iterations" => any(py, o.planner.iterations)?,
             "t_Tf" => any(py, o.projection.t_tf)?,
             "t_eta" => any(py, o.projection.t_eta)?,
@@ -359,10 +359,10 @@ impl PyStepOutput {
         self.out.planner.theta
     }
 
-    /// "already_feasible", "planned", "zero_force" or "unreachable".
+    /// "already-feasible", "planned", "zero-force" or "unreachable".
     #[getter]
     fn planner_status(&self) -> &'static str {
-        status_name(self.out.planner.status)
+        self.out.planner.status.as_str()
     }
 
     /// Bisection iterations.

@@ -28,16 +28,6 @@ pub(crate) fn iteration_cap(value: Option<i64>) -> PyResult<u32> {
     }
 }
 
-/// The planner status as a Python string.
-pub(crate) fn status_name(status: PlannerStatus) -> &'static str {
-    match status {
-        PlannerStatus::AlreadyFeasible => "already_feasible",
-        PlannerStatus::Planned => "planned",
-        PlannerStatus::ZeroForce => "zero_force",
-        PlannerStatus::Unreachable => "unreachable",
-    }
-}
-
 /// The bisection attitude planner of eqs. (9)-(11): the smallest tilt `theta` of the reference
 /// attitude `R_r` toward the force request `f_r` that makes `R_d^T f_r` attainable (in the AFS
 /// with relaxation `s`). `b_zd = rot(b_zr, k, theta)`, `k = (b_zr x f_r)/||.||`,
@@ -141,7 +131,7 @@ impl PyAttitudePlanner {
 ///     R_d: (3, 3) planned attitude `[b_xd b_yd b_zd]`.
 ///     theta: the tilt `theta*` from `b_zr` toward `f_r` (rad).
 ///     iterations: bisection iterations used (0 unless status is "planned").
-///     status: "already_feasible" (`R_d = R_r`), "planned" (bisection), "zero_force"
+///     status: "already-feasible" (`R_d = R_r`), "planned" (bisection), "zero-force"
 ///         (`f_r = 0`, `R_d = R_r`) or "unreachable" (`||f_r|| > n sigma_Tf`: `b_zd` along `f_r`).
 #[pyclass(module = "tvmd", name = "PlannerResult", frozen)]
 pub struct PyPlannerResult {
@@ -182,10 +172,10 @@ impl PyPlannerResult {
         self.iterations
     }
 
-    /// "already_feasible", "planned", "zero_force" or "unreachable".
+    /// "already-feasible", "planned", "zero-force" or "unreachable".
     #[getter]
     fn status(&self) -> &'static str {
-        status_name(self.status)
+        self.status.as_str()
     }
 
     /// The fields as a dict.

@@ -15,11 +15,7 @@
 //! fails while flying (divergence, controller error) `RuntimeError`. A panic inside tvmd-sim is
 //! caught and raised as `RuntimeError` too, never as `PanicException`.
 
-use std::any::Any;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -27,12 +23,11 @@ use pyo3::exceptions::{PyAttributeError, PyOSError, PyRuntimeError, PyTypeError,
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
-use tvmd_sim::actuators::AgentCommand;
+use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::metrics::PaperMetrics;
-use tvmd_sim::runner::run_scenario;
-use tvmd_sim::scenario::{Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{RunResult, RunSummary, Sample};
+use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
+use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
+use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
 use crate::convert::{any, array1, bool_array, scalars};
@@ -88,42 +83,18 @@ fn sim_error(error: SimError, context: &str, file: IoFile<'_>) -> PyErr {
     }
 }
 
-/// Why a run produced no result.
-enum Failure {
-    /// tvmd-sim returned an error.
-    Sim(SimError),
-    /// tvmd-sim panicked (a bug): the panic message.
-    Panic(String),
-}
-
-fn panic_message(payload: &(dyn Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| (*s).to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".to_string())
-}
-
-impl Failure {
-    fn into_py(self, context: &str, log: Option<&Path>) -> PyErr {
-        match self {
-            Self::Sim(e) => sim_error(e, context, log.map(|l| ("cannot write the MCAP log", l))),
-            Self::Panic(m) => PyRuntimeError::new_err(format!(
-                "{context}internal error in tvmd-sim (please report): {m}"
-            )),
-        }
-    }
+/// The Python exception of a failed run (a panic is `SimError::Internal`, a `RuntimeError`).
+fn run_error(error: SimError, context: &str, log: Option<&Path>) -> PyErr {
+    sim_error(
+        error,
+        context,
+        log.map(|l| ("cannot write the MCAP log", l)),
+    )
 }
 
 // ---------------------------------------------------------------------------------------------
 // Arguments
 // ---------------------------------------------------------------------------------------------
-
-/// One run to do: a validated scenario and the optional MCAP log path.
-struct RunSpec {
-    scenario: Scenario,
-    mcap: Option<PathBuf>,
-}
 
 /// Reads a scenario file; I/O errors name the file.
 fn scenario_file(path: &Path) -> PyResult<Scenario> {
@@ -137,12 +108,14 @@ fn scenario_file(path: &Path) -> PyResult<Scenario> {
 fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
     if let Ok(s) = obj.cast::<PyString>() {
         let s = s.to_cow()?;
-        let path = Path::new(s.as_ref());
-        return if s.ends_with(".toml") || path.is_file() {
-            scenario_file(path)
-        } else {
-            Scenario::builtin(&s).map_err(|e| sim_error(e, "", None))
-        };
+        // Only a file can fail with an I/O error.
+        return Scenario::load(&s).map_err(|e| {
+            sim_error(
+                e,
+                "",
+                Some(("cannot read the scenario file", Path::new(s.as_ref()))),
+            )
+        });
     }
     if obj.hasattr("__fspath__")? {
         let path: PathBuf = obj.extract().map_err(|e| {
@@ -184,16 +157,16 @@ impl RunArgs<'_, '_> {
                 Scenario::builtin(DEFAULT_SCENARIO).map_err(|e| sim_error(e, "", None))?
             }
         };
-        if let Some(s) = self.relaxation {
-            scenario.relaxation = s;
-        }
-        if let Some(a) = self.allocator {
-            scenario.allocator = a;
-        }
-        scenario.validate().map_err(|e| sim_error(e, "", None))?;
+        let overrides = Overrides {
+            relaxation: self.relaxation,
+            allocator: self.allocator,
+        };
+        overrides
+            .apply(&mut scenario)
+            .map_err(|e| sim_error(e, "", None))?;
         Ok(RunSpec {
             scenario,
-            mcap: self.mcap,
+            log: self.mcap,
         })
     }
 }
@@ -267,48 +240,6 @@ fn job_count(jobs: Option<i64>, count: usize) -> PyResult<usize> {
 // Running (without the GIL)
 // ---------------------------------------------------------------------------------------------
 
-/// One run, panics caught.
-fn execute(spec: &RunSpec) -> Result<RunResult, Failure> {
-    catch_unwind(AssertUnwindSafe(|| {
-        run_scenario(&spec.scenario, spec.mcap.as_deref(), None)
-    }))
-    .map_err(|p| Failure::Panic(panic_message(p.as_ref())))?
-    .map_err(Failure::Sim)
-}
-
-/// Runs every spec on `jobs` threads (the calling thread included); results in input order.
-fn execute_all(specs: &[RunSpec], jobs: usize) -> Vec<Result<RunResult, Failure>> {
-    let next = AtomicUsize::new(0);
-    let slots: Vec<Mutex<Option<Result<RunResult, Failure>>>> =
-        specs.iter().map(|_| Mutex::new(None)).collect();
-    let work = || loop {
-        let k = next.fetch_add(1, Ordering::Relaxed);
-        let (Some(spec), Some(slot)) = (specs.get(k), slots.get(k)) else {
-            break;
-        };
-        let outcome = execute(spec);
-        if let Ok(mut slot) = slot.lock() {
-            *slot = Some(outcome);
-        }
-    };
-    std::thread::scope(|scope| {
-        for _ in 1..jobs {
-            // If a thread cannot be spawned, the remaining threads do its share.
-            let _ = std::thread::Builder::new().spawn_scoped(scope, work);
-        }
-        work();
-    });
-    slots
-        .into_iter()
-        .map(|slot| {
-            slot.into_inner()
-                .ok()
-                .flatten()
-                .unwrap_or_else(|| Err(Failure::Panic("a run did not finish".into())))
-        })
-        .collect()
-}
-
 /// Runs the specs with the GIL released and converts the results (the first failure in input
 /// order is raised, its message prefixed with `label(k)`).
 fn run_specs(
@@ -318,14 +249,13 @@ fn run_specs(
     label: impl Fn(usize, &RunSpec) -> String,
 ) -> PyResult<Vec<PySimResult>> {
     let jobs = job_count(jobs, specs.len())?;
-    let outcomes = py.detach(|| execute_all(&specs, jobs));
-    specs
+    let outcomes = py.detach(|| runner::run_many(specs, Some(jobs), None));
+    outcomes
         .into_iter()
-        .zip(outcomes)
         .enumerate()
-        .map(|(k, (spec, outcome))| match outcome {
+        .map(|(k, RunOutcome { spec, result })| match result {
             Ok(result) => Ok(PySimResult::new(spec, result)),
-            Err(f) => Err(f.into_py(&label(k, &spec), spec.mcap.as_deref())),
+            Err(e) => Err(run_error(e, &label(k, &spec), spec.log.as_deref())),
         })
         .collect()
 }
@@ -394,10 +324,13 @@ fn run(
         allocator,
     }
     .spec("scenario")?;
-    let outcome = py.detach(|| execute(&spec));
-    match outcome {
+    let mut outcomes = py.detach(|| runner::run_many(vec![spec], Some(1), None));
+    let RunOutcome { spec, result } = outcomes
+        .pop()
+        .ok_or_else(|| PyRuntimeError::new_err("tvmd-sim returned no result"))?;
+    match result {
         Ok(result) => Ok(PySimResult::new(spec, result)),
-        Err(f) => Err(f.into_py("", spec.mcap.as_deref())),
+        Err(e) => Err(run_error(e, "", spec.log.as_deref())),
     }
 }
 
@@ -486,19 +419,8 @@ fn relaxation_sweep(
     }
     .spec("scenario")?
     .scenario;
-    let specs = values
-        .iter()
-        .map(|&s| {
-            let mut sc = base.clone();
-            sc.relaxation = s;
-            sc.name = format!("{}-s{s}", base.name);
-            sc.validate().map_err(|e| sim_error(e, "", None))?;
-            let mcap = mcap_dir
-                .as_ref()
-                .map(|d| d.join(format!("{}.mcap", sc.name)));
-            Ok(RunSpec { scenario: sc, mcap })
-        })
-        .collect::<PyResult<Vec<_>>>()?;
+    let specs =
+        sweep_specs(&base, &values, mcap_dir.as_deref()).map_err(|e| sim_error(e, "", None))?;
     run_specs(py, specs, jobs, |_, s| {
         format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
     })
@@ -606,7 +528,7 @@ fn agent_columns<'py>(
     py: Python<'py>,
     samples: &[Sample],
     n: usize,
-    f: impl Fn(&Sample) -> &[AgentCommand],
+    f: impl Fn(&Sample) -> &[ActuatorCommand],
 ) -> Bound<'py, PyArray3<f64>> {
     let a = Array3::from_shape_fn((samples.len(), n, 3), |(k, i, j)| {
         samples
@@ -673,7 +595,7 @@ impl PySimResult {
             paper,
             hover_roll_limit,
             n,
-            mcap: spec.mcap,
+            mcap: spec.log,
             samples: result.samples,
             summary: result.summary,
             scenario,

@@ -307,31 +307,31 @@ impl PyTeam {
     /// `sigma_x` (rad), the limit of `|eta_x|`.
     #[getter]
     fn sigma_x(&self) -> f64 {
-        self.inner.limits().sigma_x
+        self.inner.limits().sigma_x()
     }
 
     /// `sigma_y` (rad), the limit of `|eta_y|`.
     #[getter]
     fn sigma_y(&self) -> f64 {
-        self.inner.limits().sigma_y
+        self.inner.limits().sigma_y()
     }
 
     /// `sigma_Tf` (N), the maximum thrust of one agent.
     #[getter]
     fn max_thrust(&self) -> f64 {
-        self.inner.limits().max_thrust
+        self.inner.limits().max_thrust()
     }
 
     /// The idle thrust (N).
     #[getter]
     fn min_thrust(&self) -> f64 {
-        self.inner.limits().min_thrust
+        self.inner.limits().min_thrust()
     }
 
     /// `rho d^4 c_l` of eq. (5) (N s^2/rad^2); equals `max_thrust` for normalized speeds.
     #[getter]
     fn thrust_coefficient(&self) -> f64 {
-        self.inner.limits().thrust_coefficient
+        self.inner.limits().thrust_coefficient()
     }
 
     /// `m_0` (kg).
@@ -398,9 +398,9 @@ impl PyTeam {
         let limits = self.inner.limits();
         Ok(PyAfs::from_parts(
             inner,
-            limits.sigma_x,
-            limits.sigma_y,
-            limits.max_thrust,
+            limits.sigma_x(),
+            limits.sigma_y(),
+            limits.max_thrust(),
         ))
     }
 
@@ -417,9 +417,9 @@ impl PyTeam {
             self.arrangement(),
             self.n_x(),
             self.inner.mass(),
-            self.inner.limits().sigma_x,
-            self.inner.limits().sigma_y,
-            self.inner.limits().max_thrust
+            self.inner.limits().sigma_x(),
+            self.inner.limits().sigma_y(),
+            self.inner.limits().max_thrust()
         )
     }
 }

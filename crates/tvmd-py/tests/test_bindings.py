@@ -297,7 +297,7 @@ def test_attitude_planner_vectors(case, agreement):
     agreement.record("vectors.planner.R_d (default tolerance)", out.R_d, case["R_d"])
     np.testing.assert_allclose(out.theta, case["theta"], rtol=0.0, atol=PLANNER_TOL)
     np.testing.assert_allclose(out.R_d, np.asarray(case["R_d"]), rtol=0.0, atol=PLANNER_TOL)
-    assert (out.status == "already_feasible") == (case["theta"] == 0.0)
+    assert (out.status == "already-feasible") == (case["theta"] == 0.0)
     assert afs.contains(out.R_d.T @ np.asarray(case["f_r"]), case["s"])
 
 
@@ -313,13 +313,13 @@ def test_planner_random(agreement):
         out = tvmd.AttitudePlanner(s, tolerance=1e-12).plan(afs, R_r, f_r)
         R_d, theta, feasible = ri.attitude_planner(R_r, f_r, n, n_x, sx, sy, T, s, tol=1e-12)
         statuses.add(out.status)
-        assert (out.status == "already_feasible") == feasible
+        assert (out.status == "already-feasible") == feasible
         agreement.record("planner.theta", out.theta, theta)
         agreement.record("planner.R_d", out.R_d, R_d)
         np.testing.assert_allclose(out.theta, theta, rtol=0.0, atol=1e-6)
         np.testing.assert_allclose(out.R_d, R_d, rtol=0.0, atol=1e-6)
         np.testing.assert_allclose(out.R_d.T @ out.R_d, np.eye(3), atol=1e-12)
-    assert {"already_feasible", "planned"} <= statuses
+    assert {"already-feasible", "planned"} <= statuses
 
 
 def test_planner_hover_saturation_law():
@@ -335,7 +335,7 @@ def test_planner_hover_saturation_law():
     out = tvmd.AttitudePlanner(0.5).plan(afs, ri.rot_x(0.4), [0.0, 0.0, team.mass * 9.81])
     assert math.atan2(out.R_d[2, 1], out.R_d[2, 2]) == pytest.approx(0.3287, abs=5e-5)
     zero = tvmd.AttitudePlanner(0.5).plan(afs, ri.rot_x(0.2), [0.0, 0.0, 0.0])
-    assert zero.status == "zero_force" and zero.theta == 0.0
+    assert zero.status == "zero-force" and zero.theta == 0.0
     assert set(zero.to_dict()) == {"R_d", "theta", "iterations", "status"}
     assert repr(zero).startswith("PlannerResult(R_d=array(")
 
@@ -534,7 +534,7 @@ def test_controller_hover_equilibrium(team, allocator, agreement):
     _close(out.u_d, [0, 0, 0, 0, 0, mg], rtol=1e-12, atol=1e-12)
     _close(out.wrench, out.u_d, rtol=1e-12, atol=1e-12)
     assert np.all(np.abs(out.commands[:, :2]) < 1e-12)
-    assert out.e_f < 1e-12 and out.V_x == 0.0 and out.planner_status == "already_feasible"
+    assert out.e_f < 1e-12 and out.V_x == 0.0 and out.planner_status == "already-feasible"
     assert out.t_Tf == 1.0 and out.t_eta == 1.0 and not out.saturated.any()
     # omega normalized to 1 at maximum thrust (eq. 5 without rotor constants).
     _close(out.commands[:, 3], np.sqrt(out.commands[:, 2] / team.max_thrust), rtol=1e-12, atol=0)
@@ -559,7 +559,7 @@ def test_controller_step_matches_reference(agreement):
                                ("u_d", "u_d", 1e-5), ("V_R", "V_R", 1e-6), ("V_x", "V_x", 1e-9)):  # fmt: skip
             agreement.record(f"controller.step.{name}", getattr(out, name), ref[key])
             _close(getattr(out, name), ref[key], rtol=tol, atol=tol)
-        assert (out.planner_status == "already_feasible") == ref["feasible_already"]
+        assert (out.planner_status == "already-feasible") == ref["feasible_already"]
         if not out.saturated.any():
             compared += 1
             f_ref = ri.pseudo_inverse_allocation(team_ref["M"], ref["u_d"]).reshape(-1, 3)

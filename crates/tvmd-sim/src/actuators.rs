@@ -20,7 +20,7 @@ use crate::math::quarter_turn;
 
 /// Command (or actual state) of one agent.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct AgentCommand {
+pub struct ActuatorCommand {
     /// Gimbal angle about the agent's x axis (rad).
     pub eta_x: f64,
     /// Gimbal angle about the agent's y axis (rad).
@@ -29,7 +29,7 @@ pub struct AgentCommand {
     pub thrust: f64,
 }
 
-impl AgentCommand {
+impl ActuatorCommand {
     /// True if every field is finite.
     pub fn is_finite(&self) -> bool {
         self.eta_x.is_finite() && self.eta_y.is_finite() && self.thrust.is_finite()
@@ -40,7 +40,7 @@ impl AgentCommand {
 pub use tvmd_core::gimbal::thrust_direction;
 
 /// The agent's force in the team (body) frame: `T R_z(m_i pi/2) a_hat(eta_x, eta_y)`.
-pub fn agent_force_body(cmd: &AgentCommand, quarter_turns: i32) -> Vector3<f64> {
+pub fn agent_force_body(cmd: &ActuatorCommand, quarter_turns: i32) -> Vector3<f64> {
     quarter_turn(quarter_turns) * (cmd.thrust * thrust_direction(cmd.eta_x, cmd.eta_y))
 }
 
@@ -67,7 +67,7 @@ pub struct RotorLag {
 /// Per-agent command limits used when saturation is enabled.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ActuatorLimits {
+pub struct SaturationLimits {
     /// `|eta_x| <= sigma_x` (rad).
     pub sigma_x: f64,
     /// `|eta_y| <= sigma_y` (rad).
@@ -85,7 +85,7 @@ pub struct ActuatorModel {
     /// Rotor lag; `None` = ideal thrust.
     pub rotor_lag: Option<RotorLag>,
     /// Saturate commands to these limits before the models; `None` = no saturation.
-    pub limits: Option<ActuatorLimits>,
+    pub limits: Option<SaturationLimits>,
 }
 
 impl ActuatorModel {
@@ -123,7 +123,7 @@ impl FailureKind {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AgentActuator {
     /// Actual gimbal angles and thrust.
-    pub actual: AgentCommand,
+    pub actual: ActuatorCommand,
     /// Gimbal rates (rad/s) `[eta_x_dot, eta_y_dot]` (servo model only).
     pub rates: [f64; 2],
     /// The thrust is lost.
@@ -142,7 +142,12 @@ fn servo_axis(angle: &mut f64, rate: &mut f64, cmd: f64, m: &ServoModel, dt: f64
 
 impl AgentActuator {
     /// Advances this agent's actuators by `dt` towards `cmd` and returns the actual output.
-    pub fn step(&mut self, cmd: &AgentCommand, model: &ActuatorModel, dt: f64) -> AgentCommand {
+    pub fn step(
+        &mut self,
+        cmd: &ActuatorCommand,
+        model: &ActuatorModel,
+        dt: f64,
+    ) -> ActuatorCommand {
         let mut c = *cmd;
         if let Some(l) = &model.limits {
             c.eta_x = c.eta_x.clamp(-l.sigma_x, l.sigma_x);
@@ -215,7 +220,7 @@ impl ActuatorBank {
 
     /// Advances all agents by `dt`; `commands.len()` must equal the number of agents
     /// (extra commands are ignored, missing ones count as zero).
-    pub fn step(&mut self, commands: &[AgentCommand], dt: f64) -> Vec<AgentCommand> {
+    pub fn step(&mut self, commands: &[ActuatorCommand], dt: f64) -> Vec<ActuatorCommand> {
         self.agents
             .iter_mut()
             .enumerate()
@@ -227,7 +232,7 @@ impl ActuatorBank {
     }
 
     /// Actual outputs of all agents.
-    pub fn actual(&self) -> Vec<AgentCommand> {
+    pub fn actual(&self) -> Vec<ActuatorCommand> {
         self.agents.iter().map(|a| a.actual).collect()
     }
 
@@ -262,7 +267,7 @@ mod tests {
 
     #[test]
     fn quarter_turn_rotates_the_force() {
-        let c = AgentCommand {
+        let c = ActuatorCommand {
             eta_x: 0.0,
             eta_y: FRAC_PI_2,
             thrust: 2.0,
@@ -283,7 +288,7 @@ mod tests {
             ..Default::default()
         };
         let mut a = AgentActuator::default();
-        let cmd = AgentCommand {
+        let cmd = ActuatorCommand {
             eta_x: 0.5,
             eta_y: -0.2,
             thrust: 5.0,
@@ -307,7 +312,7 @@ mod tests {
             ..Default::default()
         };
         let mut a = AgentActuator::default();
-        let cmd = AgentCommand {
+        let cmd = ActuatorCommand {
             thrust: 10.0,
             ..Default::default()
         };
@@ -322,7 +327,7 @@ mod tests {
     fn failures_stop_thrust_and_freeze_gimbal() {
         let model = ActuatorModel::default();
         let mut bank = ActuatorBank::new(model, 2);
-        let cmd = [AgentCommand {
+        let cmd = [ActuatorCommand {
             eta_x: 0.1,
             eta_y: 0.2,
             thrust: 3.0,
@@ -331,7 +336,7 @@ mod tests {
         bank.fail(0, FailureKind::NoThrust);
         bank.fail(1, FailureKind::StuckGimbal);
         let out = bank.step(
-            &[AgentCommand {
+            &[ActuatorCommand {
                 eta_x: -0.3,
                 eta_y: 0.0,
                 thrust: 4.0,
@@ -340,7 +345,7 @@ mod tests {
         );
         assert_eq!(
             out[0],
-            AgentCommand {
+            ActuatorCommand {
                 eta_x: -0.3,
                 eta_y: 0.0,
                 thrust: 0.0
@@ -348,7 +353,7 @@ mod tests {
         );
         assert_eq!(
             out[1],
-            AgentCommand {
+            ActuatorCommand {
                 eta_x: 0.1,
                 eta_y: 0.2,
                 thrust: 4.0
@@ -359,7 +364,7 @@ mod tests {
     #[test]
     fn limits_saturate_commands() {
         let model = ActuatorModel {
-            limits: Some(ActuatorLimits {
+            limits: Some(SaturationLimits {
                 sigma_x: 0.5,
                 sigma_y: 0.6,
                 max_thrust: 10.0,
@@ -368,7 +373,7 @@ mod tests {
         };
         let mut a = AgentActuator::default();
         let out = a.step(
-            &AgentCommand {
+            &ActuatorCommand {
                 eta_x: 1.0,
                 eta_y: -1.0,
                 thrust: 20.0,
@@ -378,7 +383,7 @@ mod tests {
         );
         assert_eq!(
             out,
-            AgentCommand {
+            ActuatorCommand {
                 eta_x: 0.5,
                 eta_y: -0.6,
                 thrust: 10.0

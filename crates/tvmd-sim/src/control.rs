@@ -18,24 +18,23 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Matrix3, Vector3};
-use tvmd_core::error::{ConfigError, GimbalAxis};
+use nalgebra::Vector3;
+use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, ControllerSettings, FailureMask, Gains, Navigator,
-    PlannerStatus, PseudoInverse, RateLimits, RedistributedPseudoInverse, Relaxation, TeamConfig,
-    WeightedPseudoInverse,
+    PlannerStatus, RateLimits, Relaxation, TeamConfig,
 };
 
-use crate::actuators::AgentCommand;
-use crate::error::BoxedError;
-use crate::math::{from_rows, to_rows};
-use crate::physics::RigidState;
-use crate::reference::Reference;
-use crate::scenario::Scenario;
-use crate::sim::{
-    AllocationDiagnostics, ControlDiagnostics, ControlOutput, Diagnostics, FlightController,
-    LyapunovDiagnostics, PlannerDiagnostics,
+use crate::actuators::ActuatorCommand;
+use crate::diagnostics::{
+    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics, PlannerDiagnostics,
 };
+use crate::error::BoxedError;
+use crate::flight::{FlightController, FlightOutput};
+use crate::math::{from_rows, planned_roll, to_rows};
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
+use crate::scenario::Scenario;
 use crate::SimError;
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
@@ -67,36 +66,42 @@ fn invalid(field: &str, reason: impl Into<String>) -> SimError {
 /// The scenario field a core configuration error refers to.
 fn config_field(e: &ConfigError) -> &'static str {
     match e {
-        ConfigError::GimbalLimit {
-            axis: GimbalAxis::X,
-            ..
-        } => "limits.sigma_x",
-        ConfigError::GimbalLimit {
-            axis: GimbalAxis::Y,
-            ..
-        } => "limits.sigma_y",
-        ConfigError::NonPositiveThrust { .. } | ConfigError::IdleThrust { .. } => {
-            "limits.max_thrust"
+        ConfigError::TooManyAgents { .. } => return "team.agents",
+        ConfigError::UnknownAllocator | ConfigError::AllocatorUnavailable { .. } => {
+            return "allocator"
         }
-        ConfigError::Relaxation { .. } => "relaxation",
-        ConfigError::TooManyAgents { .. } => "team.agents",
-        ConfigError::NavigatorInertia => "team.navigator_inertia",
-        ConfigError::Parameter { name } => match *name {
-            "gains.k_x" => "gains.k_x",
-            "gains.k_r" => "gains.k_r",
-            "gains.k_omega" | "gains.k_v" => "gains.k_xi",
-            "rate_limits" => "controller_rate_limits",
-            "period" => "controller_period",
-            "gravity" => "physics.gravity",
-            _ => "allocator",
-        },
-        ConfigError::NonFinite { field } => match *field {
-            "relaxation" => "relaxation",
-            "limits.sigma_x" => "limits.sigma_x",
-            "limits.sigma_y" => "limits.sigma_y",
-            f if f.starts_with("limits.") => "limits.max_thrust",
-            _ => "team",
-        },
+        _ => {}
+    }
+    match e.field() {
+        Some(ConfigField::SigmaX) => "limits.sigma_x",
+        Some(ConfigField::SigmaY) => "limits.sigma_y",
+        Some(
+            ConfigField::MaxThrust
+            | ConfigField::MinThrust
+            | ConfigField::ThrustCoefficient
+            | ConfigField::Rho
+            | ConfigField::RotorDiameter
+            | ConfigField::LiftCoefficient
+            | ConfigField::MaxRotorSpeed,
+        ) => "limits.max_thrust",
+        Some(ConfigField::Relaxation) => "relaxation",
+        Some(ConfigField::NavigatorInertia) if matches!(e, ConfigError::NavigatorInertia) => {
+            "team.navigator_inertia"
+        }
+        Some(ConfigField::GainKx) => "gains.k_x",
+        Some(ConfigField::GainKr) => "gains.k_r",
+        Some(ConfigField::GainKomega | ConfigField::GainKv) => "gains.k_xi",
+        Some(ConfigField::RateLimits) => "controller_rate_limits",
+        Some(ConfigField::Period) => "controller_period",
+        Some(ConfigField::Gravity) => "physics.gravity",
+        Some(
+            ConfigField::AllocatorWeights
+            | ConfigField::ClarabelLambda
+            | ConfigField::ClarabelWeights
+            | ConfigField::ClarabelTolerance
+            | ConfigField::PlannerTolerance
+            | ConfigField::PlannerMaxIterations,
+        ) => "allocator",
         _ => "team",
     }
 }
@@ -107,15 +112,6 @@ fn config_error(e: ConfigError) -> SimError {
 
 fn v3(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
-}
-
-fn status_name(s: PlannerStatus) -> &'static str {
-    match s {
-        PlannerStatus::AlreadyFeasible => "already-feasible",
-        PlannerStatus::Planned => "planned",
-        PlannerStatus::ZeroForce => "zero-force",
-        PlannerStatus::Unreachable => "unreachable",
-    }
 }
 
 /// The core's team configuration of a scenario: agents in the scenario's order, with their
@@ -171,45 +167,25 @@ pub fn controller_settings(scenario: &Scenario) -> Result<ControllerSettings<f64
 
 /// The allocator named by `scenario.allocator`.
 pub fn allocator(name: &str) -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Ok(match name {
-        "redistributed-pseudo-inverse" => {
-            AnyAllocator::RedistributedPseudoInverse(RedistributedPseudoInverse)
-        }
-        "pseudo-inverse" => AnyAllocator::PseudoInverse(PseudoInverse),
-        "weighted-pseudo-inverse" => AnyAllocator::WeightedPseudoInverse(
-            WeightedPseudoInverse::new([1.0; MAX_AGENTS]).map_err(config_error)?,
+    AnyAllocator::from_name(name, &Default::default()).map_err(|e| match e {
+        ConfigError::UnknownAllocator => invalid(
+            "allocator",
+            format!(
+                "unknown allocator `{name}` (known: {})",
+                crate::scenario::ALLOCATOR_NAMES.join(", ")
+            ),
         ),
-        "clarabel" => clarabel_allocator()?,
-        other => {
-            return Err(invalid(
-                "allocator",
-                format!(
-                    "unknown allocator `{other}` (known: {})",
-                    crate::scenario::ALLOCATOR_NAMES.join(", ")
-                ),
-            ))
-        }
+        ConfigError::AllocatorUnavailable { .. } => invalid(
+            "allocator",
+            "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
+             (cargo build --features clarabel)",
+        ),
+        e => config_error(e),
     })
 }
 
-#[cfg(feature = "clarabel")]
-fn clarabel_allocator() -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Ok(AnyAllocator::Clarabel(
-        tvmd_core::allocation::ClarabelAllocator::new(1e-6, None).map_err(config_error)?,
-    ))
-}
-
-#[cfg(not(feature = "clarabel"))]
-fn clarabel_allocator() -> Result<AnyAllocator<f64, MAX_AGENTS>, SimError> {
-    Err(invalid(
-        "allocator",
-        "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
-         (cargo build --features clarabel)",
-    ))
-}
-
 /// The core's state: `v = R^T x_dot` (body frame), `Omega` as is.
-pub fn core_state(s: &RigidState) -> tvmd_core::RigidState<f64> {
+pub fn core_state(s: &PlantState) -> tvmd_core::RigidState<f64> {
     tvmd_core::RigidState {
         position: s.position,
         attitude: s.rotation,
@@ -219,7 +195,7 @@ pub fn core_state(s: &RigidState) -> tvmd_core::RigidState<f64> {
 }
 
 /// The core's reference.
-pub fn core_reference(r: &Reference) -> tvmd_core::Reference<f64> {
+pub fn core_reference(r: &ReferenceSample) -> tvmd_core::Reference<f64> {
     tvmd_core::Reference {
         position: r.position,
         velocity: r.velocity,
@@ -230,8 +206,8 @@ pub fn core_reference(r: &Reference) -> tvmd_core::Reference<f64> {
     }
 }
 
-fn sim_command(c: &tvmd_core::AgentCommand<f64>) -> AgentCommand {
-    AgentCommand {
+fn sim_command(c: &tvmd_core::AgentCommand<f64>) -> ActuatorCommand {
+    ActuatorCommand {
         eta_x: c.eta_x,
         eta_y: c.eta_y,
         thrust: c.thrust,
@@ -317,7 +293,7 @@ impl TvmdController {
                 t_eta: out.projection.t_eta,
                 reference_feasible: out.planner.status == PlannerStatus::AlreadyFeasible,
                 planned_roll: planned_roll(&r_d),
-                status: status_name(out.planner.status).to_string(),
+                status: out.planner.status.as_str().to_string(),
                 iterations: out.planner.iterations,
             }),
             control: Some(ControlDiagnostics {
@@ -351,19 +327,14 @@ impl TvmdController {
     }
 }
 
-/// The planned roll `atan2(R_d[2,1], R_d[2,2])` (rad).
-pub fn planned_roll(r_d: &Matrix3<f64>) -> f64 {
-    r_d[(2, 1)].atan2(r_d[(2, 2)])
-}
-
 impl FlightController for TvmdController {
     fn step(
         &mut self,
         _t: f64,
-        state: &RigidState,
-        reference: &Reference,
+        state: &PlantState,
+        reference: &ReferenceSample,
         failed: &[bool],
-    ) -> Result<ControlOutput, BoxedError> {
+    ) -> Result<FlightOutput, BoxedError> {
         self.update_failures(failed);
         match self
             .inner
@@ -373,12 +344,12 @@ impl FlightController for TvmdController {
                 let diagnostics = self.diagnostics(&out);
                 let commands = out.commands[..self.n].iter().map(sim_command).collect();
                 self.last = Some(out);
-                Ok(ControlOutput {
+                Ok(FlightOutput {
                     commands,
                     diagnostics,
                 })
             }
-            Err(e) => Ok(ControlOutput {
+            Err(e) => Ok(FlightOutput {
                 commands: e.commands[..self.n].iter().map(sim_command).collect(),
                 diagnostics: Diagnostics {
                     cycle_error: Some(e.to_string()),
@@ -391,7 +362,7 @@ impl FlightController for TvmdController {
 }
 
 /// `atan(c_y(1, s))`: the planned roll at which the planner saturates in hover for the
-/// scenario's team, limits and relaxation `s` (the SPEC's reproduction target).
+/// scenario's team, limits and relaxation `s` (a reproduction target, see `docs/method.md`).
 pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
     let team = team_config(scenario)?;
     let afs = team.afs(&FailureMask::none()).map_err(config_error)?;

@@ -1,6 +1,6 @@
 //! Error type of the simulator.
 
-/// Boxed error returned by a [`crate::sim::FlightController`].
+/// Boxed error returned by a flight controller.
 pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// Errors of the simulator.
@@ -75,4 +75,7 @@ pub enum SimError {
     /// The log was already finished.
     #[error("the MCAP log is already finished")]
     LogFinished,
+    /// A run of a batch panicked (a bug in the simulator) or did not finish.
+    #[error("internal error in tvmd-sim (please report): {0}")]
+    Internal(String),
 }

@@ -7,20 +7,26 @@
 //! `J_C = J_0 - sum m_i [p_i]x [p_i]x` (see [`physics::TeamBody`]). A fixed ground cuboid with
 //! contact lets runs start on the ground and land.
 //!
-//! Modules:
-//! - [`physics`]: team body, rapier world, state access ([`physics::PhysicsWorld`]).
+//! Modules, in import order (a module uses only modules above it; see
+//! `docs/architecture.md`):
+//! - [`math`] (rotations, row-major conversions, planned roll) and the
+//!   error type [`SimError`].
+//! - [`actuators`]: actuator commands, thrust direction (eq. 1), servo / rotor-lag models and
+//!   failures.
+//! - [`physics`]: team body, rapier world, the plant's state ([`physics::PlantState`]).
 //! - [`rk4`]: an independent RK4 integration of the paper's dynamics (eqs. 2-3), used as a
 //!   check on rapier.
-//! - [`actuators`]: agent commands, thrust direction (eq. 1), servo / rotor-lag models and
-//!   failures.
 //! - [`mod@reference`]: the paper's reference trajectory (stages A/B/C) and a hover reference.
-//! - [`scenario`]: TOML scenarios (serde) and the built-in scenarios.
+//! - [`scenario`]: TOML scenarios (serde), the built-ins, [`scenario::Scenario::load`] and
+//!   run-time [`scenario::Overrides`].
+//! - [`diagnostics`]: what a controller reports per period (the diagnostics schema).
+//! - [`flight`]: the controller interface [`flight::FlightController`].
 //! - [`log`]: MCAP logs (JSON messages, Foxglove `FrameTransform` / `SceneUpdate`).
-//! - [`sim`]: the digital control loop; controllers plug in through
-//!   [`sim::FlightController`].
+//! - [`sim`]: the digital control loop ([`sim::Simulation`]), its samples, per-tick log and
+//!   summary ([`sim::RunSummary`], [`sim::PaperMetrics`]).
 //! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller.
-//! - [`runner`]: run a scenario with the tvmd controller and an optional MCAP log.
-//! - [`metrics`]: the paper's reproduction metrics computed from a run's samples.
+//! - [`runner`]: runs with the tvmd controller: one ([`runner::run_scenario`]) or a batch on
+//!   one worker pool ([`runner::run_many`], [`runner::relaxation_sweep`]).
 //! - [`plot`]: PNG figures (state profile, Lyapunov candidates, relaxation study) from samples
 //!   or from an MCAP log.
 //!
@@ -31,10 +37,11 @@
 
 pub mod actuators;
 pub mod control;
+pub mod diagnostics;
 mod error;
+pub mod flight;
 pub mod log;
 pub mod math;
-pub mod metrics;
 pub mod physics;
 pub mod plot;
 pub mod reference;

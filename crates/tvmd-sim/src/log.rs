@@ -30,7 +30,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::actuators::AgentCommand;
+use crate::actuators::ActuatorCommand;
 use crate::physics::TeamBody;
 use crate::SimError;
 
@@ -45,15 +45,15 @@ pub enum LogKind {
     State,
     /// Reference ([`ReferenceMsg`]).
     Reference,
-    /// Planner diagnostics ([`crate::sim::PlannerDiagnostics`]).
+    /// Planner diagnostics ([`crate::diagnostics::PlannerDiagnostics`]).
     Planner,
-    /// Control-law diagnostics ([`crate::sim::ControlDiagnostics`]).
+    /// Control-law diagnostics ([`crate::diagnostics::ControlDiagnostics`]).
     Control,
-    /// Allocation diagnostics ([`crate::sim::AllocationDiagnostics`]).
+    /// Allocation diagnostics ([`crate::diagnostics::AllocationDiagnostics`]).
     Allocation,
     /// Actuators ([`ActuatorsMsg`]).
     Actuators,
-    /// Lyapunov candidates ([`crate::sim::LyapunovDiagnostics`]).
+    /// Lyapunov candidates ([`crate::diagnostics::LyapunovDiagnostics`]).
     Lyapunov,
 }
 
@@ -282,9 +282,9 @@ pub struct ActuatorsMsg {
     /// Time (s).
     pub t: f64,
     /// Commands from the controller (held).
-    pub commanded: Vec<AgentCommand>,
+    pub commanded: Vec<ActuatorCommand>,
     /// Actual actuator outputs.
-    pub actual: Vec<AgentCommand>,
+    pub actual: Vec<ActuatorCommand>,
     /// Failure flags (true failure state, whether or not the controller is told).
     pub failed: Vec<bool>,
     /// Actual agent forces in the body frame (N).

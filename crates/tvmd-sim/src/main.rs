@@ -12,19 +12,16 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::metrics::PaperMetrics;
 use tvmd_sim::plot::{self, PlotSeries};
-use tvmd_sim::runner::run_scenario;
-use tvmd_sim::scenario::{Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{RunResult, RunSummary};
+use tvmd_sim::runner::{run_many, run_scenario, sweep_specs};
+use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
+use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;
 
 /// Simulator of thrust-vectoring modular team UAVs with the tvmd controller in the loop.
@@ -191,16 +188,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// A built-in name, or a TOML file if the argument names an existing file or ends in `.toml`.
-fn load_scenario(arg: &str) -> Result<Scenario, SimError> {
-    let path = Path::new(arg);
-    if arg.ends_with(".toml") || path.is_file() {
-        Scenario::from_file(path)
-    } else {
-        Scenario::builtin(arg)
-    }
-}
-
 fn progress_bar(ticks: u64, message: &str) -> ProgressBar {
     let target = if std::io::stderr().is_terminal() {
         ProgressDrawTarget::stderr()
@@ -245,14 +232,10 @@ struct RunArgs {
 }
 
 fn cmd_run(a: RunArgs) -> Result<(), CliError> {
-    let mut scenario = load_scenario(&a.scenario)?;
-    if let Some(s) = a.relaxation {
-        scenario.relaxation = s;
-    }
-    if let Some(name) = a.allocator {
-        scenario.allocator = name;
-    }
-    scenario.validate()?;
+    let scenario = Scenario::load(&a.scenario)?.with_overrides(&Overrides {
+        relaxation: a.relaxation,
+        allocator: a.allocator,
+    })?;
     let log = if a.no_log {
         None
     } else {
@@ -426,49 +409,22 @@ fn cmd_sweep(
     summary: Option<PathBuf>,
     jobs: Option<usize>,
 ) -> Result<(), CliError> {
-    let base = load_scenario(scenario_arg)?;
-    let mut scenarios = Vec::new();
-    for &s in relaxations {
-        let mut sc = base.clone();
-        sc.relaxation = s;
-        sc.name = format!("{}-s{s}", base.name);
-        sc.validate()?;
-        scenarios.push(sc);
-    }
-    if scenarios.is_empty() {
+    let base = Scenario::load(scenario_arg)?;
+    let specs = sweep_specs(&base, relaxations, logs.as_deref())?;
+    if specs.is_empty() {
         return Err(CliError::Other("no relaxation given".into()));
     }
-    let jobs = jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .clamp(1, scenarios.len());
-    let total: u64 = scenarios.iter().map(ticks_of).sum();
-    let bar = progress_bar(total, &format!("{} runs", scenarios.len()));
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<RunResult, SimError>>>> =
-        Mutex::new((0..scenarios.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..jobs {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                let Some(sc) = scenarios.get(k) else { break };
-                let log = logs.as_ref().map(|d| d.join(format!("{}.mcap", sc.name)));
-                let mut tick = |_t: f64| bar.inc(1);
-                let r = run_scenario(sc, log.as_deref(), Some(&mut tick));
-                if let Ok(mut all) = results.lock() {
-                    all[k] = Some(r);
-                }
-            });
-        }
-    });
+    let total: u64 = specs.iter().map(|s| ticks_of(&s.scenario)).sum();
+    let bar = progress_bar(total, &format!("{} runs", specs.len()));
+    let outcomes = run_many(specs, jobs, Some(&|_, _| bar.inc(1)));
     bar.finish_and_clear();
-    let results = results
-        .into_inner()
-        .map_err(|_| CliError::Other("a sweep worker panicked".into()))?;
     let mut rows = Vec::new();
     let mut series = Vec::new();
-    for (sc, r) in scenarios.iter().zip(results) {
-        let r = r.ok_or_else(|| CliError::Other(format!("run {} did not finish", sc.name)))?;
-        let r = r.map_err(|e| CliError::Other(format!("run {}: {e}", sc.name)))?;
+    for outcome in outcomes {
+        let sc = &outcome.spec.scenario;
+        let r = outcome
+            .result
+            .map_err(|e| CliError::Other(format!("run {}: {e}", sc.name)))?;
         let s = &r.summary;
         let paper = PaperMetrics::new(sc, &r.samples);
         rows.push(SweepRow {

@@ -46,6 +46,17 @@ pub fn from_rows(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
     )
 }
 
+/// The planned roll `phi_d = atan2(R_d[2,1], R_d[2,2])` (rad): the core's
+/// [`tvmd_core::rotation::roll_angle`].
+pub fn planned_roll(r_d: &Matrix3<f64>) -> f64 {
+    tvmd_core::rotation::roll_angle(r_d)
+}
+
+/// Tilt of a rotation: angle between body z and world z (rad).
+pub fn tilt_angle(r: &Matrix3<f64>) -> f64 {
+    r[(2, 2)].clamp(-1.0, 1.0).acos()
+}
+
 /// Angle of the rotation `R_a^T R_b` (geodesic distance on SO(3)), in radians.
 pub fn rotation_distance(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
     let c = ((a.transpose() * b).trace() - 1.0) / 2.0;

@@ -225,7 +225,7 @@ impl TeamBody {
 
 /// Rigid-body state of the team: position and velocity of the centre of mass and attitude.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RigidState {
+pub struct PlantState {
     /// Position `x` of the centre of mass in the world frame (m).
     pub position: Vector3<f64>,
     /// Attitude `R` (body to world).
@@ -236,7 +236,7 @@ pub struct RigidState {
     pub omega: Vector3<f64>,
 }
 
-impl RigidState {
+impl PlantState {
     /// At rest at `position` with identity attitude.
     pub fn at_rest(position: Vector3<f64>) -> Self {
         Self {
@@ -351,7 +351,7 @@ impl PhysicsWorld {
     pub fn new(
         team: &TeamBody,
         config: &PhysicsConfig,
-        initial: &RigidState,
+        initial: &PlantState,
     ) -> Result<Self, SimError> {
         team.validate()?;
         if !(config.dt.is_finite() && config.dt > 0.0) {
@@ -469,10 +469,10 @@ impl PhysicsWorld {
     }
 
     /// Current state of the team body.
-    pub fn state(&self) -> RigidState {
+    pub fn state(&self) -> PlantState {
         let rb = &self.world.bodies[self.body];
         let rotation = quat_from_rapier(rb.rotation());
-        RigidState {
+        PlantState {
             position: from_rapier(rb.translation()),
             rotation,
             velocity: from_rapier(rb.linvel()),
@@ -481,7 +481,7 @@ impl PhysicsWorld {
     }
 
     /// Overwrites the body's state (teleport); contacts are re-detected at the next step.
-    pub fn set_state(&mut self, state: &RigidState) {
+    pub fn set_state(&mut self, state: &PlantState) {
         let rb = &mut self.world.bodies[self.body];
         rb.set_position(
             rm::Pose::from_parts(to_rapier(&state.position), quat_to_rapier(&state.rotation)),
@@ -598,7 +598,7 @@ mod tests {
             let w = PhysicsWorld::new(
                 &team,
                 &PhysicsConfig::default(),
-                &RigidState::at_rest(Vector3::new(0.0, 0.0, 1.0)),
+                &PlantState::at_rest(Vector3::new(0.0, 0.0, 1.0)),
             )
             .unwrap();
             let dm = (w.mass() - team.mass()).abs() / team.mass();

@@ -1,6 +1,6 @@
 //! Reference trajectories as pure functions of time.
 //!
-//! The paper's reference (section Simulations, SPEC "The paper's simulation"):
+//! The paper's reference (section Simulations; see `docs/method.md`):
 //! - A) ascent on `[0, 2]` s: `x_r = [0, 0, 0.75 (1 - cos(pi t / 2))]`, then hover at
 //!   `[0, 0, 1.5]`;
 //! - B) tilt on `[4, 10]` s: roll `phi_r(t) = (pi/6)(1 + cos((t - 7) pi / 3))` (peak `pi/3`
@@ -19,7 +19,7 @@ use crate::math::rot_x;
 
 /// The reference at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Reference {
+pub struct ReferenceSample {
     /// Time (s).
     pub t: f64,
     /// `x_r` (m).
@@ -110,7 +110,7 @@ fn cosine_ramp(t: f64, [t0, t1]: [f64; 2], h: f64) -> (f64, f64, f64) {
 
 impl PaperTilt {
     /// Evaluates the reference at `t`.
-    pub fn at(&self, t: f64) -> Reference {
+    pub fn at(&self, t: f64) -> ReferenceSample {
         let h = self.ascent_height;
         let (up, up_d, up_dd) = cosine_ramp(t, self.ascent, h);
         let (down, down_d, down_dd) = cosine_ramp(t, self.descent, h);
@@ -127,7 +127,7 @@ impl PaperTilt {
         } else {
             (0.0, 0.0)
         };
-        Reference {
+        ReferenceSample {
             t,
             position: Vector3::new(0.0, 0.0, z),
             velocity: Vector3::new(0.0, 0.0, z_d),
@@ -143,10 +143,10 @@ impl PaperTilt {
 
 impl ReferenceConfig {
     /// Evaluates the reference at `t`.
-    pub fn at(&self, t: f64) -> Reference {
+    pub fn at(&self, t: f64) -> ReferenceSample {
         match self {
             Self::PaperTilt(p) => p.at(t),
-            Self::Hover { position, roll } => Reference {
+            Self::Hover { position, roll } => ReferenceSample {
                 t,
                 position: Vector3::from(*position),
                 velocity: Vector3::zeros(),

@@ -10,7 +10,7 @@
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
-use crate::physics::RigidState;
+use crate::physics::PlantState;
 
 /// Mass properties and gravity for [`Rk4Body`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,7 +63,7 @@ pub struct Rk4Body {
 
 impl Rk4Body {
     /// A body with `params` in `initial` at time 0. Returns `None` if the inertia is singular.
-    pub fn new(params: RigidBodyParams, initial: &RigidState) -> Option<Self> {
+    pub fn new(params: RigidBodyParams, initial: &PlantState) -> Option<Self> {
         let inertia_inv = params.inertia.try_inverse()?;
         let q = UnitQuaternion::from_matrix(&initial.rotation).into_inner();
         Some(Self {
@@ -85,11 +85,11 @@ impl Rk4Body {
     }
 
     /// Current state.
-    pub fn state(&self) -> RigidState {
+    pub fn state(&self) -> PlantState {
         let r = UnitQuaternion::from_quaternion(self.s.q)
             .to_rotation_matrix()
             .into_inner();
-        RigidState {
+        PlantState {
             position: self.s.x,
             rotation: r,
             velocity: r * self.s.v,
@@ -119,14 +119,14 @@ impl Rk4Body {
     /// stages, so a continuous program is integrated to fourth order).
     pub fn step<F>(&mut self, dt: f64, wrench: F)
     where
-        F: Fn(f64, &RigidState) -> BodyWrench,
+        F: Fn(f64, &PlantState) -> BodyWrench,
     {
         let t = self.time;
         let state_of = |s: &Q| {
             let r = UnitQuaternion::from_quaternion(s.q)
                 .to_rotation_matrix()
                 .into_inner();
-            RigidState {
+            PlantState {
                 position: s.x,
                 rotation: r,
                 velocity: r * s.v,
@@ -163,7 +163,7 @@ mod tests {
             inertia: Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3)),
             gravity: 9.81,
         };
-        let mut b = Rk4Body::new(params, &RigidState::at_rest(Vector3::zeros())).unwrap();
+        let mut b = Rk4Body::new(params, &PlantState::at_rest(Vector3::zeros())).unwrap();
         for _ in 0..1000 {
             b.step(1e-3, |_, _| BodyWrench::default());
         }
@@ -179,11 +179,11 @@ mod tests {
             inertia: j,
             gravity: 0.0,
         };
-        let mut s = RigidState::at_rest(Vector3::zeros());
+        let mut s = PlantState::at_rest(Vector3::zeros());
         s.omega = Vector3::new(1.0, 2.0, 0.5);
         let mut b = Rk4Body::new(params, &s).unwrap();
-        let energy = |s: &RigidState| 0.5 * s.omega.dot(&(j * s.omega));
-        let momentum = |s: &RigidState| s.rotation * j * s.omega;
+        let energy = |s: &PlantState| 0.5 * s.omega.dot(&(j * s.omega));
+        let momentum = |s: &PlantState| s.rotation * j * s.omega;
         let (e0, h0) = (energy(&s), momentum(&s));
         for _ in 0..2000 {
             b.step(1e-3, |_, _| BodyWrench::default());

@@ -1,15 +1,22 @@
-//! One call to run a scenario with the tvmd controller, optionally logging to an MCAP file.
+//! Running scenarios with the tvmd controller: one run ([`run_scenario`], optionally logging to
+//! an MCAP file) and batches on one worker pool ([`run_many`], [`relaxation_sweep`]), which the
+//! command line and the Python module call.
 
+use std::any::Any;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 use crate::control::TvmdController;
 use crate::error::BoxedError;
+use crate::flight::{FlightController, FlightOutput};
 use crate::log::{McapLog, METADATA_SCENARIO};
-use crate::physics::RigidState;
-use crate::reference::Reference;
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
 use crate::scenario::Scenario;
-use crate::sim::{ControlOutput, FlightController, RunResult, SimOptions, Simulation};
+use crate::sim::{RunResult, SimOptions, Simulation};
 use crate::SimError;
 
 /// A controller that reports the time of every call to a callback (for progress bars).
@@ -29,10 +36,10 @@ impl FlightController for WithProgress<'_> {
     fn step(
         &mut self,
         t: f64,
-        state: &RigidState,
-        reference: &Reference,
+        state: &PlantState,
+        reference: &ReferenceSample,
         failed: &[bool],
-    ) -> Result<ControlOutput, BoxedError> {
+    ) -> Result<FlightOutput, BoxedError> {
         (self.progress)(t);
         self.inner.step(t, state, reference, failed)
     }
@@ -79,4 +86,200 @@ pub fn run_scenario(
         l.finish()?;
     }
     result
+}
+
+/// One run of a batch: a validated scenario and the MCAP log to write, if any.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpec {
+    /// The scenario (overrides applied, validated).
+    pub scenario: Scenario,
+    /// MCAP log to write (parent directories are created).
+    pub log: Option<PathBuf>,
+}
+
+/// A finished run of a batch: what was asked and what came out.
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// The run.
+    pub spec: RunSpec,
+    /// Its result; a panic inside the run is reported as [`SimError::Internal`].
+    pub result: Result<RunResult, SimError>,
+}
+
+/// Progress callback of a batch: `progress(k, t)` at every controller tick of run `k`. Called
+/// from the worker threads.
+pub type Progress<'a> = &'a (dyn Fn(usize, f64) + Sync);
+
+/// Worker threads for `runs` runs: `jobs` or the available cores, at least 1, at most `runs`.
+pub fn worker_count(jobs: Option<usize>, runs: usize) -> usize {
+    jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, runs.max(1))
+}
+
+fn panic_message(payload: &(dyn Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string())
+}
+
+/// One run of a batch, a panic caught as [`SimError::Internal`].
+fn run_guarded(
+    k: usize,
+    spec: &RunSpec,
+    progress: Option<Progress<'_>>,
+) -> Result<RunResult, SimError> {
+    catch_unwind(AssertUnwindSafe(|| match progress {
+        Some(p) => run_scenario(&spec.scenario, spec.log.as_deref(), Some(&mut |t| p(k, t))),
+        None => run_scenario(&spec.scenario, spec.log.as_deref(), None),
+    }))
+    .unwrap_or_else(|p| Err(SimError::Internal(panic_message(p.as_ref()))))
+}
+
+/// Runs every spec with [`run_scenario`] on [`worker_count`]`(jobs, len)` threads (the calling
+/// thread is one of them) and returns the outcomes in input order. Runs are independent and
+/// deterministic, so the results do not depend on `jobs`.
+pub fn run_many(
+    specs: Vec<RunSpec>,
+    jobs: Option<usize>,
+    progress: Option<Progress<'_>>,
+) -> Vec<RunOutcome> {
+    let jobs = worker_count(jobs, specs.len());
+    let next = AtomicUsize::new(0);
+    let slots: Vec<Mutex<Option<Result<RunResult, SimError>>>> =
+        specs.iter().map(|_| Mutex::new(None)).collect();
+    let work = || loop {
+        let k = next.fetch_add(1, Ordering::Relaxed);
+        let (Some(spec), Some(slot)) = (specs.get(k), slots.get(k)) else {
+            break;
+        };
+        let result = run_guarded(k, spec, progress);
+        if let Ok(mut slot) = slot.lock() {
+            *slot = Some(result);
+        }
+    };
+    std::thread::scope(|scope| {
+        for _ in 1..jobs {
+            // If a thread cannot be spawned, the others do its share.
+            let _ = std::thread::Builder::new().spawn_scoped(scope, work);
+        }
+        work();
+    });
+    specs
+        .into_iter()
+        .zip(slots)
+        .map(|(spec, slot)| RunOutcome {
+            spec,
+            result: slot
+                .into_inner()
+                .ok()
+                .flatten()
+                .unwrap_or_else(|| Err(SimError::Internal("a run did not finish".into()))),
+        })
+        .collect()
+}
+
+/// The runs of a relaxation study: `base` once per `s` in `relaxations`, named
+/// `<name>-s<s>`, each validated, logged to `<log_dir>/<name>-s<s>.mcap` if `log_dir` is given.
+pub fn sweep_specs(
+    base: &Scenario,
+    relaxations: &[f64],
+    log_dir: Option<&Path>,
+) -> Result<Vec<RunSpec>, SimError> {
+    relaxations
+        .iter()
+        .map(|&s| {
+            let mut scenario = base.clone();
+            scenario.relaxation = s;
+            scenario.name = format!("{}-s{s}", base.name);
+            scenario.validate()?;
+            let log = log_dir.map(|d| d.join(format!("{}.mcap", scenario.name)));
+            Ok(RunSpec { scenario, log })
+        })
+        .collect()
+}
+
+/// The relaxation study: [`sweep_specs`] flown by [`run_many`]. An invalid `s` is an error
+/// before any run starts.
+pub fn relaxation_sweep(
+    base: &Scenario,
+    relaxations: &[f64],
+    log_dir: Option<&Path>,
+    jobs: Option<usize>,
+    progress: Option<Progress<'_>>,
+) -> Result<Vec<RunOutcome>, SimError> {
+    Ok(run_many(
+        sweep_specs(base, relaxations, log_dir)?,
+        jobs,
+        progress,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn short(name: &str, relaxation: f64) -> Scenario {
+        Scenario {
+            name: name.into(),
+            duration: 0.2,
+            relaxation,
+            ..Scenario::default()
+        }
+    }
+
+    #[test]
+    fn worker_count_is_clamped_to_the_runs() {
+        assert_eq!(worker_count(Some(8), 3), 3);
+        assert_eq!(worker_count(Some(0), 3), 1);
+        assert_eq!(worker_count(Some(2), 0), 1);
+        assert!(worker_count(None, 64) >= 1);
+    }
+
+    #[test]
+    fn run_many_keeps_input_order_and_matches_single_runs() {
+        let specs: Vec<RunSpec> = [("a", 0.25), ("b", 1.0), ("c", 0.5)]
+            .iter()
+            .map(|&(n, s)| RunSpec {
+                scenario: short(n, s),
+                log: None,
+            })
+            .collect();
+        let ticks = AtomicUsize::new(0);
+        let outcomes = run_many(
+            specs.clone(),
+            Some(2),
+            Some(&|_, _| {
+                ticks.fetch_add(1, Ordering::Relaxed);
+            }),
+        );
+        assert_eq!(ticks.into_inner(), 3 * 20);
+        for (spec, outcome) in specs.iter().zip(&outcomes) {
+            assert_eq!(&outcome.spec, spec);
+            let single = run_scenario(&spec.scenario, None, None).unwrap();
+            let batch = outcome.result.as_ref().unwrap();
+            assert_eq!(batch.samples, single.samples);
+            assert_eq!(batch.summary.scenario, spec.scenario.name);
+        }
+        assert!(run_many(Vec::new(), None, None).is_empty());
+    }
+
+    #[test]
+    fn sweep_specs_name_log_and_validate_each_relaxation() {
+        let base = short("base", 0.5);
+        let specs = sweep_specs(&base, &[0.25, 1.0], Some(Path::new("logs"))).unwrap();
+        let names: Vec<&str> = specs.iter().map(|s| s.scenario.name.as_str()).collect();
+        assert_eq!(names, ["base-s0.25", "base-s1"]);
+        assert_eq!(specs[1].scenario.relaxation, 1.0);
+        assert_eq!(
+            specs[0].log.as_deref(),
+            Some(Path::new("logs/base-s0.25.mcap"))
+        );
+        let e = relaxation_sweep(&base, &[0.5, 1.5], None, None, None).unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "relaxation"),
+            "{e}"
+        );
+    }
 }

@@ -7,10 +7,10 @@
 use std::f64::consts::PI;
 
 use tvmd_sim::control::{hover_roll_limit, TvmdController};
-use tvmd_sim::metrics::PaperMetrics;
 use tvmd_sim::reference::ReferenceConfig;
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::scenario::Scenario;
+use tvmd_sim::sim::PaperMetrics;
 use tvmd_sim::sim::{RunResult, Simulation};
 use tvmd_sim::GRAVITY;
 
@@ -96,7 +96,7 @@ fn paper_tilt_reproduces_the_paper() {
     assert!(sum.max_abs_eta_x < PI / 6.0 && sum.max_abs_eta_y < PI / 4.0);
     assert!(sum.max_thrust.unwrap() < 2.0 * 0.7 * GRAVITY);
 
-    // SPEC calibration (independent NumPy reading): 0.23 m at t = 4 s, 0.11 m at t = 12 s.
+    // Calibration of an independent NumPy reading (docs/method.md): 0.23 m at 4 s, 0.11 m at 12 s.
     let h4 = m.horizontal_error_at_4s.unwrap();
     let h12 = m.horizontal_error_at_12s.unwrap();
     assert!((h4 - 0.23).abs() < 0.01, "{h4}");

@@ -6,13 +6,13 @@ use std::collections::BTreeMap;
 use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use tvmd_sim::control::{core_reference, core_state, TvmdController};
+use tvmd_sim::flight::FlightController;
 use tvmd_sim::log::METADATA_SCENARIO;
-use tvmd_sim::physics::RigidState;
+use tvmd_sim::physics::PlantState;
 use tvmd_sim::plot::{self, PlotSeries};
 use tvmd_sim::reference::ReferenceConfig;
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::scenario::Scenario;
-use tvmd_sim::sim::FlightController;
 use tvmd_sim::SimError;
 
 fn tmp_dir(name: &str) -> std::path::PathBuf {
@@ -118,7 +118,7 @@ fn short_run_log_has_every_channel_and_replots() {
 #[test]
 fn state_conversion_uses_body_velocity() {
     let r = Rotation3::from_euler_angles(0.3, -0.2, 1.1).into_inner();
-    let s = RigidState {
+    let s = PlantState {
         position: Vector3::new(1.0, 2.0, 3.0),
         rotation: r,
         velocity: Vector3::new(0.5, -0.1, 0.2),
@@ -165,7 +165,7 @@ fn scenario_errors_name_the_field() {
 fn failures_reach_the_core_and_bad_inputs_hold_the_commands() {
     let s = Scenario::builtin("a6-agent-failure").unwrap();
     let mut ctl = TvmdController::from_scenario(&s).unwrap();
-    let state = RigidState::at_rest(Vector3::new(0.0, 0.0, 1.5));
+    let state = PlantState::at_rest(Vector3::new(0.0, 0.0, 1.5));
     let reference = ReferenceConfig::Hover {
         position: [0.0, 0.0, 1.5],
         roll: 0.0,

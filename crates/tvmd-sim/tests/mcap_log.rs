@@ -7,13 +7,14 @@ use std::collections::BTreeMap;
 use common::PdHover;
 use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Vector3};
-use tvmd_sim::actuators::AgentCommand;
+use tvmd_sim::actuators::ActuatorCommand;
+use tvmd_sim::flight::FlightOutput;
 use tvmd_sim::log::{LogKind, McapLog};
 use tvmd_sim::math::rot_x;
-use tvmd_sim::physics::{RigidState, TeamBody};
-use tvmd_sim::reference::{Reference, ReferenceConfig};
+use tvmd_sim::physics::{PlantState, TeamBody};
+use tvmd_sim::reference::{ReferenceConfig, ReferenceSample};
 use tvmd_sim::scenario::Scenario;
-use tvmd_sim::sim::{ControlOutput, Simulation};
+use tvmd_sim::sim::Simulation;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;
 
@@ -136,17 +137,17 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
         let mut log = McapLog::create(&path).unwrap();
         let mut sim = Simulation::new(&s).unwrap();
         let mut ctl = |t: f64,
-                       _: &RigidState,
-                       _: &Reference,
+                       _: &PlantState,
+                       _: &ReferenceSample,
                        _: &[bool]|
-         -> Result<ControlOutput, BoxedError> {
+         -> Result<FlightOutput, BoxedError> {
             if t > 0.25 {
                 return Err("controller gave up".into());
             }
-            Ok(ControlOutput {
-                commands: vec![AgentCommand::default(); 4],
-                diagnostics: tvmd_sim::sim::Diagnostics {
-                    planner: Some(tvmd_sim::sim::PlannerDiagnostics {
+            Ok(FlightOutput {
+                commands: vec![ActuatorCommand::default(); 4],
+                diagnostics: tvmd_sim::diagnostics::Diagnostics {
+                    planner: Some(tvmd_sim::diagnostics::PlannerDiagnostics {
                         r_d: tvmd_sim::math::to_rows(&Matrix3::identity()),
                         t_tf: 1.0,
                         t_eta: 1.0,

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use tvmd_sim::math::rotation_distance;
-use tvmd_sim::physics::{ExtraWrench, PhysicsConfig, PhysicsWorld, RigidState, TeamBody};
+use tvmd_sim::physics::{ExtraWrench, PhysicsConfig, PhysicsWorld, PlantState, TeamBody};
 use tvmd_sim::rk4::{BodyWrench, RigidBodyParams, Rk4Body};
 use tvmd_sim::GRAVITY;
 
@@ -36,8 +36,8 @@ struct Errors {
     omega: f64,
 }
 
-fn compare(team: &TeamBody, dt: f64, solver_iterations: usize) -> (Errors, RigidState) {
-    let mut initial = RigidState::at_rest(Vector3::new(0.0, 0.0, 10.0));
+fn compare(team: &TeamBody, dt: f64, solver_iterations: usize) -> (Errors, PlantState) {
+    let mut initial = PlantState::at_rest(Vector3::new(0.0, 0.0, 10.0));
     initial.velocity = Vector3::new(0.2, -0.1, 0.3);
     initial.omega = Vector3::new(0.1, -0.05, 0.2);
     let config = PhysicsConfig {

@@ -6,11 +6,12 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use common::{zero_thrust, PdHover};
-use tvmd_sim::actuators::{AgentCommand, FailureKind};
-use tvmd_sim::physics::RigidState;
-use tvmd_sim::reference::{Reference, ReferenceConfig};
+use tvmd_sim::actuators::{ActuatorCommand, FailureKind};
+use tvmd_sim::flight::FlightOutput;
+use tvmd_sim::physics::PlantState;
+use tvmd_sim::reference::{ReferenceConfig, ReferenceSample};
 use tvmd_sim::scenario::{Failure, Scenario, StateNoise};
-use tvmd_sim::sim::{ControlOutput, Simulation};
+use tvmd_sim::sim::Simulation;
 use tvmd_sim::SimError;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;
@@ -128,14 +129,14 @@ fn controller_runs_at_its_period_with_zero_order_hold() {
     let times = Rc::new(RefCell::new(Vec::new()));
     let seen = times.clone();
     let mut ctl = move |t: f64,
-                        _: &RigidState,
-                        _: &Reference,
+                        _: &PlantState,
+                        _: &ReferenceSample,
                         _: &[bool]|
-          -> Result<ControlOutput, BoxedError> {
+          -> Result<FlightOutput, BoxedError> {
         seen.borrow_mut().push(t);
-        Ok(ControlOutput {
+        Ok(FlightOutput {
             commands: vec![
-                AgentCommand {
+                ActuatorCommand {
                     thrust: t,
                     ..Default::default()
                 };
@@ -170,14 +171,14 @@ fn failure_flags_seen(informed: bool) -> Vec<(f64, bool, f64)> {
     let log = Rc::new(RefCell::new(Vec::new()));
     let l2 = log.clone();
     let mut ctl = move |t: f64,
-                        _: &RigidState,
-                        _: &Reference,
+                        _: &PlantState,
+                        _: &ReferenceSample,
                         failed: &[bool]|
-          -> Result<ControlOutput, BoxedError> {
+          -> Result<FlightOutput, BoxedError> {
         l2.borrow_mut().push((t, failed[2]));
-        Ok(ControlOutput {
+        Ok(FlightOutput {
             commands: vec![
-                AgentCommand {
+                ActuatorCommand {
                     thrust: 1.0,
                     ..Default::default()
                 };
@@ -225,18 +226,18 @@ fn fed_positions(seed: u64) -> Vec<[f64; 3]> {
     let out = Rc::new(RefCell::new(Vec::new()));
     let o2 = out.clone();
     let mut ctl = move |_: f64,
-                        st: &RigidState,
-                        _: &Reference,
+                        st: &PlantState,
+                        _: &ReferenceSample,
                         _: &[bool]|
-          -> Result<ControlOutput, BoxedError> {
+          -> Result<FlightOutput, BoxedError> {
         o2.borrow_mut()
             .push([st.position.x, st.position.y, st.position.z]);
         // The noisy attitude is still a rotation.
         assert!(
             (st.rotation.transpose() * st.rotation - nalgebra::Matrix3::identity()).norm() < 1e-12
         );
-        Ok(ControlOutput {
-            commands: vec![AgentCommand::default(); 4],
+        Ok(FlightOutput {
+            commands: vec![ActuatorCommand::default(); 4],
             ..Default::default()
         })
     };
@@ -271,49 +272,58 @@ fn wind_pushes_the_team() {
 fn controller_errors_and_bad_outputs_stop_the_run() {
     let s = hover_scenario(0.0, 1.0);
     let mut sim = Simulation::new(&s).unwrap();
-    let mut bad =
-        |t: f64, _: &RigidState, _: &Reference, _: &[bool]| -> Result<ControlOutput, BoxedError> {
-            if t > 0.5 {
-                Err("boom".into())
-            } else {
-                Ok(ControlOutput {
-                    commands: vec![AgentCommand::default(); 4],
-                    ..Default::default()
-                })
-            }
-        };
+    let mut bad = |t: f64,
+                   _: &PlantState,
+                   _: &ReferenceSample,
+                   _: &[bool]|
+     -> Result<FlightOutput, BoxedError> {
+        if t > 0.5 {
+            Err("boom".into())
+        } else {
+            Ok(FlightOutput {
+                commands: vec![ActuatorCommand::default(); 4],
+                ..Default::default()
+            })
+        }
+    };
     let e = sim.run(&mut bad, None).unwrap_err();
     assert!(matches!(e, SimError::Controller { .. }), "{e}");
     assert!(e.to_string().contains("boom"));
     assert_eq!(sim.samples().len(), 51);
 
     let mut sim = Simulation::new(&s).unwrap();
-    let mut short =
-        |_: f64, _: &RigidState, _: &Reference, _: &[bool]| -> Result<ControlOutput, BoxedError> {
-            Ok(ControlOutput {
-                commands: vec![AgentCommand::default(); 3],
-                ..Default::default()
-            })
-        };
+    let mut short = |_: f64,
+                     _: &PlantState,
+                     _: &ReferenceSample,
+                     _: &[bool]|
+     -> Result<FlightOutput, BoxedError> {
+        Ok(FlightOutput {
+            commands: vec![ActuatorCommand::default(); 3],
+            ..Default::default()
+        })
+    };
     assert!(matches!(
         sim.run(&mut short, None),
         Err(SimError::InvalidCommand { .. })
     ));
 
     let mut sim = Simulation::new(&s).unwrap();
-    let mut nan =
-        |_: f64, _: &RigidState, _: &Reference, _: &[bool]| -> Result<ControlOutput, BoxedError> {
-            Ok(ControlOutput {
-                commands: vec![
-                    AgentCommand {
-                        thrust: f64::NAN,
-                        ..Default::default()
-                    };
-                    4
-                ],
-                ..Default::default()
-            })
-        };
+    let mut nan = |_: f64,
+                   _: &PlantState,
+                   _: &ReferenceSample,
+                   _: &[bool]|
+     -> Result<FlightOutput, BoxedError> {
+        Ok(FlightOutput {
+            commands: vec![
+                ActuatorCommand {
+                    thrust: f64::NAN,
+                    ..Default::default()
+                };
+                4
+            ],
+            ..Default::default()
+        })
+    };
     assert!(matches!(
         sim.run(&mut nan, None),
         Err(SimError::InvalidCommand { .. })

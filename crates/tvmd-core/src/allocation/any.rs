@@ -1,12 +1,72 @@
-//! Run-time choice of allocator (for configuration files and bindings).
+//! Run-time choice of allocator (for configuration files and bindings), and the one table of
+//! allocator names.
 
 use super::{
     Allocation, AllocationRequest, Allocator, PseudoInverse, RedistributedPseudoInverse,
     WeightedPseudoInverse,
 };
+use crate::effectiveness::Effectiveness;
+use crate::error::{ConfigError, ConfigField};
 use crate::real::Real;
 
+/// Name of [`PseudoInverse`].
+pub const PSEUDO_INVERSE: &str = "pseudo-inverse";
+/// Name of [`WeightedPseudoInverse`].
+pub const WEIGHTED_PSEUDO_INVERSE: &str = "weighted-pseudo-inverse";
+/// Name of [`RedistributedPseudoInverse`], the default (the paper's).
+pub const REDISTRIBUTED_PSEUDO_INVERSE: &str = "redistributed-pseudo-inverse";
+/// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without
+/// the feature can say what is missing).
+pub const CLARABEL: &str = "clarabel";
+
+#[cfg(feature = "clarabel")]
+const NAMES: &[&str] = &[
+    REDISTRIBUTED_PSEUDO_INVERSE,
+    PSEUDO_INVERSE,
+    WEIGHTED_PSEUDO_INVERSE,
+    CLARABEL,
+];
+#[cfg(not(feature = "clarabel"))]
+const NAMES: &[&str] = &[
+    REDISTRIBUTED_PSEUDO_INVERSE,
+    PSEUDO_INVERSE,
+    WEIGHTED_PSEUDO_INVERSE,
+];
+
+/// Options of [`AnyAllocator::from_name`]; each applies to one allocator only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AllocatorOptions<T: Real, const N: usize> {
+    /// Per-agent weights `w_i` of [`WeightedPseudoInverse`] (default: all 1).
+    pub agent_weights: Option<[T; N]>,
+    /// Wrench weights `W` of `ClarabelAllocator` (default: identity).
+    pub wrench_weights: Option<[T; 6]>,
+    /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`).
+    pub regularization: Option<T>,
+}
+
+impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
+    fn default() -> Self {
+        Self {
+            agent_weights: None,
+            wrench_weights: None,
+            regularization: None,
+        }
+    }
+}
+
 /// One of the crate's allocators, chosen at run time.
+///
+/// ```
+/// use tvmd_core::{AnyAllocator, Allocator};
+/// use tvmd_core::allocation::AllocatorOptions;
+///
+/// let names = AnyAllocator::<f64, 4>::NAMES;
+/// assert_eq!(names[0], "redistributed-pseudo-inverse");
+/// let a = AnyAllocator::<f64, 4>::from_name("pseudo-inverse", &AllocatorOptions::default())?;
+/// assert_eq!(a.name(), "pseudo-inverse");
+/// assert!(AnyAllocator::<f64, 4>::from_name("magic", &AllocatorOptions::default()).is_err());
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub enum AnyAllocator<T: Real, const N: usize> {
     /// [`PseudoInverse`].
@@ -20,6 +80,89 @@ pub enum AnyAllocator<T: Real, const N: usize> {
     Clarabel(super::ClarabelAllocator<T, N>),
 }
 
+impl<T: Real, const N: usize> AnyAllocator<T, N> {
+    /// The names this build knows, the default first; `"clarabel"` only with the feature.
+    pub const NAMES: &'static [&'static str] = NAMES;
+
+    /// The name of the default allocator.
+    pub const DEFAULT_NAME: &'static str = REDISTRIBUTED_PSEUDO_INVERSE;
+
+    /// The allocator named `name` (one of [`Self::NAMES`]) with `options`.
+    ///
+    /// Errors: [`ConfigError::UnknownAllocator`]; [`ConfigError::AllocatorUnavailable`] for
+    /// `"clarabel"` without the feature; [`ConfigError::UnusedOption`] for an option the
+    /// allocator does not take; the allocator's own validation errors.
+    pub fn from_name(name: &str, options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        let refuse = |given: bool, field| {
+            if given {
+                Err(ConfigError::UnusedOption { field })
+            } else {
+                Ok(())
+            }
+        };
+        let no_clarabel_options = || {
+            refuse(
+                options.wrench_weights.is_some(),
+                ConfigField::ClarabelWeights,
+            )?;
+            refuse(
+                options.regularization.is_some(),
+                ConfigField::ClarabelLambda,
+            )
+        };
+        match name {
+            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE => {
+                refuse(
+                    options.agent_weights.is_some(),
+                    ConfigField::AllocatorWeights,
+                )?;
+                no_clarabel_options()?;
+                Ok(if name == PSEUDO_INVERSE {
+                    Self::PseudoInverse(PseudoInverse)
+                } else {
+                    Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
+                })
+            }
+            WEIGHTED_PSEUDO_INVERSE => {
+                no_clarabel_options()?;
+                let weights = options.agent_weights.unwrap_or([T::one(); N]);
+                Ok(Self::WeightedPseudoInverse(WeightedPseudoInverse::new(
+                    weights,
+                )?))
+            }
+            CLARABEL => {
+                refuse(
+                    options.agent_weights.is_some(),
+                    ConfigField::AllocatorWeights,
+                )?;
+                Self::clarabel(options)
+            }
+            _ => Err(ConfigError::UnknownAllocator),
+        }
+    }
+
+    #[cfg(feature = "clarabel")]
+    fn clarabel(options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        let lambda = options
+            .regularization
+            .unwrap_or_else(|| super::ClarabelAllocator::<T, N>::default().lambda());
+        Ok(Self::Clarabel(super::ClarabelAllocator::new(
+            lambda,
+            options.wrench_weights,
+        )?))
+    }
+
+    #[cfg(not(feature = "clarabel"))]
+    fn clarabel(_options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        Err(ConfigError::AllocatorUnavailable { name: CLARABEL })
+    }
+
+    /// The allocator's name, one of [`Self::NAMES`].
+    pub fn name(&self) -> &'static str {
+        Allocator::<T, N>::name(self)
+    }
+}
+
 impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
     /// The redistributed pseudo-inverse.
     fn default() -> Self {
@@ -28,6 +171,16 @@ impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
 }
 
 impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
+    fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
+        match self {
+            Self::PseudoInverse(a) => a.configure(effectiveness),
+            Self::WeightedPseudoInverse(a) => a.configure(effectiveness),
+            Self::RedistributedPseudoInverse(a) => a.configure(effectiveness),
+            #[cfg(feature = "clarabel")]
+            Self::Clarabel(a) => a.configure(effectiveness),
+        }
+    }
+
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
         match self {
             Self::PseudoInverse(a) => a.allocate(request),

@@ -11,7 +11,10 @@ mod clarabel;
 mod pseudo_inverse;
 mod redistributed;
 
-pub use any::AnyAllocator;
+pub use any::{
+    AllocatorOptions, AnyAllocator, CLARABEL, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
+    WEIGHTED_PSEUDO_INVERSE,
+};
 #[cfg(feature = "clarabel")]
 pub use clarabel::{ClarabelAllocator, ClarabelStatus, FallbackReason, SolveReport};
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
@@ -21,7 +24,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
-use crate::linalg::solve_gram;
+use crate::linalg::{solve_gram, weighted_gram, GramSolver};
 use crate::real::Real;
 
 /// What an allocator is asked to do.
@@ -83,6 +86,14 @@ impl<T: Real, const N: usize> Allocation<T, N> {
 
 /// An allocation algorithm. `&mut self` lets an allocator keep warm-start data between periods.
 pub trait Allocator<T: Real, const N: usize> {
+    /// Tells the allocator the effectiveness model it will be asked to invert, once per
+    /// change of team or failures (as PX4's `setEffectivenessMatrix`), so it can prepare
+    /// factorizations. [`crate::Controller`] calls it in `new` and `set_failures`; the default
+    /// does nothing.
+    fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
+        let _ = effectiveness;
+    }
+
     /// Allocates `request.wrench` over the working agents.
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N>;
 
@@ -96,23 +107,15 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
     effectiveness: &Effectiveness<T, N>,
     free: &[bool; N],
     weights: Option<&[T; N]>,
+    factor: Option<&GramSolver<T>>,
     rhs: &Vector6<T>,
     out: &mut [Vector3<T>; N],
 ) {
     let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
-    let mut gram = Matrix6::zeros();
-    for (i, (block, _)) in effectiveness
-        .blocks()
-        .iter()
-        .zip(free)
-        .enumerate()
-        .filter(|(_, (_, f))| **f)
-    {
-        if let Some(b) = block {
-            gram += b * b.transpose() / weight(i);
-        }
-    }
-    let lambda = solve_gram(&gram, rhs);
+    let lambda = match factor {
+        Some(f) => f.solve(rhs),
+        None => solve_gram(&gram_of(effectiveness, free, weights), rhs),
+    };
     for (i, ((block, f), slot)) in effectiveness
         .blocks()
         .iter()
@@ -124,6 +127,24 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
             *slot = b.tr_mul(&lambda) / weight(i);
         }
     }
+}
+
+/// `sum_{i free} M_i M_i^T / w_i`.
+pub(crate) fn gram_of<T: Real, const N: usize>(
+    effectiveness: &Effectiveness<T, N>,
+    free: &[bool; N],
+    weights: Option<&[T; N]>,
+) -> Matrix6<T> {
+    let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+    weighted_gram(
+        Matrix6::zeros(),
+        effectiveness
+            .blocks()
+            .iter()
+            .zip(free)
+            .enumerate()
+            .filter_map(|(i, (block, f))| block.as_ref().filter(|_| *f).map(|b| (b, weight(i)))),
+    )
 }
 
 /// Working agents as a mask.

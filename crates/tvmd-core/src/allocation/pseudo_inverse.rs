@@ -2,32 +2,75 @@
 
 use nalgebra::Vector3;
 
-use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
-use crate::error::ConfigError;
+use super::{
+    gram_of, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
+};
+use crate::effectiveness::Effectiveness;
+use crate::error::{ConfigError, ConfigField};
 use crate::gimbal::GimbalCommand;
+use crate::linalg::GramSolver;
 use crate::real::Real;
 
 /// `f = M^T (M M^T)^-1 u_d` through the 6x6 Gram matrix (`O(n)`), then each agent outside its
 /// admissible set is clamped onto it (so the result is admissible but the wrench may be off;
 /// [`super::RedistributedPseudoInverse`] redistributes what the clamp loses).
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::PseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = PseudoInverse;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PseudoInverse;
 
 impl<T: Real, const N: usize> Allocator<T, N> for PseudoInverse {
+    /// Nothing to do: the factor of `M M^T` is kept by the [`Effectiveness`] itself.
+    fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {}
+
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
-        saturated_pseudo_inverse(request, None)
+        let factor = request.effectiveness.gram_solver();
+        saturated_pseudo_inverse(request, None, Some(factor))
     }
 
     fn name(&self) -> &'static str {
-        "pseudo-inverse"
+        super::any::PSEUDO_INVERSE
     }
 }
 
 /// The weighted pseudo-inverse: minimizes `sum_i w_i ||f_i||^2` subject to `M f = u_d`, then
 /// clamps as [`PseudoInverse`]. A larger `w_i` makes agent `i` work less.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::WeightedPseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = WeightedPseudoInverse::new([1.0, 1.0, 2.0, 2.0])?;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WeightedPseudoInverse<T: Real, const N: usize> {
     weights: [T; N],
+    /// The factor of `M W^-1 M^T` from [`Allocator::configure`], with the working agents it
+    /// was computed for (used only while they match the request's).
+    configured: Option<([bool; N], GramSolver<T>)>,
 }
 
 impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
@@ -35,10 +78,13 @@ impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
     pub fn new(weights: [T; N]) -> Result<Self, ConfigError> {
         if weights.iter().any(|w| !w.is_finite() || *w <= T::zero()) {
             return Err(ConfigError::Parameter {
-                name: "allocation.weights",
+                field: ConfigField::AllocatorWeights,
             });
         }
-        Ok(Self { weights })
+        Ok(Self {
+            weights,
+            configured: None,
+        })
     }
 
     /// The weights.
@@ -48,18 +94,32 @@ impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
 }
 
 impl<T: Real, const N: usize> Allocator<T, N> for WeightedPseudoInverse<T, N> {
+    /// Factors `M W^-1 M^T` once for this effectiveness.
+    fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
+        let working = working_mask(effectiveness);
+        let gram = gram_of(effectiveness, &working, Some(&self.weights));
+        self.configured = Some((working, GramSolver::new(&gram)));
+    }
+
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
-        saturated_pseudo_inverse(request, Some(&self.weights))
+        let working = working_mask(request.effectiveness);
+        let factor = self
+            .configured
+            .as_ref()
+            .filter(|(mask, _)| *mask == working)
+            .map(|(_, f)| f);
+        saturated_pseudo_inverse(request, Some(&self.weights), factor)
     }
 
     fn name(&self) -> &'static str {
-        "weighted-pseudo-inverse"
+        super::any::WEIGHTED_PSEUDO_INVERSE
     }
 }
 
 fn saturated_pseudo_inverse<T: Real, const N: usize>(
     request: &AllocationRequest<'_, T, N>,
     weights: Option<&[T; N]>,
+    factor: Option<&GramSolver<T>>,
 ) -> Allocation<T, N> {
     let working = working_mask(request.effectiveness);
     let mut forces = [Vector3::zeros(); N];
@@ -67,6 +127,7 @@ fn saturated_pseudo_inverse<T: Real, const N: usize>(
         request.effectiveness,
         &working,
         weights,
+        factor,
         &request.wrench,
         &mut forces,
     );
@@ -83,4 +144,43 @@ fn saturated_pseudo_inverse<T: Real, const N: usize>(
         }
     }
     Allocation::from_forces(request, forces, 1, saturated)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use crate::admissible::AdmissibleSet;
+    use crate::failure::FailureMask;
+    use crate::team::presets;
+    use nalgebra::Vector6;
+
+    #[test]
+    fn configured_factor_gives_the_same_bits_as_a_fresh_one() {
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+        let weights = [1.0, 2.0, 0.5, 3.0];
+        for failed in [&[][..], &[1][..]] {
+            let e = team.effectiveness(&FailureMask::with_failed(failed).unwrap());
+            let request = AllocationRequest {
+                effectiveness: &e,
+                sets: &sets,
+                wrench: Vector6::new(0.3, -0.2, 0.1, 1.0, -2.0, 25.0),
+            };
+            let mut fresh = WeightedPseudoInverse::new(weights).unwrap();
+            let mut configured = fresh;
+            configured.configure(&e);
+            assert!(configured.configured.is_some());
+            assert_eq!(configured.allocate(&request), fresh.allocate(&request));
+            // The effectiveness's own factor of M M^T against a fresh factorization.
+            let mut forces = [Vector3::zeros(); 4];
+            let working = working_mask(&e);
+            pseudo_inverse_forces(&e, &working, None, None, &request.wrench, &mut forces);
+            assert_eq!(PseudoInverse.allocate(&request).forces.len(), 4);
+            let mut cached = [Vector3::zeros(); 4];
+            let f = e.gram_solver();
+            pseudo_inverse_forces(&e, &working, None, Some(f), &request.wrench, &mut cached);
+            assert_eq!(forces, cached);
+        }
+    }
 }

@@ -3,18 +3,38 @@
 use nalgebra::Vector3;
 
 use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
+use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
 
-/// The redistributed pseudo-inverse (Jin 2005; SPEC "Allocation"): solve the pseudo-inverse
+/// The redistributed pseudo-inverse (Jin 2005; `docs/method.md`, "Allocation"): solve the pseudo-inverse
 /// over the free agents; if some leave their admissible set, saturate the one that leaves it
 /// furthest (largest normalized excess, see [`crate::admissible::AdmissibleSet::violation`]),
 /// fix it, and redistribute the remaining wrench over the others. At most `n` rounds; agents
 /// still outside after the last round are clamped. Failed agents never take part.
+///
+/// ```
+/// use tvmd_core::nalgebra::Vector6;
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::RedistributedPseudoInverse;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let mut allocator = RedistributedPseudoInverse;
+/// allocator.configure(&effectiveness);
+/// // Hover: the weight shared by the four agents, exactly.
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, team.mass() * 9.81);
+/// let out = allocator.allocate(&AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench });
+/// assert!(out.e_f < 1e-12 && out.saturated_count() == 0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RedistributedPseudoInverse;
 
 impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
+    /// Nothing to do: the factor of `M M^T` is kept by the [`Effectiveness`] itself.
+    fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {}
+
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
         let e = request.effectiveness;
         let mut free = working_mask(e);
@@ -30,7 +50,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
                     fixed_wrench -= b * f;
                 }
             }
-            pseudo_inverse_forces(e, &free, None, &fixed_wrench, &mut forces);
+            // Round 1 inverts every working agent: the effectiveness's own factor of `M M^T`.
+            let factor = (rounds == 1).then(|| e.gram_solver());
+            pseudo_inverse_forces(e, &free, None, factor, &fixed_wrench, &mut forces);
             let worst = forces
                 .iter()
                 .zip(request.sets)
@@ -73,6 +95,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
     }
 
     fn name(&self) -> &'static str {
-        "redistributed-pseudo-inverse"
+        super::any::REDISTRIBUTED_PSEUDO_INVERSE
     }
 }

@@ -2,10 +2,11 @@
 #![allow(dead_code)]
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use tvmd_sim::actuators::AgentCommand;
-use tvmd_sim::physics::{RigidState, TeamBody};
-use tvmd_sim::reference::Reference;
-use tvmd_sim::sim::{ControlOutput, Diagnostics, FlightController, LyapunovDiagnostics};
+use tvmd_sim::actuators::ActuatorCommand;
+use tvmd_sim::diagnostics::{Diagnostics, LyapunovDiagnostics};
+use tvmd_sim::flight::{FlightController, FlightOutput};
+use tvmd_sim::physics::{PlantState, TeamBody};
+use tvmd_sim::reference::ReferenceSample;
 use tvmd_sim::GRAVITY;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;
@@ -56,14 +57,14 @@ impl FlightController for PdHover {
     fn step(
         &mut self,
         t: f64,
-        s: &RigidState,
-        r: &Reference,
+        s: &PlantState,
+        r: &ReferenceSample,
         failed: &[bool],
-    ) -> Result<ControlOutput, BoxedError> {
+    ) -> Result<FlightOutput, BoxedError> {
         let n = self.alloc.nrows();
         if self.cut_at.is_some_and(|c| t >= c) {
-            return Ok(ControlOutput {
-                commands: vec![AgentCommand::default(); n],
+            return Ok(FlightOutput {
+                commands: vec![ActuatorCommand::default(); n],
                 ..Default::default()
             });
         }
@@ -75,7 +76,7 @@ impl FlightController for PdHover {
         let tau = -self.kr * er - self.kw * s.omega;
         let t_i = &self.alloc * DVector::from_vec(vec![thrust, tau.x, tau.y]);
         let commands = (0..n)
-            .map(|i| AgentCommand {
+            .map(|i| ActuatorCommand {
                 eta_x: 0.0,
                 eta_y: 0.0,
                 thrust: if failed.get(i).copied().unwrap_or(false) {
@@ -92,7 +93,7 @@ impl FlightController for PdHover {
             }),
             ..Default::default()
         };
-        Ok(ControlOutput {
+        Ok(FlightOutput {
             commands,
             diagnostics,
         })
@@ -102,10 +103,10 @@ impl FlightController for PdHover {
 /// Zero thrust always.
 pub fn zero_thrust(
     n: usize,
-) -> impl FnMut(f64, &RigidState, &Reference, &[bool]) -> Result<ControlOutput, BoxedError> {
+) -> impl FnMut(f64, &PlantState, &ReferenceSample, &[bool]) -> Result<FlightOutput, BoxedError> {
     move |_, _, _, _| {
-        Ok(ControlOutput {
-            commands: vec![AgentCommand::default(); n],
+        Ok(FlightOutput {
+            commands: vec![ActuatorCommand::default(); n],
             ..Default::default()
         })
     }

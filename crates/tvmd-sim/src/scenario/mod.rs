@@ -55,32 +55,22 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::actuators::{ActuatorLimits, ActuatorModel, FailureKind};
+use crate::actuators::{ActuatorModel, FailureKind, SaturationLimits};
 use crate::physics::{AgentBody, PhysicsConfig, TeamBody, DEFAULT_COLLIDER_RADIUS};
-use crate::reference::{PaperTilt, ReferenceConfig};
+use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
 
-/// Names of the built-in scenarios, for [`Scenario::builtin`].
-pub const BUILTIN_NAMES: &[&str] = &[
-    "paper-tilt",
-    "relaxation-0.25",
-    "relaxation-0.5",
-    "relaxation-0.75",
-    "relaxation-1.0",
-    "paper-tilt-sigma-y-pi6",
-    "a4-con",
-    "a4-inc",
-    "agent-failure",
-    "a6-agent-failure",
-];
+mod builtin;
+mod overrides;
+mod validate;
 
-/// Allocator names a scenario may give (`"clarabel"` needs the `clarabel` feature at run time).
-pub const ALLOCATOR_NAMES: &[&str] = &[
-    "redistributed-pseudo-inverse",
-    "pseudo-inverse",
-    "weighted-pseudo-inverse",
-    "clarabel",
-];
+pub use builtin::BUILTIN_NAMES;
+pub use overrides::Overrides;
+use validate::invalid;
+
+/// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
+/// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
+pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
 
 /// The team: a preset or explicit agents.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -166,7 +156,7 @@ impl TeamSpec {
 /// Gimbal and thrust limits (eq. 6).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct Limits {
+pub struct LimitsConfig {
     /// `sigma_x` (rad); `pi/6`.
     pub sigma_x: f64,
     /// `sigma_y` (rad); `pi/4`.
@@ -176,7 +166,7 @@ pub struct Limits {
     pub max_thrust: Option<f64>,
 }
 
-impl Default for Limits {
+impl Default for LimitsConfig {
     fn default() -> Self {
         Self {
             sigma_x: PI / 6.0,
@@ -189,7 +179,7 @@ impl Default for Limits {
 /// Controller gains (diagonals), not scaled by mass or inertia.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct Gains {
+pub struct GainsConfig {
     /// `K_x`; `[0.4, 0.4, 1]`.
     pub k_x: [f64; 3],
     /// `K_R`; `[12, 12, 1]`.
@@ -198,7 +188,7 @@ pub struct Gains {
     pub k_xi: [f64; 6],
 }
 
-impl Default for Gains {
+impl Default for GainsConfig {
     fn default() -> Self {
         Self {
             k_x: [0.4, 0.4, 1.0],
@@ -325,9 +315,9 @@ pub struct Scenario {
     /// The team.
     pub team: TeamSpec,
     /// Gimbal and thrust limits.
-    pub limits: Limits,
+    pub limits: LimitsConfig,
     /// Controller gains.
-    pub gains: Gains,
+    pub gains: GainsConfig,
     /// Reference trajectory.
     pub reference: ReferenceConfig,
     /// Actuator model (ideal by default).
@@ -353,43 +343,13 @@ impl Default for Scenario {
             controller_rate_limits: None,
             physics: PhysicsConfig::default(),
             team: TeamSpec::default(),
-            limits: Limits::default(),
-            gains: Gains::default(),
+            limits: LimitsConfig::default(),
+            gains: GainsConfig::default(),
             reference: ReferenceConfig::default(),
             actuators: ActuatorModel::default(),
             failures: Vec::new(),
             disturbances: Disturbances::default(),
         }
-    }
-}
-
-fn invalid(field: impl Into<String>, reason: impl Into<String>) -> SimError {
-    SimError::InvalidScenario {
-        field: field.into(),
-        reason: reason.into(),
-    }
-}
-
-fn check_pos(field: &str, v: f64) -> Result<(), SimError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(field, format!("must be finite and > 0, got {v}")))
-    }
-}
-
-fn check_nonneg(field: &str, v: &[f64]) -> Result<(), SimError> {
-    match v.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
-        None => Ok(()),
-        Some(x) => Err(invalid(field, format!("must be finite and >= 0, got {x}"))),
-    }
-}
-
-fn check_finite(field: &str, v: &[f64]) -> Result<(), SimError> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(invalid(field, "must be finite"))
     }
 }
 
@@ -429,96 +389,24 @@ impl Scenario {
         })
     }
 
+    /// The scenario named by a command-line or Python argument: a TOML file if `name_or_path`
+    /// ends in `.toml` or names an existing file, else a built-in (see [`BUILTIN_NAMES`]).
+    /// Errors: [`SimError::Io`] for a file that cannot be read, [`SimError::ScenarioParse`] /
+    /// [`SimError::InvalidScenario`] naming the field, [`SimError::UnknownScenario`].
+    pub fn load(name_or_path: &str) -> Result<Self, SimError> {
+        let path = Path::new(name_or_path);
+        if name_or_path.ends_with(".toml") || path.is_file() {
+            Self::from_file(path)
+        } else {
+            Self::builtin(name_or_path)
+        }
+    }
+
     /// Serialises the scenario as TOML (the format [`Scenario::from_toml_str`] reads).
     pub fn to_toml_string(&self) -> Result<String, SimError> {
         toml::to_string(self).map_err(|e| SimError::ScenarioParse {
             path: None,
             message: e.to_string(),
-        })
-    }
-
-    /// A built-in scenario by name (see [`BUILTIN_NAMES`]).
-    pub fn builtin(name: &str) -> Result<Self, SimError> {
-        let mut s = Scenario::default();
-        let with = |mut s: Scenario, description: &str| {
-            s.name = name.to_string();
-            s.description = description.to_string();
-            s
-        };
-        Ok(match name {
-            "paper-tilt" => s,
-            "relaxation-0.25" | "relaxation-0.5" | "relaxation-0.75" | "relaxation-1.0" => {
-                s.relaxation = match name {
-                    "relaxation-0.25" => 0.25,
-                    "relaxation-0.5" => 0.5,
-                    "relaxation-0.75" => 0.75,
-                    _ => 1.0,
-                };
-                let d = format!("Relaxation study: paper-tilt with s = {}", s.relaxation);
-                with(s, &d)
-            }
-            "paper-tilt-sigma-y-pi6" => {
-                s.limits.sigma_y = PI / 6.0;
-                with(
-                    s,
-                    "paper-tilt with sigma_y = pi/6: the planned roll saturates at exactly pi/12",
-                )
-            }
-            "a4-con" => {
-                s.team.preset = Some("a4-con".into());
-                with(s, "paper-tilt flown by the consistent team A4-Con")
-            }
-            "a4-inc" => {
-                s.team.preset = Some("a4-inc".into());
-                with(
-                    s,
-                    "paper-tilt flown by the inconsistent team A4-Inc (the paper's)",
-                )
-            }
-            "agent-failure" => {
-                s.initial_position = [0.0, 0.0, 0.0];
-                s.reference = ReferenceConfig::PaperTilt(PaperTilt {
-                    roll_peak: 0.0,
-                    ..PaperTilt::default()
-                });
-                s.failures = vec![Failure {
-                    agent: 0,
-                    time: 5.0,
-                    kind: FailureKind::NoThrust,
-                    controller_informed: true,
-                }];
-                with(
-                    s,
-                    "A4-Inc ascends and hovers at 1.5 m; agent 0 loses its thrust at t = 5 s \
-                     (controller informed); descent at 12 s",
-                )
-            }
-            "a6-agent-failure" => {
-                s.initial_position = [0.0, 0.0, 0.0];
-                s.reference = ReferenceConfig::PaperTilt(PaperTilt {
-                    roll_peak: 0.0,
-                    ..PaperTilt::default()
-                });
-                s.team.agents = Some(TeamBody::ring(6, 0.5, 0.7, true).agents);
-                s.failures = vec![Failure {
-                    agent: 0,
-                    time: 5.0,
-                    kind: FailureKind::NoThrust,
-                    controller_informed: true,
-                }];
-                with(
-                    s,
-                    "A6-Inc ring (radius 0.5 m, alternate quarter turns) ascends and hovers at \
-                     1.5 m; agent 0 loses its thrust at t = 5 s (controller informed); descent \
-                     at 12 s",
-                )
-            }
-            other => {
-                return Err(SimError::UnknownScenario {
-                    name: other.to_string(),
-                    known: BUILTIN_NAMES.join(", "),
-                })
-            }
         })
     }
 
@@ -538,8 +426,8 @@ impl Scenario {
     }
 
     /// The actuator limits of this scenario (for an actuator model that saturates).
-    pub fn actuator_limits(&self) -> Result<ActuatorLimits, SimError> {
-        Ok(ActuatorLimits {
+    pub fn actuator_limits(&self) -> Result<SaturationLimits, SimError> {
+        Ok(SaturationLimits {
             sigma_x: self.limits.sigma_x,
             sigma_y: self.limits.sigma_y,
             max_thrust: self.max_thrust()?,
@@ -561,135 +449,11 @@ impl Scenario {
         }
         Ok(n as usize)
     }
-
-    /// Checks values that parse but make no sense; errors name the field.
-    pub fn validate(&self) -> Result<(), SimError> {
-        check_pos("duration", self.duration)?;
-        check_pos("physics.dt", self.physics.dt)?;
-        check_pos("controller_period", self.controller_period)?;
-        self.steps_per_control()?;
-        check_nonneg("physics.gravity", &[self.physics.gravity])?;
-        check_nonneg("physics.friction", &[self.physics.friction])?;
-        check_finite("initial_position", &self.initial_position)?;
-        if !(self.relaxation > 0.0 && self.relaxation <= 1.0) {
-            return Err(invalid(
-                "relaxation",
-                format!("must be in (0, 1], got {}", self.relaxation),
-            ));
-        }
-        for (f, v) in [
-            ("limits.sigma_x", self.limits.sigma_x),
-            ("limits.sigma_y", self.limits.sigma_y),
-        ] {
-            if !(v > 0.0 && v <= PI) {
-                return Err(invalid(f, format!("must be in (0, pi], got {v}")));
-            }
-        }
-        if let Some(t) = self.limits.max_thrust {
-            check_pos("limits.max_thrust", t)?;
-        }
-        if !ALLOCATOR_NAMES.contains(&self.allocator.as_str()) {
-            return Err(invalid(
-                "allocator",
-                format!(
-                    "unknown allocator `{}` (known: {})",
-                    self.allocator,
-                    ALLOCATOR_NAMES.join(", ")
-                ),
-            ));
-        }
-        if let Some([x, y]) = self.controller_rate_limits {
-            check_pos("controller_rate_limits[0]", x)?;
-            check_pos("controller_rate_limits[1]", y)?;
-        }
-        check_nonneg("gains.k_x", &self.gains.k_x)?;
-        check_nonneg("gains.k_r", &self.gains.k_r)?;
-        check_nonneg("gains.k_xi", &self.gains.k_xi)?;
-        let team = self.team_body()?;
-        match &self.reference {
-            ReferenceConfig::PaperTilt(p) => {
-                check_finite("reference.ascent_height", &[p.ascent_height])?;
-                check_finite("reference.roll_peak", &[p.roll_peak])?;
-                for (f, w) in [
-                    ("reference.ascent", p.ascent),
-                    ("reference.tilt", p.tilt),
-                    ("reference.descent", p.descent),
-                ] {
-                    check_finite(f, &w)?;
-                    if w[1] < w[0] {
-                        return Err(invalid(f, "end before start"));
-                    }
-                }
-            }
-            ReferenceConfig::Hover { position, roll } => {
-                check_finite("reference.position", position)?;
-                check_finite("reference.roll", &[*roll])?;
-            }
-        }
-        if let Some(s) = &self.actuators.servo {
-            check_pos("actuators.servo.natural_frequency", s.natural_frequency)?;
-            check_nonneg("actuators.servo.damping_ratio", &[s.damping_ratio])?;
-            check_pos("actuators.servo.rate_limit", s.rate_limit)?;
-        }
-        if let Some(l) = &self.actuators.rotor_lag {
-            check_pos("actuators.rotor_lag.time_constant", l.time_constant)?;
-        }
-        if let Some(l) = &self.actuators.limits {
-            check_pos("actuators.limits.sigma_x", l.sigma_x)?;
-            check_pos("actuators.limits.sigma_y", l.sigma_y)?;
-            check_pos("actuators.limits.max_thrust", l.max_thrust)?;
-        }
-        for (i, f) in self.failures.iter().enumerate() {
-            if f.agent >= team.len() {
-                return Err(invalid(
-                    format!("failures[{i}].agent"),
-                    format!(
-                        "agent {} does not exist (the team has {})",
-                        f.agent,
-                        team.len()
-                    ),
-                ));
-            }
-            check_nonneg(&format!("failures[{i}].time"), &[f.time])?;
-        }
-        check_finite("disturbances.wind", &self.disturbances.wind)?;
-        if let Some(w) = &self.disturbances.external_wrench {
-            check_finite("disturbances.external_wrench.force", &w.force)?;
-            check_finite("disturbances.external_wrench.torque", &w.torque)?;
-            check_finite("disturbances.external_wrench.start", &[w.start])?;
-            if let Some(e) = w.end {
-                check_finite("disturbances.external_wrench.end", &[e])?;
-            }
-        }
-        if let Some(n) = &self.disturbances.state_noise {
-            check_nonneg(
-                "disturbances.state_noise",
-                &[n.position, n.velocity, n.attitude, n.angular_velocity],
-            )?;
-        }
-        Ok(())
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn builtins_validate_and_round_trip() {
-        for name in BUILTIN_NAMES {
-            let s = Scenario::builtin(name).unwrap();
-            s.validate().unwrap();
-            assert_eq!(&s.name, name);
-            let text = s.to_toml_string().unwrap();
-            let back = Scenario::from_toml_str(&text).unwrap();
-            assert_eq!(back, s, "round trip of {name}:\n{text}");
-        }
-        assert!(matches!(
-            Scenario::builtin("nope"),
-            Err(SimError::UnknownScenario { .. })
-        ));
-    }
 
     #[test]
     fn empty_file_is_paper_tilt() {
@@ -720,21 +484,6 @@ mod tests {
         assert!(e.to_string().contains("step"), "{e}");
         let e = Scenario::from_toml_str("[physics]\ndt = \"x\"\n").unwrap_err();
         assert!(e.to_string().contains("physics.dt"), "{e}");
-    }
-
-    #[test]
-    fn bad_values_name_the_field() {
-        let e = Scenario::from_toml_str("relaxation = 1.5\n").unwrap_err();
-        assert!(
-            matches!(&e, SimError::InvalidScenario { field, .. } if field == "relaxation"),
-            "{e}"
-        );
-        let e = Scenario::from_toml_str("controller_period = 0.0125\n").unwrap_err();
-        assert!(e.to_string().contains("controller_period"), "{e}");
-        let e =
-            Scenario::from_toml_str("[[failures]]\nagent = 7\ntime = 1.0\nkind = \"no-thrust\"\n")
-                .unwrap_err();
-        assert!(e.to_string().contains("failures[0].agent"), "{e}");
     }
 
     #[test]
@@ -778,5 +527,36 @@ state_noise = { position = 0.01, seed = 7 }
         assert_eq!(s.disturbances.state_noise.unwrap().seed, 7);
         assert_eq!(s.max_thrust().unwrap(), 12.0);
         assert!(matches!(s.reference, ReferenceConfig::Hover { .. }));
+    }
+
+    #[test]
+    fn load_takes_a_builtin_name_or_a_file() {
+        assert_eq!(
+            Scenario::load("a4-con").unwrap(),
+            Scenario::builtin("a4-con").unwrap()
+        );
+        assert!(matches!(
+            Scenario::load("nope"),
+            Err(SimError::UnknownScenario { .. })
+        ));
+        assert!(matches!(
+            Scenario::load("missing-file.toml"),
+            Err(SimError::Io(_))
+        ));
+        let dir = std::env::temp_dir().join(format!("tvmd-sim-load-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A file without the .toml suffix is still a file.
+        let path = dir.join("scenario");
+        std::fs::write(&path, "name = \"from-file\"\nrelaxation = 1.0\n").unwrap();
+        let s = Scenario::load(path.to_str().unwrap()).unwrap();
+        assert_eq!((s.name.as_str(), s.relaxation), ("from-file", 1.0));
+        std::fs::write(&path, "[physics]\ndt = -1.0\n").unwrap();
+        let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("invalid scenario field `physics.dt`"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,0 +1,110 @@
+//! The diagnostics schema: what a controller may report at each tick, recorded in the samples
+//! and logged on `/planner`, `/control`, `/allocation` and `/lyapunov` (see the module `log`).
+//! The field names are the MCAP messages' and stay stable.
+
+use serde::{Deserialize, Serialize};
+
+/// Attitude-planner diagnostics (logged on `/planner`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlannerDiagnostics {
+    /// Planned attitude `R_d`, row-major.
+    pub r_d: [[f64; 3]; 3],
+    /// Bisection angle `theta*` (rad); 0 when `R_d = R_r`.
+    pub theta: f64,
+    /// Thrust scaling `t_Tf`.
+    pub t_tf: f64,
+    /// Gimbal scaling `t_eta`.
+    pub t_eta: f64,
+    /// Whether `R_r` itself was feasible.
+    pub reference_feasible: bool,
+    /// Planned roll `atan2(R_d[2,1], R_d[2,2])` (rad).
+    #[serde(default)]
+    pub planned_roll: f64,
+    /// How the planner reached `R_d` (e.g. `already-feasible`, `planned`).
+    #[serde(default)]
+    pub status: String,
+    /// Bisection iterations used.
+    #[serde(default)]
+    pub iterations: u32,
+}
+
+/// Control-law diagnostics (logged on `/control`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ControlDiagnostics {
+    /// `u_r = [tau; f]` before projection.
+    pub u_r: [f64; 6],
+    /// `u_d = blockdiag(I, K_f) u_r`.
+    pub u_d: [f64; 6],
+    /// `e_x` (m).
+    pub e_x: [f64; 3],
+    /// `e_v` (m/s).
+    pub e_v: [f64; 3],
+    /// `e_R`.
+    pub e_r: [f64; 3],
+    /// `e_Omega` (rad/s).
+    pub e_omega: [f64; 3],
+    /// Thrust scaling `t_Tf` of the force projection.
+    #[serde(default)]
+    pub t_tf: f64,
+    /// Gimbal scaling `t_eta` of the force projection.
+    #[serde(default)]
+    pub t_eta: f64,
+    /// Anything else the controller wants logged.
+    #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
+    pub extra: serde_json::Value,
+}
+
+/// Allocation diagnostics (logged on `/allocation`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AllocationDiagnostics {
+    /// Wrench `M f` of the allocated agent forces, `[tau; f]`.
+    pub wrench: [f64; 6],
+    /// Allocation error `e_f = ||u_fd - u_f||` (N).
+    pub e_f: f64,
+    /// Per agent: whether the allocator saturated it.
+    pub saturated: Vec<bool>,
+    /// `||u_d - M f||` over the whole wrench.
+    #[serde(default)]
+    pub wrench_error: f64,
+    /// Solve rounds (pseudo-inverse 1, redistribution up to `n`, Clarabel: iterations).
+    #[serde(default)]
+    pub rounds: u32,
+    /// The allocator fell back to another method.
+    #[serde(default)]
+    pub fallback: bool,
+    /// Allocated agent-frame forces `f_i` (N).
+    #[serde(default)]
+    pub forces: Vec<[f64; 3]>,
+    /// Rotor speeds of the commands (normalised to 1 at maximum thrust unless rotor constants
+    /// are given).
+    #[serde(default)]
+    pub rotor_speeds: Vec<f64>,
+}
+
+/// Lyapunov candidates (logged on `/lyapunov`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LyapunovDiagnostics {
+    /// `V_x = ||e_x||_{K_x} + ||e_v||_{K_v}`.
+    pub v_x: f64,
+    /// `V_R = Psi(R, R_d) + ||e_Omega||_{K_Omega}`.
+    pub v_r: f64,
+}
+
+/// Optional diagnostics returned by a controller; every present part is logged and recorded.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Diagnostics {
+    /// Planner.
+    pub planner: Option<PlannerDiagnostics>,
+    /// Control law.
+    pub control: Option<ControlDiagnostics>,
+    /// Allocation.
+    pub allocation: Option<AllocationDiagnostics>,
+    /// Lyapunov candidates.
+    pub lyapunov: Option<LyapunovDiagnostics>,
+    /// The controller skipped this cycle and held its previous commands, for this reason.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_error: Option<String>,
+    /// A note on the failure mask (e.g. the controller could not use the reported failures).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure_note: Option<String>,
+}

@@ -1,0 +1,80 @@
+//! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator`, the
+//! Python keywords `relaxation=` / `allocator=`), applied with validation.
+
+use super::Scenario;
+use crate::SimError;
+
+/// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// Planner relaxation `s` in `(0, 1]`.
+    pub relaxation: Option<f64>,
+    /// Allocator name (one of [`super::ALLOCATOR_NAMES`]).
+    pub allocator: Option<String>,
+}
+
+impl Overrides {
+    /// True if nothing is overridden.
+    pub fn is_empty(&self) -> bool {
+        self.relaxation.is_none() && self.allocator.is_none()
+    }
+
+    /// Applies the overrides to `scenario` and validates the result; errors name the field.
+    pub fn apply(&self, scenario: &mut Scenario) -> Result<(), SimError> {
+        if let Some(s) = self.relaxation {
+            scenario.relaxation = s;
+        }
+        if let Some(a) = &self.allocator {
+            scenario.allocator.clone_from(a);
+        }
+        scenario.validate()
+    }
+}
+
+impl Scenario {
+    /// This scenario with `overrides` applied, validated.
+    pub fn with_overrides(mut self, overrides: &Overrides) -> Result<Self, SimError> {
+        overrides.apply(&mut self)?;
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_replace_and_validate() {
+        let o = Overrides {
+            relaxation: Some(1.0),
+            allocator: Some("pseudo-inverse".into()),
+        };
+        let s = Scenario::default().with_overrides(&o).unwrap();
+        assert_eq!(s.relaxation, 1.0);
+        assert_eq!(s.allocator, "pseudo-inverse");
+        assert_eq!(
+            Scenario::default()
+                .with_overrides(&Overrides::default())
+                .unwrap(),
+            Scenario::default()
+        );
+        let bad = Overrides {
+            relaxation: Some(1.5),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "relaxation"),
+            "{e}"
+        );
+        let bad = Overrides {
+            allocator: Some("magic".into()),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "allocator"),
+            "{e}"
+        );
+    }
+}

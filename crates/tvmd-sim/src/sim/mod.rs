@@ -1,0 +1,315 @@
+//! The digital control loop.
+//!
+//! Physics runs at `physics.dt`; the controller runs every `controller_period` (an integer
+//! number of physics steps) and its commands are held (zero-order hold) until the next call.
+//! Actuators, failures and disturbances act at the physics rate. Each controller tick
+//! (`t_k = k controller_period`):
+//!
+//! 1. the true state is read and, if configured, noise is added to the copy fed back;
+//! 2. the reference is evaluated at `t_k`;
+//! 3. the controller is called with the state, the reference and the failure flags it is
+//!    told about (a failure with `controller_informed = false` stays `false` for it);
+//! 4. the sample (true state, reference, commands, diagnostics) is recorded ([`sample`]) and
+//!    logged ([`tick_log`]).
+//!
+//! Then `steps_per_control` physics steps follow, each one: failures whose time has come are
+//! applied, the actuators move towards the held commands, and the agents' body-frame forces
+//! (plus wind and external wrench) are applied for one step. The summary of a run is computed
+//! from its samples ([`summary`]).
+
+pub mod sample;
+pub mod summary;
+pub mod tick_log;
+
+use nalgebra::{Rotation3, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use serde::Serialize;
+
+use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
+use crate::flight::FlightController;
+use crate::log::McapLog;
+use crate::physics::{ExtraWrench, PhysicsWorld, PlantState, TeamBody};
+use crate::scenario::{Failure, Scenario, StateNoise};
+use crate::SimError;
+
+pub use sample::Sample;
+pub use summary::{PaperMetrics, RunSummary, RunTotals, VxRise};
+
+/// Result of a run: the samples and a summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunResult {
+    /// Samples at the controller rate.
+    pub samples: Vec<Sample>,
+    /// Summary.
+    pub summary: RunSummary,
+}
+
+/// Options that are not part of the scenario.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimOptions {
+    /// Period of `/scene` messages (s); rounded to a multiple of the controller period.
+    pub scene_period: f64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self { scene_period: 0.05 }
+    }
+}
+
+/// A simulation of one scenario.
+pub struct Simulation {
+    scenario: Scenario,
+    team: TeamBody,
+    world: PhysicsWorld,
+    actuators: ActuatorBank,
+    steps_per_control: usize,
+    total_steps: usize,
+    failures: Vec<Failure>,
+    applied: Vec<bool>,
+    failed_true: Vec<bool>,
+    failed_told: Vec<bool>,
+    noise: Option<(StateNoise, ChaCha8Rng)>,
+    max_thrust: f64,
+    options: SimOptions,
+    samples: Vec<Sample>,
+    step_index: usize,
+    controller_calls: usize,
+    wall_time: f64,
+}
+
+impl Simulation {
+    /// Builds the simulation: validates the scenario, builds the world with the team resting
+    /// at `initial_position` (identity attitude) and the actuators at rest.
+    pub fn new(scenario: &Scenario) -> Result<Self, SimError> {
+        Self::with_options(scenario, SimOptions::default())
+    }
+
+    /// As [`Simulation::new`], with options.
+    pub fn with_options(scenario: &Scenario, options: SimOptions) -> Result<Self, SimError> {
+        scenario.validate()?;
+        let team = scenario.team_body()?;
+        let initial = PlantState::at_rest(Vector3::from(scenario.initial_position));
+        let world = PhysicsWorld::new(&team, &scenario.physics, &initial)?;
+        let n = team.len();
+        let mut failures = scenario.failures.clone();
+        failures.sort_by(|a, b| a.time.total_cmp(&b.time));
+        let steps_per_control = scenario.steps_per_control()?;
+        let total_steps = (scenario.duration / scenario.physics.dt).round() as usize;
+        Ok(Self {
+            actuators: ActuatorBank::new(scenario.actuators, n),
+            applied: vec![false; failures.len()],
+            failures,
+            failed_true: vec![false; n],
+            failed_told: vec![false; n],
+            noise: scenario
+                .disturbances
+                .state_noise
+                .map(|s| (s, ChaCha8Rng::seed_from_u64(s.seed))),
+            max_thrust: scenario.max_thrust()?,
+            scenario: scenario.clone(),
+            team,
+            world,
+            steps_per_control,
+            total_steps,
+            options,
+            samples: Vec::new(),
+            step_index: 0,
+            controller_calls: 0,
+            wall_time: 0.0,
+        })
+    }
+
+    /// The physics world.
+    pub fn world(&self) -> &PhysicsWorld {
+        &self.world
+    }
+
+    /// The team.
+    pub fn team(&self) -> &TeamBody {
+        &self.team
+    }
+
+    /// The scenario.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Samples recorded so far (also available after a failed run).
+    pub fn samples(&self) -> &[Sample] {
+        &self.samples
+    }
+
+    fn noisy(&mut self, s: &PlantState) -> PlantState {
+        let Some((n, rng)) = self.noise.as_mut() else {
+            return *s;
+        };
+        let mut g = |std: f64| -> Vector3<f64> {
+            Vector3::new(
+                rng.sample::<f64, _>(StandardNormal),
+                rng.sample::<f64, _>(StandardNormal),
+                rng.sample::<f64, _>(StandardNormal),
+            ) * std
+        };
+        let dp = g(n.position);
+        let dv = g(n.velocity);
+        let da = g(n.attitude);
+        let dw = g(n.angular_velocity);
+        PlantState {
+            position: s.position + dp,
+            rotation: s.rotation * Rotation3::new(da).into_inner(),
+            velocity: s.velocity + dv,
+            omega: s.omega + dw,
+        }
+    }
+
+    fn extra_wrench(&self, t: f64) -> ExtraWrench {
+        let d = &self.scenario.disturbances;
+        let mut w = ExtraWrench {
+            force_world: Vector3::from(d.wind),
+            ..Default::default()
+        };
+        if let Some(e) = d.external_wrench.as_ref().filter(|e| e.active(t)) {
+            w.force_world += Vector3::from(e.force);
+            w.torque_body += Vector3::from(e.torque);
+        }
+        w
+    }
+
+    fn apply_failures(&mut self, t: f64) {
+        for (k, f) in self.failures.iter().enumerate() {
+            if !self.applied[k] && f.time <= t + 1e-12 {
+                self.applied[k] = true;
+                self.actuators.fail(f.agent, f.kind);
+                self.failed_true[f.agent] = true;
+                if f.controller_informed {
+                    self.failed_told[f.agent] = true;
+                }
+            }
+        }
+    }
+
+    fn forces(&self, actual: &[ActuatorCommand]) -> Vec<Vector3<f64>> {
+        actual
+            .iter()
+            .zip(&self.team.agents)
+            .map(|(c, a)| agent_force_body(c, a.quarter_turns))
+            .collect()
+    }
+
+    /// Runs the scenario to its end with `controller`, logging to `log` if given.
+    ///
+    /// On error the samples recorded so far stay available through
+    /// [`Simulation::samples`]; the caller's log stays valid (finalised on drop).
+    pub fn run(
+        &mut self,
+        controller: &mut dyn FlightController,
+        log: Option<&mut McapLog>,
+    ) -> Result<RunResult, SimError> {
+        let start = std::time::Instant::now();
+        let result = self.run_loop(controller, log);
+        self.wall_time += start.elapsed().as_secs_f64();
+        result?;
+        Ok(RunResult {
+            samples: self.samples.clone(),
+            summary: self.summary(),
+        })
+    }
+
+    fn run_loop(
+        &mut self,
+        controller: &mut dyn FlightController,
+        mut log: Option<&mut McapLog>,
+    ) -> Result<(), SimError> {
+        let dt = self.scenario.physics.dt;
+        let period = self.scenario.controller_period;
+        let scene_every = ((self.options.scene_period / period).round() as usize).max(1);
+        let mut held = vec![ActuatorCommand::default(); self.team.len()];
+        while self.step_index < self.total_steps {
+            let k = self.step_index;
+            let t = k as f64 * dt;
+            self.apply_failures(t);
+            if k % self.steps_per_control == 0 {
+                let truth = self.world.state();
+                let fed = self.noisy(&truth);
+                let reference = self.scenario.reference.at(t);
+                let out = controller
+                    .step(t, &fed, &reference, &self.failed_told)
+                    .map_err(|source| SimError::Controller { t, source })?;
+                if out.commands.len() != self.team.len() {
+                    return Err(SimError::InvalidCommand {
+                        t,
+                        reason: format!(
+                            "{} commands for {} agents",
+                            out.commands.len(),
+                            self.team.len()
+                        ),
+                    });
+                }
+                if let Some(i) = out.commands.iter().position(|c| !c.is_finite()) {
+                    return Err(SimError::InvalidCommand {
+                        t,
+                        reason: format!("non-finite command for agent {i}"),
+                    });
+                }
+                held.clone_from(&out.commands);
+                let tick = self.controller_calls;
+                self.controller_calls += 1;
+                let actual = self.actuators.actual();
+                self.samples.push(Sample::record(
+                    t,
+                    &truth,
+                    &reference,
+                    &out,
+                    actual.clone(),
+                    self.failed_true.clone(),
+                ));
+                if let Some(log) = log.as_deref_mut() {
+                    let tick_log = tick_log::Tick {
+                        t,
+                        state: &truth,
+                        reference: &reference,
+                        output: &out,
+                        forces_body: self.forces(&actual),
+                        actual,
+                        failed: &self.failed_true,
+                    };
+                    tick_log.write(log)?;
+                    if tick % scene_every == 0 {
+                        // Show the commanded forces: at a tick the actual ones still lag by one
+                        // period.
+                        let cmd_forces = self.forces(&out.commands);
+                        log.write_scene(
+                            t,
+                            &self.team,
+                            &cmd_forces,
+                            &self.failed_true,
+                            self.max_thrust,
+                        )?;
+                    }
+                }
+            }
+            let actual = self.actuators.step(&held, dt);
+            let forces = self.forces(&actual);
+            let extra = self.extra_wrench(t);
+            self.world.step(&forces, &extra)?;
+            self.step_index += 1;
+        }
+        Ok(())
+    }
+
+    /// Summary of the run so far (final state from the physics, extremes from the samples).
+    pub fn summary(&self) -> RunSummary {
+        let totals = RunTotals {
+            time: self.world.time(),
+            final_state: self.world.state(),
+            mass: self.team.mass(),
+            controller_calls: self.controller_calls,
+            physics_steps: self.step_index,
+            wall_time: self.wall_time,
+        };
+        RunSummary::new(&self.scenario, &self.samples, &totals)
+    }
+}

@@ -1,0 +1,117 @@
+//! What the loop records at each controller tick: [`Sample`].
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::actuators::ActuatorCommand;
+use crate::flight::FlightOutput;
+use crate::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
+
+/// One recorded sample (at each controller tick, true state).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sample {
+    /// Time (s).
+    pub t: f64,
+    /// `x` (m).
+    pub position: [f64; 3],
+    /// `x_dot` (m/s).
+    pub velocity: [f64; 3],
+    /// `x_r` (m).
+    pub reference_position: [f64; 3],
+    /// Roll, pitch, yaw of `R` (rad).
+    pub roll_pitch_yaw: [f64; 3],
+    /// Roll, pitch, yaw of `R_r` (rad).
+    pub reference_roll_pitch_yaw: [f64; 3],
+    /// `phi_r` (rad).
+    pub reference_roll: f64,
+    /// Roll of the planned `R_d` (rad), if the controller reported it.
+    pub planned_roll: Option<f64>,
+    /// Roll, pitch, yaw of the planned `R_d` (rad), if reported.
+    pub planned_roll_pitch_yaw: Option<[f64; 3]>,
+    /// Angle between `R` and the planned `R_d` (rad), if `R_d` was reported.
+    pub attitude_error: Option<f64>,
+    /// Planner angle `theta*` (rad), if reported.
+    pub theta: Option<f64>,
+    /// Allocation error `e_f` (N), if reported.
+    pub e_f: Option<f64>,
+    /// Number of agents the allocator saturated, if reported.
+    pub saturated_agents: Option<usize>,
+    /// `V_x`, if reported.
+    pub v_x: Option<f64>,
+    /// `V_R`, if reported.
+    pub v_r: Option<f64>,
+    /// The controller skipped this cycle (held its previous commands).
+    pub cycle_error: bool,
+    /// Commands returned at this tick.
+    pub commands: Vec<ActuatorCommand>,
+    /// Actual actuator outputs at this tick (before the new commands act).
+    pub actual: Vec<ActuatorCommand>,
+    /// True failure flags.
+    pub failed: Vec<bool>,
+}
+
+/// `[x, y, z]` of a vector.
+pub(crate) fn arr(v: &Vector3<f64>) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn sub3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm3(a: &[f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+impl Sample {
+    /// The sample of a tick: true state `s`, reference `r`, the controller's output, the
+    /// actuators' actual outputs and the true failure flags.
+    pub fn record(
+        t: f64,
+        s: &PlantState,
+        r: &ReferenceSample,
+        out: &FlightOutput,
+        actual: Vec<ActuatorCommand>,
+        failed: Vec<bool>,
+    ) -> Self {
+        let d = &out.diagnostics;
+        let r_d = d.planner.as_ref().map(|p| from_rows(&p.r_d));
+        Self {
+            t,
+            position: arr(&s.position),
+            velocity: arr(&s.velocity),
+            reference_position: arr(&r.position),
+            roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
+            reference_roll_pitch_yaw: roll_pitch_yaw(&r.rotation),
+            reference_roll: r.roll,
+            planned_roll: r_d.as_ref().map(planned_roll),
+            planned_roll_pitch_yaw: r_d.as_ref().map(roll_pitch_yaw),
+            attitude_error: r_d.as_ref().map(|m| rotation_distance(&s.rotation, m)),
+            theta: d.planner.as_ref().map(|p| p.theta),
+            e_f: d.allocation.as_ref().map(|a| a.e_f),
+            saturated_agents: d
+                .allocation
+                .as_ref()
+                .map(|a| a.saturated.iter().filter(|x| **x).count()),
+            v_x: d.lyapunov.map(|l| l.v_x),
+            v_r: d.lyapunov.map(|l| l.v_r),
+            cycle_error: d.cycle_error.is_some(),
+            commands: out.commands.clone(),
+            actual,
+            failed,
+        }
+    }
+
+    /// `||x - x_r||` (m).
+    pub fn position_error(&self) -> f64 {
+        norm3(&sub3(&self.position, &self.reference_position))
+    }
+
+    /// Horizontal position error `||(x - x_r)_{x,y}||` (m).
+    pub fn horizontal_error(&self) -> f64 {
+        let d = sub3(&self.position, &self.reference_position);
+        d[0].hypot(d[1])
+    }
+}
