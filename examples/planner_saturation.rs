@@ -1,7 +1,7 @@
 //! The attitude planner's saturation angle for the paper's A4-Inc team in hover.
 //!
 //! With the reference rolled past the attainable set, the planner stops at
-//! `phi_max = atan(c_y(1, s))` (SPEC, "Reproduction targets"). Run with
+//! `phi_max = atan(c_y(1, s))` (`docs/method.md`, "Reproduction targets"). Run with
 //! `cargo run --release --example planner_saturation`.
 
 use tvmd::core::nalgebra::{Rotation3, Vector3};

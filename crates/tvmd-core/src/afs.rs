@@ -52,7 +52,7 @@ pub struct SemiAxes<T: Real> {
 /// with `C = diag(1/c_x^2, 1/c_y^2, 0)` and `c_x, c_y` from eq. (8).
 ///
 /// A force with `z <= 0` is outside unless a semi-axis comes from the `sigma >= pi/2` branch
-/// (SPEC reading; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
+/// (the reading of `docs/method.md`; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
 /// paper writes `<`, so that the projection's output `t_Tf u` is a member.
 ///
 /// ```

@@ -8,7 +8,7 @@ use crate::real::{lit, Real};
 use crate::rotation::vee;
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
-/// block-diagonal one keeps the force request independent of the planned attitude (SPEC order).
+/// block-diagonal one keeps the force request independent of the planned attitude (the order of `docs/method.md`).
 /// Gains are not scaled by mass or inertia (the paper does not; the authors' MATLAB does).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains<T: Real> {
@@ -186,7 +186,7 @@ pub struct Plant<T: Real> {
 }
 
 /// `u_fr`, the force part of `u_r` (team frame), which does not depend on `R_d`:
-/// `u_fr = m R^T x_r_ddot - K_v e_v - R^T K_x e_x + m g R^T e_3` (SPEC, eq. 12 with
+/// `u_fr = m R^T x_r_ddot - K_v e_v - R^T K_x e_x + m g R^T e_3` (`docs/method.md`, eq. 12 with
 /// `g_C = [0; -m g R^T e_3]`), `e_v = v - R^T x_r_dot`.
 pub fn force_request<T: Real>(
     plant: &Plant<T>,

@@ -18,6 +18,12 @@
 //!
 //! [`Controller`] composes them into one `step` per control period.
 //!
+//! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
+//! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
+//! (e.g. [`projection`] and [`planner`] import [`afs`]; [`allocation`] imports [`admissible`]
+//! and [`effectiveness`]); no stage imports [`team`]; only [`team`] and [`controller`] compose
+//! stages. See `docs/architecture.md`.
+//!
 //! `no_std`, no allocator, generic over [`Real`] (`f32` or `f64`), fixed capacity `N` agents.
 #![no_std]
 #![deny(missing_docs)]
@@ -55,7 +61,7 @@ pub mod real;
 pub mod rotation;
 pub mod team;
 
-pub use admissible::{AdmissibleSet, RateLimits};
+pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 #[cfg(feature = "clarabel")]
 pub use allocation::ClarabelAllocator;
@@ -72,4 +78,6 @@ pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 pub use projection::{project_force, project_force_in, ForceProjection};
 pub use real::Real;
-pub use team::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};
+pub use failure::FailureMask;
+pub use limits::{AgentLimits, RateLimits};
+pub use team::{AgentSpec, Arrangement, Navigator, TeamConfig};

@@ -61,7 +61,7 @@ pub struct PlannerOutput<T: Real> {
     pub status: PlannerStatus,
 }
 
-/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in SPEC:
+/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in `docs/method.md`:
 /// it returns the last *feasible* bisection point, stops on a tolerance or an iteration cap, and
 /// tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
 ///

@@ -7,7 +7,7 @@ use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
 
-/// The redistributed pseudo-inverse (Jin 2005; SPEC "Allocation"): solve the pseudo-inverse
+/// The redistributed pseudo-inverse (Jin 2005; `docs/method.md`, "Allocation"): solve the pseudo-inverse
 /// over the free agents; if some leave their admissible set, saturate the one that leaves it
 /// furthest (largest normalized excess, see [`crate::admissible::AdmissibleSet::violation`]),
 /// fix it, and redistribute the remaining wrench over the others. At most `n` rounds; agents

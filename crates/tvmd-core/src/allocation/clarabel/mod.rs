@@ -30,7 +30,7 @@ use qp::Problem;
 pub use report::{ClarabelStatus, FallbackReason, SolveReport};
 use settings::{default_settings, DEFAULT_LAMBDA};
 
-/// The constrained allocator of the SPEC ("Allocation"): a QP with second-order cones solved by
+/// The constrained allocator of `docs/method.md` ("Allocation"): a QP with second-order cones solved by
 /// [Clarabel](https://clarabel.org) over the working agents' forces `f` (agent frames):
 ///
 /// ```text
@@ -42,7 +42,7 @@ use settings::{default_settings, DEFAULT_LAMBDA};
 /// ```
 ///
 /// per agent, from its [`AdmissibleSet`] `{eta_x in [lo_x, hi_x], eta_y in [lo_y, hi_y], T in
-/// [T_lo, T_hi]}`. In the symmetric case of eq. (6) this is the SPEC's pyramid `|f_x| <= f_z
+/// [T_lo, T_hi]}`. In the symmetric case of eq. (6) this is the method's pyramid `|f_x| <= f_z
 /// tan(sigma_y)`, `|f_y| <= f_z tan(sigma_x)`, `f_z >= 0`, `||f|| <= sigma_Tf`.
 ///
 /// # Why the constraints lie inside the admissible set
