@@ -1,10 +1,11 @@
 //! The control law (eq. 12): `Gains`, `State`, `Reference`, `Plant`, `LawOutput` and the
 //! functions `force_request` and `control_wrench` binding `tvmd_core::law`.
 
-use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use pyo3::{PyClass, PyTypeInfo};
 
 use tvmd_core::law::{control_wrench as core_control_wrench, force_request as core_force_request};
 use tvmd_core::law::{LawOutput, Plant};
@@ -107,27 +108,21 @@ pub(crate) fn gains_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Gains<f64>> 
     }
 }
 
-const STATE_KEYS: &[&str] = &["position", "attitude", "angular_velocity", "velocity"];
-const REFERENCE_KEYS: &[&str] = &[
-    "position",
-    "velocity",
-    "acceleration",
-    "attitude",
-    "angular_velocity",
-    "angular_acceleration",
-];
-
-/// The values of a `State` / `Reference` dict, in `keys` order (`position` required).
-fn dict_values<'py>(
+/// `obj` if it is a `T` (`State` / `Reference`), else `T(**obj)` for a dict `obj` of known
+/// keys with a `position`.
+fn record_arg<'py, T: PyClass + PyTypeInfo>(
     obj: &Bound<'py, PyAny>,
     what: &str,
-    class: &str,
     keys: &[&str],
-) -> PyResult<Vec<Option<Bound<'py, PyAny>>>> {
+) -> PyResult<Bound<'py, T>> {
+    if let Ok(record) = obj.cast::<T>() {
+        return Ok(record.clone());
+    }
+    let keys_list = keys.join(", ");
     let dict = obj.cast::<PyDict>().map_err(|_| {
-        let keys = keys.join(", ");
+        let class = T::NAME;
         PyTypeError::new_err(format!(
-            "`{what}` must be a tvmd.{class} or a dict with keys {keys}"
+            "`{what}` must be a tvmd.{class} or a dict with keys {keys_list}"
         ))
     })?;
     for key in dict.keys() {
@@ -136,88 +131,32 @@ fn dict_values<'py>(
             .map_err(|_| PyTypeError::new_err(format!("`{what}` keys must be strings")))?;
         if !keys.contains(&key.as_str()) {
             return Err(PyValueError::new_err(format!(
-                "unknown key '{key}' in `{what}`; expected some of: {}",
-                keys.join(", ")
+                "unknown key '{key}' in `{what}`; expected some of: {keys_list}"
             )));
         }
     }
-    let values: Vec<_> = keys
-        .iter()
-        .map(|k| dict.get_item(k))
-        .collect::<PyResult<_>>()?;
-    match values.first() {
-        Some(Some(_)) => Ok(values),
-        _ => Err(PyValueError::new_err(format!(
+    if dict.get_item("position")?.is_none() {
+        return Err(PyValueError::new_err(format!(
             "`{what}` needs a 'position'"
-        ))),
+        )));
     }
-}
-
-/// Named optional arguments of a `State` / `Reference`; each is named `what.key` in errors.
-struct Fields<'a, 'py> {
-    what: &'static str,
-    keys: &'static [&'static str],
-    values: Vec<Option<&'a Bound<'py, PyAny>>>,
-}
-
-impl Fields<'_, '_> {
-    /// The value under `keys[k]`, `default` if missing or None.
-    fn get<const R: usize, const C: usize>(
-        &self,
-        k: usize,
-        default: SMatrix<f64, R, C>,
-    ) -> PyResult<SMatrix<f64, R, C>> {
-        let name = format!("{}.{}", self.what, self.keys.get(k).unwrap_or(&"?"));
-        opt_arg(self.values.get(k).copied().flatten(), &name, default)
-    }
-
-    fn state(&self) -> PyResult<RigidState<f64>> {
-        Ok(RigidState {
-            position: self.get(0, Vector3::zeros())?,
-            attitude: self.get(1, Matrix3::identity())?,
-            angular_velocity: self.get(2, Vector3::zeros())?,
-            velocity: self.get(3, Vector3::zeros())?,
-        })
-    }
-
-    fn reference(&self) -> PyResult<Reference<f64>> {
-        Ok(Reference {
-            position: self.get(0, Vector3::zeros())?,
-            velocity: self.get(1, Vector3::zeros())?,
-            acceleration: self.get(2, Vector3::zeros())?,
-            attitude: self.get(3, Matrix3::identity())?,
-            angular_velocity: self.get(4, Vector3::zeros())?,
-            angular_acceleration: self.get(5, Vector3::zeros())?,
-        })
-    }
-}
-
-fn state_fields<'a, 'py>(values: Vec<Option<&'a Bound<'py, PyAny>>>) -> Fields<'a, 'py> {
-    let (what, keys) = ("state", STATE_KEYS);
-    Fields { what, keys, values }
-}
-
-fn reference_fields<'a, 'py>(values: Vec<Option<&'a Bound<'py, PyAny>>>) -> Fields<'a, 'py> {
-    let (what, keys) = ("reference", REFERENCE_KEYS);
-    Fields { what, keys, values }
+    Ok(obj
+        .py()
+        .get_type::<T>()
+        .call((), Some(dict))?
+        .cast_into::<T>()?)
 }
 
 /// A state argument: a `State` or a dict with the same keys (`position` required).
 pub(crate) fn state_arg(obj: &Bound<'_, PyAny>) -> PyResult<RigidState<f64>> {
-    if let Ok(state) = obj.cast::<PyState>() {
-        return Ok(state.get().inner);
-    }
-    let values = dict_values(obj, "state", "State", STATE_KEYS)?;
-    state_fields(values.iter().map(Option::as_ref).collect()).state()
+    let state = record_arg::<PyState>(obj, "state", PyState::FIELD_NAMES)?;
+    Ok(state.get().inner)
 }
 
 /// A reference argument: a `Reference` or a dict with the same keys (`position` required).
 pub(crate) fn reference_arg(obj: &Bound<'_, PyAny>) -> PyResult<Reference<f64>> {
-    if let Ok(reference) = obj.cast::<PyReference>() {
-        return Ok(reference.get().inner);
-    }
-    let values = dict_values(obj, "reference", "Reference", REFERENCE_KEYS)?;
-    reference_fields(values.iter().map(Option::as_ref).collect()).reference()
+    let reference = record_arg::<PyReference>(obj, "reference", PyReference::FIELD_NAMES)?;
+    Ok(reference.get().inner)
 }
 
 record! {
@@ -241,8 +180,12 @@ record! {
             angular_velocity: Option<&Bound<'_, PyAny>>,
             velocity: Option<&Bound<'_, PyAny>>,
         ) -> PyResult<Self> {
-            let values = vec![Some(position), attitude, angular_velocity, velocity];
-            let inner = state_fields(values).state()?;
+            let inner = RigidState {
+                position: arg(position, "state.position")?,
+                attitude: opt_arg(attitude, "state.attitude", Matrix3::identity())?,
+                angular_velocity: opt_arg(angular_velocity, "state.angular_velocity", Vector3::zeros())?,
+                velocity: opt_arg(velocity, "state.velocity", Vector3::zeros())?,
+            };
             Ok(Self { inner })
         }
     }
@@ -275,8 +218,15 @@ record! {
             angular_velocity: Option<&Bound<'_, PyAny>>,
             angular_acceleration: Option<&Bound<'_, PyAny>>,
         ) -> PyResult<Self> {
-            let values = vec![Some(position), velocity, acceleration, attitude, angular_velocity, angular_acceleration];
-            let inner = reference_fields(values).reference()?;
+            let zero = Vector3::zeros();
+            let inner = Reference {
+                position: arg(position, "reference.position")?,
+                velocity: opt_arg(velocity, "reference.velocity", zero)?,
+                acceleration: opt_arg(acceleration, "reference.acceleration", zero)?,
+                attitude: opt_arg(attitude, "reference.attitude", Matrix3::identity())?,
+                angular_velocity: opt_arg(angular_velocity, "reference.angular_velocity", zero)?,
+                angular_acceleration: opt_arg(angular_acceleration, "reference.angular_acceleration", zero)?,
+            };
             Ok(Self { inner })
         }
 
