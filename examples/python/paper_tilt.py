@@ -2,7 +2,7 @@
 """The paper's simulation through the Python bindings: run it and draw its state figure.
 
 Runs the built-in scenario ``paper-tilt`` (A4-Inc team, ascent to 1.5 m, roll reference towards
-the infeasible pi/3 between 4 s and 10 s, descent; SPEC "The paper's simulation") with
+the infeasible pi/3 between 4 s and 10 s, descent; docs/method.md#scenario-paper-tilt) with
 ``tvmd.sim.run`` and draws, against time:
 
 * the position ``x, y, z`` against the reference ``x_r``;

@@ -108,7 +108,7 @@ def test_attitude_planner_vectors(case):
 
 
 # ---------------------------------------------------------------------------
-# Planner saturation in hover (SPEC "Reproduction targets")
+# Planner saturation in hover (docs/method.md#reproduction-targets)
 # ---------------------------------------------------------------------------
 
 
@@ -283,7 +283,7 @@ def test_control_law_hover_equilibrium():
 
 
 def test_control_law_matches_spec_reduction():
-    """With Omega_d = 0, SPEC's reduced forms hold for any state."""
+    """With Omega_d = 0, the reduced forms of docs/method.md#control-law hold for any state."""
     team = ri.paper_a4_inc()
     rng = np.random.default_rng(3)
     K_Om, K_v = team["K_xi"][:3, :3], team["K_xi"][3:, 3:]
@@ -358,7 +358,7 @@ def test_closed_loop_paper_scenario():
     phi_max = math.atan(c_y)
 
     assert np.all(np.isfinite(log["x"]))
-    # The planned roll saturates at the hover law (SPEC calibration: 0.331 rad vs 0.3287).
+    # The planned roll saturates at the hover law (NumPy calibration: 0.331 rad vs 0.3287).
     assert abs(np.max(log["phi_d"]) - phi_max) < 0.01
     assert np.max(log["phi_d"]) <= phi_max + 0.01
     # The vehicle stays within 1 m of the reference (the start is 0.71 m off).
