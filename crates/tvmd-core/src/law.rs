@@ -75,6 +75,26 @@ impl<T: Real> Gains<T> {
             k_v: d(0.8, 0.8, 2.0),
         }
     }
+
+    /// `K_x`, position gain.
+    pub fn k_x(&self) -> Matrix3<T> {
+        self.k_x
+    }
+
+    /// `K_R`, attitude gain.
+    pub fn k_r(&self) -> Matrix3<T> {
+        self.k_r
+    }
+
+    /// `K_Omega`, angular-velocity block of `K_xi`.
+    pub fn k_omega(&self) -> Matrix3<T> {
+        self.k_omega
+    }
+
+    /// `K_v`, velocity block of `K_xi`.
+    pub fn k_v(&self) -> Matrix3<T> {
+        self.k_v
+    }
 }
 
 /// The measured state: pose and body-frame twist `xi = [Omega; v]`.

@@ -235,4 +235,14 @@ impl<T: Real> RateLimits<T> {
         }
         Ok(Self { eta_x, eta_y })
     }
+
+    /// Largest `|d eta_x / dt|`.
+    pub fn eta_x(&self) -> T {
+        self.eta_x
+    }
+
+    /// Largest `|d eta_y / dt|`.
+    pub fn eta_y(&self) -> T {
+        self.eta_y
+    }
 }
