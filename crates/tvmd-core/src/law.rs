@@ -12,14 +12,10 @@ use crate::rotation::vee;
 /// Gains are not scaled by mass or inertia (the paper does not; the authors' MATLAB does).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains<T: Real> {
-    /// `K_x`, position gain.
-    pub k_x: Matrix3<T>,
-    /// `K_R`, attitude gain.
-    pub k_r: Matrix3<T>,
-    /// `K_Omega`, angular-velocity block of `K_xi`.
-    pub k_omega: Matrix3<T>,
-    /// `K_v`, velocity block of `K_xi`.
-    pub k_v: Matrix3<T>,
+    k_x: Matrix3<T>,
+    k_r: Matrix3<T>,
+    k_omega: Matrix3<T>,
+    k_v: Matrix3<T>,
 }
 
 impl<T: Real> Gains<T> {

@@ -217,10 +217,8 @@ impl<T: Real> Interval<T> {
 /// Gimbal rate limits (rad/s) of the rate-constrained allocation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RateLimits<T: Real> {
-    /// Largest `|d eta_x / dt|`.
-    pub eta_x: T,
-    /// Largest `|d eta_y / dt|`.
-    pub eta_y: T,
+    eta_x: T,
+    eta_y: T,
 }
 
 impl<T: Real> RateLimits<T> {
