@@ -105,8 +105,8 @@ impl<T: Real> AdmissibleSet<T> {
         dt: T,
     ) -> Self {
         Self {
-            eta_x: self.eta_x.window(previous.eta_x, rates.eta_x * dt),
-            eta_y: self.eta_y.window(previous.eta_y, rates.eta_y * dt),
+            eta_x: self.eta_x.window(previous.eta_x, rates.eta_x() * dt),
+            eta_y: self.eta_y.window(previous.eta_y, rates.eta_y() * dt),
             thrust: self.thrust,
         }
     }

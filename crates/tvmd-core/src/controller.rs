@@ -45,14 +45,9 @@ impl<T: Real> ControllerSettings<T> {
         }
     }
 
+    /// Gains, relaxation and rate limits are valid by construction (private fields); only the
+    /// two plain numbers are checked here.
     fn validate(&self) -> Result<(), ConfigError> {
-        Gains::new(
-            self.gains.k_x,
-            self.gains.k_r,
-            self.gains.k_omega,
-            self.gains.k_v,
-        )?;
-        Relaxation::new(self.relaxation.get())?;
         for (value, field) in [
             (self.gravity, ConfigField::Gravity),
             (self.period, ConfigField::Period),
@@ -60,9 +55,6 @@ impl<T: Real> ControllerSettings<T> {
             if !value.is_finite() || value <= T::zero() {
                 return Err(ConfigError::Parameter { field });
             }
-        }
-        if let Some(r) = self.rate_limits {
-            RateLimits::new(r.eta_x, r.eta_y)?;
         }
         Ok(())
     }

@@ -12,14 +12,10 @@ use crate::rotation::vee;
 /// Gains are not scaled by mass or inertia (the paper does not; the authors' MATLAB does).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains<T: Real> {
-    /// `K_x`, position gain.
-    pub k_x: Matrix3<T>,
-    /// `K_R`, attitude gain.
-    pub k_r: Matrix3<T>,
-    /// `K_Omega`, angular-velocity block of `K_xi`.
-    pub k_omega: Matrix3<T>,
-    /// `K_v`, velocity block of `K_xi`.
-    pub k_v: Matrix3<T>,
+    k_x: Matrix3<T>,
+    k_r: Matrix3<T>,
+    k_omega: Matrix3<T>,
+    k_v: Matrix3<T>,
 }
 
 impl<T: Real> Gains<T> {
@@ -74,6 +70,26 @@ impl<T: Real> Gains<T> {
             k_omega: d(8.0, 8.0, 1.5),
             k_v: d(0.8, 0.8, 2.0),
         }
+    }
+
+    /// `K_x`, position gain.
+    pub fn k_x(&self) -> Matrix3<T> {
+        self.k_x
+    }
+
+    /// `K_R`, attitude gain.
+    pub fn k_r(&self) -> Matrix3<T> {
+        self.k_r
+    }
+
+    /// `K_Omega`, angular-velocity block of `K_xi`.
+    pub fn k_omega(&self) -> Matrix3<T> {
+        self.k_omega
+    }
+
+    /// `K_v`, velocity block of `K_xi`.
+    pub fn k_v(&self) -> Matrix3<T> {
+        self.k_v
     }
 }
 

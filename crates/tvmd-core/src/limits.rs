@@ -217,10 +217,8 @@ impl<T: Real> Interval<T> {
 /// Gimbal rate limits (rad/s) of the rate-constrained allocation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RateLimits<T: Real> {
-    /// Largest `|d eta_x / dt|`.
-    pub eta_x: T,
-    /// Largest `|d eta_y / dt|`.
-    pub eta_y: T,
+    eta_x: T,
+    eta_y: T,
 }
 
 impl<T: Real> RateLimits<T> {
@@ -234,5 +232,15 @@ impl<T: Real> RateLimits<T> {
             }
         }
         Ok(Self { eta_x, eta_y })
+    }
+
+    /// Largest `|d eta_x / dt|`.
+    pub fn eta_x(&self) -> T {
+        self.eta_x
+    }
+
+    /// Largest `|d eta_y / dt|`.
+    pub fn eta_y(&self) -> T {
+        self.eta_y
     }
 }

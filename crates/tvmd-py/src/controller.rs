@@ -138,7 +138,7 @@ impl PyController {
     #[getter]
     fn rate_limits(&self) -> Option<(f64, f64)> {
         let rates = self.inner.settings().rate_limits;
-        rates.map(|r| (r.eta_x, r.eta_y))
+        rates.map(|r| (r.eta_x(), r.eta_y()))
     }
 
     /// The allocator's name.

@@ -46,8 +46,9 @@ fn k_xi_blocks(obj: &Bound<'_, PyAny>) -> PyResult<(Matrix3<f64>, Matrix3<f64>)>
 /// `Gains(k_x=[..], ...)` for diagonal gains, else `Gains(<full matrices>)`.
 fn gains_repr(g: &Gains<f64>) -> String {
     let d = |m: &Matrix3<f64>| format!("[{}, {}, {}]", m.m11, m.m22, m.m33);
-    if [g.k_x, g.k_r, g.k_omega, g.k_v].iter().all(is_diagonal) {
-        let (x, r, o, v) = (d(&g.k_x), d(&g.k_r), d(&g.k_omega), d(&g.k_v));
+    let ks = [g.k_x(), g.k_r(), g.k_omega(), g.k_v()];
+    if ks.iter().all(is_diagonal) {
+        let [x, r, o, v] = ks.map(|k| d(&k));
         format!("Gains(k_x={x}, k_r={r}, k_omega={o}, k_v={v})")
     } else {
         "Gains(<full matrices>)".to_string()
@@ -57,8 +58,8 @@ fn gains_repr(g: &Gains<f64>) -> String {
 /// `blockdiag(K_Omega, K_v)`.
 fn k_xi(g: &Gains<f64>) -> Matrix6<f64> {
     let mut k = Matrix6::zeros();
-    k.fixed_view_mut::<3, 3>(0, 0).copy_from(&g.k_omega);
-    k.fixed_view_mut::<3, 3>(3, 3).copy_from(&g.k_v);
+    k.fixed_view_mut::<3, 3>(0, 0).copy_from(&g.k_omega());
+    k.fixed_view_mut::<3, 3>(3, 3).copy_from(&g.k_v());
     k
 }
 
@@ -66,13 +67,13 @@ record! {
     /// Gains `K_x`, `K_R`, `K_xi = blockdiag(K_Omega, K_v)` of eq. (12). See the stub.
     "Gains" in "tvmd" => PyGains(Gains<f64>) repr gains_repr |py, o| {
         /// `K_x` (3, 3).
-        k_x => matrix(py, &o.k_x)?,
+        k_x => matrix(py, &o.k_x())?,
         /// `K_R` (3, 3).
-        k_r => matrix(py, &o.k_r)?,
+        k_r => matrix(py, &o.k_r())?,
         /// `K_Omega` (3, 3).
-        k_omega => matrix(py, &o.k_omega)?,
+        k_omega => matrix(py, &o.k_omega())?,
         /// `K_v` (3, 3).
-        k_v => matrix(py, &o.k_v)?,
+        k_v => matrix(py, &o.k_v())?,
         /// `K_xi` (6, 6).
         k_xi => matrix(py, &k_xi(o))?,
     }
