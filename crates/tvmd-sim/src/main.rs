@@ -3,7 +3,9 @@
 //!
 //! ```text
 //! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
+//!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
+//!                [--precision f64|f32]
 //! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
 //! tvmd-sim list
 //! tvmd-sim show NAME
@@ -20,7 +22,7 @@ use serde::Serialize;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::plot::{self, PlotSeries};
 use tvmd_sim::runner::{run_many, run_scenario, sweep_specs};
-use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
+use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;
 
@@ -60,6 +62,10 @@ enum Command {
         /// weighted-pseudo-inverse, clarabel).
         #[arg(long)]
         allocator: Option<String>,
+        /// Override the scenario's controller precision: f64, or f32 (the flight
+        /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
+        #[arg(long, value_parser = ["f64", "f32"])]
+        precision: Option<String>,
     },
     /// The relaxation study: the scenario flown once per relaxation s (in parallel threads).
     Sweep {
@@ -81,6 +87,10 @@ enum Command {
         /// Worker threads (default: available cores).
         #[arg(long)]
         jobs: Option<usize>,
+        /// Override the scenario's controller precision: f64, or f32 (the flight
+        /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
+        #[arg(long, value_parser = ["f64", "f32"])]
+        precision: Option<String>,
     },
     /// Re-plot runs from their MCAP logs: figures of each run, and the relaxation-study figure
     /// when several logs are given.
@@ -146,6 +156,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            precision,
         } => cmd_run(RunArgs {
             scenario,
             out,
@@ -154,6 +165,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            precision,
         }),
         Command::Sweep {
             relaxations,
@@ -162,7 +174,16 @@ fn main() -> ExitCode {
             logs,
             summary,
             jobs,
-        } => cmd_sweep(&relaxations, &scenario, plots, logs, summary, jobs),
+            precision,
+        } => cmd_sweep(
+            &relaxations,
+            &scenario,
+            precision.as_deref(),
+            plots,
+            logs,
+            summary,
+            jobs,
+        ),
         Command::Plot { logs, out } => cmd_plot(&logs, &out),
         Command::List => {
             for name in BUILTIN_NAMES {
@@ -214,6 +235,8 @@ struct RunReport<'a> {
     scenario: &'a str,
     relaxation: f64,
     allocator: &'a str,
+    /// The controller's float type, `"f64"` or `"f32"`.
+    controller_precision: Precision,
     /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
     hover_roll_limit: Option<f64>,
     summary: &'a RunSummary,
@@ -229,12 +252,19 @@ struct RunArgs {
     summary: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    precision: Option<String>,
+}
+
+/// The `--precision` argument (clap has checked the spelling; the parse names the field).
+fn precision_arg(p: Option<&str>) -> Result<Option<Precision>, CliError> {
+    Ok(p.map(str::parse).transpose()?)
 }
 
 fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     let scenario = Scenario::load(&a.scenario)?.with_overrides(&Overrides {
         relaxation: a.relaxation,
         allocator: a.allocator,
+        precision: precision_arg(a.precision.as_deref())?,
     })?;
     let log = if a.no_log {
         None
@@ -253,6 +283,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
+        controller_precision: scenario.controller_precision,
         hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
         summary: &result.summary,
         paper: PaperMetrics::new(&scenario, &result.samples),
@@ -302,6 +333,7 @@ fn print_run(r: &RunReport<'_>) {
         ("scenario", r.scenario.to_string()),
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
+        ("controller precision", r.controller_precision.to_string()),
         ("simulated time", format!("{:.3} s", s.time)),
         (
             "wall time / RTF",
@@ -389,6 +421,7 @@ fn print_run(r: &RunReport<'_>) {
 #[derive(Serialize, Clone)]
 struct SweepRow {
     relaxation: f64,
+    controller_precision: Precision,
     max_planned_roll: Option<f64>,
     hover_roll_limit: f64,
     max_e_f: Option<f64>,
@@ -404,12 +437,16 @@ struct SweepRow {
 fn cmd_sweep(
     relaxations: &[f64],
     scenario_arg: &str,
+    precision: Option<&str>,
     plots: Option<PathBuf>,
     logs: Option<PathBuf>,
     summary: Option<PathBuf>,
     jobs: Option<usize>,
 ) -> Result<(), CliError> {
-    let base = Scenario::load(scenario_arg)?;
+    let base = Scenario::load(scenario_arg)?.with_overrides(&Overrides {
+        precision: precision_arg(precision)?,
+        ..Overrides::default()
+    })?;
     let specs = sweep_specs(&base, relaxations, logs.as_deref())?;
     if specs.is_empty() {
         return Err(CliError::Other("no relaxation given".into()));
@@ -429,6 +466,7 @@ fn cmd_sweep(
         let paper = PaperMetrics::new(sc, &r.samples);
         rows.push(SweepRow {
             relaxation: sc.relaxation,
+            controller_precision: sc.controller_precision,
             max_planned_roll: s.max_planned_roll,
             hover_roll_limit: hover_roll_limit(sc, sc.relaxation)?,
             max_e_f: s.max_e_f,

@@ -51,6 +51,10 @@ pub fn write_scenario_metadata(log: &mut McapLog, scenario: &Scenario) -> Result
     meta.insert("name".to_string(), scenario.name.clone());
     meta.insert("relaxation".to_string(), scenario.relaxation.to_string());
     meta.insert("allocator".to_string(), scenario.allocator.clone());
+    meta.insert(
+        "controller_precision".to_string(),
+        scenario.controller_precision.to_string(),
+    );
     meta.insert("toml".to_string(), scenario.to_toml_string()?);
     log.write_metadata(METADATA_SCENARIO, meta)
 }

@@ -103,6 +103,7 @@ fn run_writes_log_summary_and_figures_then_plot_rereads_the_log() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
     assert_eq!(json["scenario"], "short");
+    assert_eq!(json["controller_precision"], "f64");
     assert!((json["summary"]["time"].as_f64().unwrap() - 0.3).abs() < 1e-9);
     for key in [
         "max_position_error",
@@ -138,6 +139,76 @@ fn run_writes_log_summary_and_figures_then_plot_rereads_the_log() {
     for f in ["short-state.png", "short-lyapunov.png", "relaxation.png"] {
         assert!(replot.join(f).is_file(), "{f}");
     }
+}
+
+#[test]
+fn precision_option_flies_f32_and_rejects_other_types() {
+    let dir = tmp_dir("precision");
+    let scenario = short_scenario(&dir);
+    let summary = dir.join("f32.json");
+    let stdout = ok(bin()
+        .arg("run")
+        .arg(&scenario)
+        .args(["--precision", "f32", "--no-log", "--summary"])
+        .arg(&summary)
+        .output()
+        .unwrap());
+    assert!(
+        stdout.contains("controller precision       f32"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(json["controller_precision"], "f32");
+    assert_eq!(json["summary"]["controller_precision"], "f32");
+    assert_eq!(json["summary"]["cycle_errors"], 0);
+    let table = dir.join("sweep.json");
+    ok(bin()
+        .args([
+            "sweep",
+            "--relaxations",
+            "1.0",
+            "--precision",
+            "f32",
+            "--scenario",
+        ])
+        .arg(&scenario)
+        .arg("--summary")
+        .arg(&table)
+        .output()
+        .unwrap());
+    let rows: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(&table).unwrap()).unwrap();
+    assert_eq!(rows[0]["controller_precision"], "f32");
+    for args in [
+        &["run", "--precision", "f16", "--no-log"][..],
+        &["sweep", "--precision", "double"][..],
+    ] {
+        let out = bin().args(args).output().unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("--precision") && stderr.contains("f32"),
+            "{stderr}"
+        );
+    }
+    // A scenario file names it too.
+    let file = dir.join("f32.toml");
+    std::fs::write(
+        &file,
+        "name = \"f32-file\"\nduration = 0.1\ncontroller_precision = \"f32\"\n",
+    )
+    .unwrap();
+    let stdout = ok(bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--no-log")
+        .output()
+        .unwrap());
+    assert!(
+        stdout.contains("controller precision       f32"),
+        "{stdout}"
+    );
 }
 
 #[test]

@@ -528,6 +528,30 @@ mod tests {
     }
 
     #[test]
+    fn controller_precision_parses_round_trips_and_rejects_others() {
+        let s = Scenario::from_toml_str("controller_precision = \"f32\"\n").unwrap();
+        assert_eq!(s.controller_precision, Precision::F32);
+        let again = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
+        assert_eq!(again, s);
+        assert_eq!(Scenario::default().controller_precision, Precision::F64);
+        let e = Scenario::from_toml_str("controller_precision = \"f16\"\n").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("controller_precision") && msg.contains("f32"),
+            "{msg}"
+        );
+        for p in Precision::ALL {
+            assert_eq!(p.as_str().parse::<Precision>().unwrap(), p);
+            assert_eq!(p.to_string(), p.as_str());
+        }
+        let e = "double".parse::<Precision>().unwrap_err();
+        assert!(
+            matches!(&e, SimError::InvalidScenario { field, .. } if field == "controller_precision"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn unknown_key_is_rejected_by_name() {
         let e = Scenario::from_toml_str("relaxaton = 0.5\n").unwrap_err();
         assert!(e.to_string().contains("relaxaton"), "{e}");

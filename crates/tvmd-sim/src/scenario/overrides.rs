@@ -1,7 +1,8 @@
-//! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator`, the
-//! Python keywords `relaxation=` / `allocator=`), applied with validation.
+//! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator` /
+//! `--precision`, the Python keywords `relaxation=` / `allocator=` / `precision=`), applied
+//! with validation.
 
-use super::Scenario;
+use super::{Precision, Scenario};
 use crate::SimError;
 
 /// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
@@ -11,12 +12,14 @@ pub struct Overrides {
     pub relaxation: Option<f64>,
     /// Allocator name (one of [`super::ALLOCATOR_NAMES`]).
     pub allocator: Option<String>,
+    /// The controller's float type (`controller_precision`).
+    pub precision: Option<Precision>,
 }
 
 impl Overrides {
     /// True if nothing is overridden.
     pub fn is_empty(&self) -> bool {
-        self.relaxation.is_none() && self.allocator.is_none()
+        self.relaxation.is_none() && self.allocator.is_none() && self.precision.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -26,6 +29,9 @@ impl Overrides {
         }
         if let Some(a) = &self.allocator {
             scenario.allocator.clone_from(a);
+        }
+        if let Some(p) = self.precision {
+            scenario.controller_precision = p;
         }
         scenario.validate()
     }
@@ -48,10 +54,13 @@ mod tests {
         let o = Overrides {
             relaxation: Some(1.0),
             allocator: Some("pseudo-inverse".into()),
+            precision: Some(Precision::F32),
         };
+        assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();
         assert_eq!(s.relaxation, 1.0);
         assert_eq!(s.allocator, "pseudo-inverse");
+        assert_eq!(s.controller_precision, Precision::F32);
         assert_eq!(
             Scenario::default()
                 .with_overrides(&Overrides::default())

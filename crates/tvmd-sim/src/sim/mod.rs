@@ -15,8 +15,10 @@
 //! Then `steps_per_control` physics steps follow, each one: failures whose time has come are
 //! applied, the actuators move towards the held commands, and the agents' body-frame forces
 //! (plus wind and external wrench) are applied for one step. The summary of a run is computed
-//! from its samples ([`summary`]).
+//! from its samples ([`summary`]); two flights of one scenario are compared sample by sample
+//! with [`difference`].
 
+pub mod difference;
 pub mod sample;
 pub mod summary;
 pub mod tick_log;
@@ -34,6 +36,7 @@ use crate::physics::{ExtraWrench, PhysicsWorld, PlantState, TeamBody};
 use crate::scenario::{Failure, Scenario, StateNoise};
 use crate::SimError;
 
+pub use difference::FlightDifference;
 pub use sample::Sample;
 pub use summary::{PaperMetrics, RunSummary, RunTotals, VxRise};
 
