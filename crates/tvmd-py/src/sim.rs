@@ -12,7 +12,7 @@ use pyo3::types::{PyDict, PyString};
 use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
-use tvmd_sim::scenario::{Overrides, Scenario, BUILTIN_NAMES};
+use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
@@ -23,7 +23,14 @@ use crate::record::record;
 const DEFAULT_SCENARIO: &str = "paper-tilt";
 
 /// The keys a `run_many` dict may hold (the keyword arguments of `run`).
-const RUN_KEYS: &[&str] = &["scenario", "toml", "mcap", "relaxation", "allocator"];
+const RUN_KEYS: &[&str] = &[
+    "scenario",
+    "toml",
+    "mcap",
+    "relaxation",
+    "allocator",
+    "precision",
+];
 
 /// What was done with the file an I/O error names.
 const READ: &str = "cannot read the scenario file";
@@ -89,6 +96,7 @@ struct RunArgs<'a, 'py> {
     mcap: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    precision: Option<String>,
 }
 
 impl RunArgs<'_, '_> {
@@ -104,9 +112,11 @@ impl RunArgs<'_, '_> {
             (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
             (None, None) => Scenario::builtin(DEFAULT_SCENARIO).map_err(value_error)?,
         };
+        let precision = self.precision.as_deref().map(str::parse::<Precision>);
         let overrides = Overrides {
             relaxation: self.relaxation,
             allocator: self.allocator,
+            precision: precision.transpose().map_err(value_error)?,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
         let log = self.mcap;
@@ -164,6 +174,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         mcap: opt(dict, &name, "mcap")?,
         relaxation: opt(dict, &name, "relaxation")?,
         allocator: opt(dict, &name, "allocator")?,
+        precision: opt(dict, &name, "precision")?,
     }
     .spec(&format!("{name}['scenario']"))
 }
@@ -217,7 +228,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None))]
 fn run(
     py: Python<'_>,
     scenario: Option<&Bound<'_, PyAny>>,
@@ -225,6 +236,7 @@ fn run(
     mcap: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    precision: Option<String>,
 ) -> PyResult<PySimResult> {
     let spec = RunArgs {
         scenario,
@@ -232,6 +244,7 @@ fn run(
         mcap,
         relaxation,
         allocator,
+        precision,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?
@@ -265,7 +278,7 @@ fn run_many(
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
 #[pyfunction]
-#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, mcap_dir = None, jobs = None))]
+#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None))]
 #[allow(clippy::too_many_arguments)]
 fn relaxation_sweep(
     py: Python<'_>,
@@ -273,6 +286,7 @@ fn relaxation_sweep(
     scenario: Option<&Bound<'_, PyAny>>,
     toml: Option<String>,
     allocator: Option<String>,
+    precision: Option<String>,
     mcap_dir: Option<PathBuf>,
     jobs: Option<i64>,
 ) -> PyResult<Vec<PySimResult>> {
@@ -287,6 +301,7 @@ fn relaxation_sweep(
         scenario,
         toml,
         allocator,
+        precision,
         ..RunArgs::default()
     };
     let base = args.spec("scenario")?.scenario;
@@ -377,11 +392,12 @@ impl SimData {
     fn repr(&self) -> String {
         let mcap = self.mcap_string();
         format!(
-            "SimResult(scenario_name='{}', relaxation={}, allocator='{}', samples={}, \
-             n_agents={}, mcap_path={})",
+            "SimResult(scenario_name='{}', relaxation={}, allocator='{}', precision='{}', \
+             samples={}, n_agents={}, mcap_path={})",
             self.scenario.name,
             self.scenario.relaxation,
             self.scenario.allocator,
+            self.scenario.controller_precision,
             self.samples.len(),
             self.n,
             mcap.map_or_else(|| "None".to_string(), |p| format!("'{p}'"))
@@ -398,6 +414,8 @@ record! {
         relaxation => o.scenario.relaxation,
         /// Allocator of the run.
         allocator => o.scenario.allocator.as_str(),
+        /// The float type the controller flew in, "f64" or "f32".
+        precision => o.scenario.controller_precision.as_str(),
         /// Path of the MCAP log written, or None.
         mcap_path => o.mcap_string(),
         /// Number of agents `n`.

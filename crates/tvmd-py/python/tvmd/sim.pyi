@@ -14,7 +14,7 @@ errno subclass, e.g. ``FileNotFoundError``, with the file name), a run that fail
 """
 
 import os
-from typing import Any, ClassVar, Iterable, Mapping, Optional, Tuple, Union, final
+from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,6 +25,9 @@ _F64 = NDArray[np.float64]
 _ScenarioArg = Union[str, "os.PathLike[str]"]
 _PathArg = Union[str, "os.PathLike[str]"]
 _RunItem = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+# The controller's float type: "f32" flies ``tvmd_core::Controller<f32, ..>`` (the flight
+# configuration), "f64" the default; the physics is f64 either way.
+_Precision = Literal["f32", "f64"]
 
 @final
 class SimResult:
@@ -36,7 +39,8 @@ class SimResult:
     not report at a tick (a skipped cycle) are NaN.
 
     Attributes:
-        scenario_name, relaxation (``s``), allocator, mcap_path (str or None), n_agents,
+        scenario_name, relaxation (``s``), allocator, precision (``"f64"`` or ``"f32"``, the
+        controller's float type), mcap_path (str or None), n_agents,
         mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
         planned roll at which the planner saturates in hover).
         t: (K,) time (s).
@@ -67,6 +71,9 @@ class SimResult:
     @property
     def allocator(self) -> AllocatorName:
         """Allocator of the run."""
+    @property
+    def precision(self) -> _Precision:
+        """The float type the controller flew in, "f64" or "f32"."""
     @property
     def mcap_path(self) -> Optional[str]:
         """Path of the MCAP log written, or None."""
@@ -177,6 +184,7 @@ def run(
     mcap: Optional[_PathArg] = None,
     relaxation: Optional[float] = None,
     allocator: Optional[AllocatorName] = None,
+    precision: Optional[_Precision] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -193,6 +201,10 @@ def run(
         relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
         allocator: override the allocator ("redistributed-pseudo-inverse", "pseudo-inverse",
             "weighted-pseudo-inverse", "clarabel" with the cargo feature).
+        precision: override the controller's float type (scenario field
+            ``controller_precision``): "f32" flies ``tvmd_core::Controller<f32, ..>``, the type a
+            flight controller runs; "f64" (the default). The physics stays f64; the summary's
+            ``controller_precision`` says which flew.
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
@@ -210,7 +222,8 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
     Args:
         runs: a sequence whose items are each a scenario (a built-in name or a TOML file, as
             ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
-            ``{"scenario": "a4-con", "relaxation": 1.0}`` or ``{"toml": text, "mcap": "x.mcap"}``.
+            ``{"scenario": "a4-con", "relaxation": 1.0}``, ``{"toml": text, "mcap": "x.mcap"}`` or
+            ``{"scenario": "paper-tilt", "precision": "f32"}``.
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
 
     Every item is loaded and validated before any run starts. If runs fail, the first failure
@@ -227,6 +240,7 @@ def relaxation_sweep(
     *,
     toml: Optional[str] = None,
     allocator: Optional[AllocatorName] = None,
+    precision: Optional[_Precision] = None,
     mcap_dir: Optional[_PathArg] = None,
     jobs: Optional[int] = None,
 ) -> list[SimResult]:
@@ -241,6 +255,7 @@ def relaxation_sweep(
         scenario: as ``run`` (default ``"paper-tilt"``).
         toml: inline TOML text instead of ``scenario``.
         allocator: override the scenario's allocator.
+        precision: override the controller's float type, as ``run``.
         mcap_dir: write one MCAP log per run there, ``<name>-s<s>.mcap``.
         jobs: worker threads (default: the available cores).
 
