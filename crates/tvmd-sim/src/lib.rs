@@ -24,7 +24,8 @@
 //! - [`log`]: MCAP logs (JSON messages, Foxglove `FrameTransform` / `SceneUpdate`).
 //! - [`sim`]: the digital control loop ([`sim::Simulation`]), its samples, per-tick log and
 //!   summary ([`sim::RunSummary`], [`sim::PaperMetrics`]).
-//! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller.
+//! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller, in
+//!   f64 or in f32 (the flight configuration; scenario field `controller_precision`).
 //! - [`runner`]: runs with the tvmd controller: one ([`runner::run_scenario`]) or a batch on
 //!   one worker pool ([`runner::run_many`], [`runner::relaxation_sweep`]).
 //! - [`plot`]: PNG figures (state profile, Lyapunov candidates, relaxation study) from samples
