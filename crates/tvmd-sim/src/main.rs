@@ -484,6 +484,7 @@ fn cmd_sweep(
             &r.samples,
         ));
     }
+    println!("controller precision: {}", base.controller_precision);
     let na =
         |v: Option<f64>, prec: usize| v.map_or_else(|| "-".to_string(), |x| format!("{x:.prec$}"));
     println!(
@@ -493,7 +494,7 @@ fn cmd_sweep(
         "atan(c_y)",
         "max e_f",
         "at t",
-        "e_f>1uN",
+        "e_f onset",
         "|e_x|t>=4",
         "|e_x|6-12",
         "final V_x",
@@ -501,7 +502,7 @@ fn cmd_sweep(
     );
     println!(
         "{:>5} {:>11} {:>11} {:>10} {:>6} {:>9} {:>10} {:>10} {:>10} {:>6}",
-        "", "(rad)", "(rad)", "(N)", "(s)", "from (s)", "(m)", "(m)", "", "(per.)"
+        "", "(rad)", "(rad)", "(N)", "(s)", "(s)", "(m)", "(m)", "", "(per.)"
     );
     for r in &rows {
         println!(
