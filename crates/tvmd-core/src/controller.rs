@@ -15,7 +15,7 @@ use crate::error::{ConfigError, ConfigField, InputError};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::{project_force_in, ForceProjection};
-use crate::real::{lit, Real};
+use crate::real::{count, lit, to_f64, Real};
 use crate::team::{FailureMask, TeamConfig};
 
 /// Settings of a [`Controller`] besides the team and the allocator.
@@ -120,6 +120,8 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     effectiveness: Effectiveness<T, N>,
     admissible: AdmissibleSet<T>,
     previous: [AgentCommand<T>; N],
+    /// The bound on every input component ([`Self::input_limit`]).
+    input_limit: T,
 }
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
@@ -135,7 +137,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let effectiveness = team.effectiveness(&failures);
         let mut allocator = allocator;
         allocator.configure(&effectiveness);
+        let input_limit = input_limit(&team, &settings);
         Ok(Self {
+            input_limit,
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
             afs,
@@ -210,6 +214,21 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         &self.allocator
     }
 
+    /// The bound `B` on `|component|` of every vector input of [`Self::step`] (positions,
+    /// velocities, accelerations, angular velocities and accelerations of state and reference):
+    /// beyond it the cycle returns [`InputError::OutOfRange`]. Derived once in [`Self::new`]
+    /// from the team's own scales so that every product of the cycle stays finite:
+    /// `B = (1/64) min(MAX / S1, sqrt(MAX / S2))`, with `S1` the largest linear coefficient
+    /// (`1`, `m_C`, `m_C g`, `n sigma_Tf` and `3 max|.|` of `J_C`, `K_x`, `K_R`, `K_Omega`,
+    /// `K_v`) and `S2` the largest quadratic one (`1`, `m_C` and `3 max|.|` of `J_C`, `K_x`,
+    /// `K_Omega`, `K_v`: `[J Omega]x Omega_d` and the Lyapunov values). The allocators take any
+    /// finite wrench (they scale a huge one, `docs/method.md`), so the Gram matrix's
+    /// conditioning does not enter. For the paper's A4-Inc with the paper's settings:
+    /// `5.9e16` in `f32` and `4.3e151` in `f64` (`S2 = 24`, from `K_Omega`).
+    pub fn input_limit(&self) -> T {
+        self.input_limit
+    }
+
     /// The previous period's commands.
     pub fn previous_commands(&self) -> &[AgentCommand<T>; N] {
         &self.previous
@@ -266,6 +285,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         };
         state.validate().map_err(reject)?;
         reference.validate().map_err(reject)?;
+        self.check_range(state, reference).map_err(reject)?;
         let gains = &self.settings.gains;
         let u_fr = force_request(&self.plant, gains, state, reference);
         let projection = project_force_in(&self.full_cone, &u_fr);
@@ -303,8 +323,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                 command_clamp = command_clamp.max(clamp);
             }
         }
-        self.previous = commands;
-        Ok(ControlOutput {
+        let output = ControlOutput {
             planner,
             projection,
             f_r,
@@ -312,6 +331,121 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             allocation,
             commands,
             command_clamp,
-        })
+        };
+        // Never a silent free fall: zero thrust everywhere for a finite, non-zero request.
+        if u_fr != Vector3::zeros() && commands.iter().all(|c| c.thrust == T::zero()) {
+            return Err(reject(InputError::Unattainable {
+                field: "force_request",
+            }));
+        }
+        if let Some(field) = first_non_finite(&output) {
+            return Err(reject(InputError::Overflow { field }));
+        }
+        self.previous = commands;
+        Ok(output)
     }
+
+    /// [`InputError::OutOfRange`] for the first vector input with a component beyond
+    /// [`Self::input_limit`].
+    fn check_range(
+        &self,
+        state: &RigidState<T>,
+        reference: &Reference<T>,
+    ) -> Result<(), InputError> {
+        for (v, field) in [
+            (&state.position, "state.position"),
+            (&state.angular_velocity, "state.angular_velocity"),
+            (&state.velocity, "state.velocity"),
+            (&reference.position, "reference.position"),
+            (&reference.velocity, "reference.velocity"),
+            (&reference.acceleration, "reference.acceleration"),
+            (&reference.angular_velocity, "reference.angular_velocity"),
+            (
+                &reference.angular_acceleration,
+                "reference.angular_acceleration",
+            ),
+        ] {
+            if v.iter().any(|x| x.abs() > self.input_limit) {
+                return Err(InputError::OutOfRange {
+                    field,
+                    limit: to_f64(self.input_limit),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `B` of [`Controller::input_limit`].
+fn input_limit<T: Real, const N: usize>(
+    team: &TeamConfig<T, N>,
+    settings: &ControllerSettings<T>,
+) -> T {
+    let row = |k: &nalgebra::Matrix3<T>| k.amax() * lit(3.0);
+    let gains = &settings.gains;
+    let mass = team.mass();
+    let quadratic = [
+        row(&team.inertia()),
+        row(&gains.k_x()),
+        row(&gains.k_omega()),
+        row(&gains.k_v()),
+        mass,
+    ]
+    .iter()
+    .fold(T::one(), |m, x| m.max(*x));
+    let linear = [
+        quadratic,
+        row(&gains.k_r()),
+        mass * settings.gravity,
+        count::<T>(team.len()) * team.limits().max_thrust(),
+    ]
+    .iter()
+    .fold(T::one(), |m, x| m.max(*x));
+    let max = T::max_value().unwrap_or_else(T::one);
+    (max / linear).min((max / quadratic).sqrt()) / lit(64.0)
+}
+
+/// The first output field with a non-finite number (the cycle's safety net).
+fn first_non_finite<T: Real, const N: usize>(out: &ControlOutput<T, N>) -> Option<&'static str> {
+    let finite = |mut it: core::slice::Iter<'_, T>| it.all(|x| x.is_finite());
+    let commands = out.commands.iter().all(|c| {
+        [c.eta_x, c.eta_y, c.thrust, c.omega]
+            .iter()
+            .all(|x| x.is_finite())
+    });
+    let forces = out
+        .allocation
+        .forces
+        .iter()
+        .all(|f| finite(f.as_slice().iter()));
+    let law = &out.law;
+    let checks = [
+        (commands, "output.commands"),
+        (forces, "output.allocation.forces"),
+        (
+            finite(out.allocation.wrench.as_slice().iter())
+                && out.allocation.e_f.is_finite()
+                && out.allocation.wrench_error.is_finite(),
+            "output.allocation",
+        ),
+        (
+            finite(out.planner.r_d.as_slice().iter()) && out.planner.theta.is_finite(),
+            "output.planner",
+        ),
+        (
+            finite(out.projection.force.as_slice().iter()) && finite(out.f_r.as_slice().iter()),
+            "output.projection",
+        ),
+        (
+            finite(law.u_r.as_slice().iter())
+                && finite(law.u_d.as_slice().iter())
+                && finite(law.e_xi.as_slice().iter())
+                && finite(law.e_r.as_slice().iter())
+                && finite(law.e_x.as_slice().iter())
+                && law.v_r.is_finite()
+                && law.v_x.is_finite(),
+            "output.law",
+        ),
+    ];
+    checks.iter().find(|(ok, _)| !ok).map(|(_, field)| *field)
 }

@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 
 use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{lit, Real};
-use crate::rotation::vee;
+use crate::rotation::{validate_rotation as rotation, vee};
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
 /// block-diagonal one keeps the force request independent of the planned attitude (the order of `docs/method.md`).
@@ -172,21 +172,6 @@ fn finite3<T: Real>(v: &Vector3<T>, field: &'static str) -> Result<(), InputErro
         Ok(())
     } else {
         Err(InputError::NonFinite { field })
-    }
-}
-
-/// Accepts rotations up to `1e-3` (f64) / `1e-3` (f32) of orthonormality error: state estimators
-/// renormalize, but not every period.
-fn rotation<T: Real>(r: &Matrix3<T>, field: &'static str) -> Result<(), InputError> {
-    if !r.iter().all(|x| x.is_finite()) {
-        return Err(InputError::NonFinite { field });
-    }
-    let tol: T = lit(1e-3);
-    let orthonormal = (r.transpose() * r - Matrix3::identity()).amax() <= tol;
-    if orthonormal && (r.determinant() - T::one()).abs() <= tol {
-        Ok(())
-    } else {
-        Err(InputError::NotRotation { field })
     }
 }
 

@@ -4,9 +4,46 @@
 // Triangular solves read clearest with index loops over the fixed 6x6 arrays.
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
-use nalgebra::{Matrix6, Matrix6x3, Vector6};
+use nalgebra::{Matrix6, Matrix6x3, SVector, Vector6};
 
 use crate::real::{eps, lit, Real};
+
+/// `||v||` scaled by `m = max |v_i|` (hand-written: nalgebra's `norm()` squares the components,
+/// which overflows above `sqrt(MAX)` and underflows below `sqrt(MIN_POSITIVE)`; this costs a max
+/// and a division per component). Zero for `v = 0`; `+inf` only when the true norm exceeds `MAX`; NaN for a
+/// non-finite `v`.
+pub(crate) fn norm<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
+    let m = max_abs(v);
+    if m == T::zero() {
+        return m;
+    }
+    // Divided, not multiplied by `1 / m`, which overflows for a subnormal `m`.
+    (v / m).norm() * m
+}
+
+/// `v / ||v||` through [`norm`]'s scaling (zero for `v = 0`, NaN for a non-finite `v`).
+pub(crate) fn normalize<T: Real, const D: usize>(v: &SVector<T, D>) -> SVector<T, D> {
+    let m = max_abs(v);
+    if m == T::zero() {
+        return *v;
+    }
+    let u = v / m;
+    u / u.norm()
+}
+
+/// `max |v_i|`; non-finite (the first non-finite `|v_i|`) if a component is, so callers'
+/// finiteness checks see it.
+pub(crate) fn max_abs<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
+    let mut m = T::zero();
+    for x in v.iter() {
+        let a = x.abs();
+        if !a.is_finite() {
+            return a;
+        }
+        m = m.max(a);
+    }
+    m
+}
 
 /// `A = L D L^T` of a symmetric 6x6 matrix, without pivoting. `None` unless every pivot is
 /// above `tol` (so `A` is numerically positive definite).
