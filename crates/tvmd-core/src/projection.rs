@@ -89,8 +89,21 @@ pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> F
         t_tf,
         t_eta,
     };
-    ForceProjection {
+    let projected = ForceProjection {
         force: projection.gain() * u_fr,
         ..projection
+    };
+    // Subnormal components round absolutely, beyond the shrink: then keep only the vertical
+    // part, which is always a member. (`t_eta = 1` needs no check: the force is `scaled`.)
+    if t_eta < T::one() && !cone.contains(&projected.force) {
+        let vertical = ForceProjection {
+            t_eta: T::zero(),
+            ..projection
+        };
+        return ForceProjection {
+            force: vertical.gain() * u_fr,
+            ..vertical
+        };
     }
+    projected
 }
