@@ -51,6 +51,12 @@ step "cargo test --features clarabel (the constrained allocator; the paper scena
 cargo test -p tvmd-core --features clarabel
 cargo test -p tvmd-sim --features clarabel --test closed_loop
 
+step "randomized control cycle: 1,000,000 steps per type (f32, f64), then with clarabel"
+# Release build; prints the counts (steps, Ok, each error variant, rejected teams).
+# Measured on the 2-core development machine: about 20 s for both types after the build.
+TVMD_FUZZ_STEPS=1000000 cargo test --release -p tvmd-core --test cycle_fuzz -- --nocapture
+TVMD_FUZZ_STEPS=1000000 cargo test --release -p tvmd-core --features clarabel --test cycle_fuzz -- --nocapture
+
 step "benchmarks compile (cargo bench --no-run)"
 cargo bench --workspace --no-run
 

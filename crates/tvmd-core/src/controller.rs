@@ -250,8 +250,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// One control period: `u_fr`, projection `t_Tf`, planner (`R_d`), `K_f` and the torque part,
     /// allocation, and inversion to commands inside `E_f`.
     ///
-    /// A non-finite or non-rotation input is rejected with a [`CycleError`] that carries the
-    /// previous commands to hold.
+    /// A non-finite or non-rotation input, or a component beyond [`Self::input_limit`]
+    /// ([`InputError::OutOfRange`]), is rejected with a [`CycleError`] that carries the previous
+    /// commands to hold. So is a period whose only answer to a finite, non-zero force request
+    /// `u_fr` is zero thrust on every agent ([`InputError::Unattainable`]: never a silent free
+    /// fall), and, as a safety net, one with a non-finite output ([`InputError::Overflow`]).
     ///
     /// ```
     /// use tvmd_core::nalgebra::Vector3;

@@ -50,7 +50,8 @@ class ConfigError(ValueError):
     field: Optional[str]
 
 class InputError(ValueError):
-    """A control-cycle input that cannot be used: not finite, or not a rotation."""
+    """A control-cycle input that cannot be used: not finite, not a rotation, beyond the cycle's
+    bound for its float type, or a non-zero force request answered only by zero thrust."""
 
 class CycleError(InputError):
     """``Controller.step`` rejected its input.
@@ -885,8 +886,10 @@ class Controller:
             StepOutput.
 
         Raises:
-            CycleError (a ValueError): NaN/inf input or a non-rotation attitude; the exception's
-                ``commands`` (n, 4) are the previous period's commands to hold.
+            CycleError (a ValueError): NaN/inf input, a non-rotation attitude, a component beyond
+                the cycle's input bound (``tvmd_core::Controller::input_limit``, 4.3e151 for the
+                paper's team in f64), or a non-zero force request that only zero thrust answers;
+                the exception's ``commands`` (n, 4) are the previous period's commands to hold.
             ValueError / TypeError: wrong shapes or argument types.
         """
     @property
