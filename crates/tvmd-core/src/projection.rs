@@ -56,8 +56,7 @@ pub fn project_force<T: Real>(
 
 /// As [`project_force`] with the AFS already evaluated at `s = 1` (`afs.cone(Relaxation::none())`).
 pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> ForceProjection<T> {
-    // `!(z >= 0)` also catches NaN.
-    if !u_fr.iter().all(|x| x.is_finite()) || !(u_fr.z >= T::zero()) {
+    if !u_fr.iter().all(|x| x.is_finite()) || u_fr.z < T::zero() {
         return ForceProjection {
             force: Vector3::zeros(),
             t_tf: T::zero(),

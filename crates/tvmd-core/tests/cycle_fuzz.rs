@@ -17,7 +17,7 @@
 //!   commands held; `Overflow` (the safety net) never trips;
 //! - invalid teams and failure masks are refused with a `ConfigError`, never a panic.
 //!
-//! Steps per type: `TVMD_FUZZ_STEPS` (default 20,000, for a debug `cargo test`);
+//! Steps per type: `TVMD_FUZZ_STEPS` (default 5,000, for a debug `cargo test`);
 //! `scripts/test.sh` runs 1,000,000 per type in release. The seed is `TVMD_FUZZ_SEED`
 //! (default fixed, so a failure reproduces). The counts are printed (`--nocapture`).
 
@@ -537,7 +537,7 @@ fn fuzz<T: Real>(label: &str, steps: u64, seed: u64, clarabel: bool) -> Counts {
 }
 
 fn run<T: Real>(label: &str, seed_offset: u64) {
-    let steps = env_u64("TVMD_FUZZ_STEPS", 20_000);
+    let steps = env_u64("TVMD_FUZZ_STEPS", 5_000);
     let seed = env_u64("TVMD_FUZZ_SEED", 13) + seed_offset;
     let counts = fuzz::<T>(label, steps, seed, cfg!(feature = "clarabel"));
     assert_eq!(counts.steps, steps);

@@ -3,6 +3,8 @@
 //! planner's rotation check, admissible allocations with honest `e_f`, and the controller's
 //! input bound and zero-thrust rule, in `f32` and `f64`.
 
+use std::f64::consts::{FRAC_PI_4, FRAC_PI_6};
+
 use nalgebra::{Matrix3, Vector3, Vector6};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -98,7 +100,7 @@ fn projection_is_always_a_member<T: Real>() {
         .map(|m| m.to_subset().unwrap_or(f64::MAX))
         .unwrap();
     for (sx, sy) in [
-        (0.5236, 0.7854),
+        (FRAC_PI_6, FRAC_PI_4),
         (half_pi, 0.4),
         (0.3, half_pi),
         (half_pi, half_pi),
@@ -143,7 +145,7 @@ fn projection_is_always_a_member_f64() {
 fn afs_never_admits_a_downward_force() {
     let half_pi = std::f64::consts::FRAC_PI_2;
     // sigma_y = pi/2 gives the branch with an offset; s = 1.
-    let afs = AttainableForceSpace::<f64>::new(4, 2, 0.5236, half_pi, 13.734).unwrap();
+    let afs = AttainableForceSpace::<f64>::new(4, 2, FRAC_PI_6, half_pi, 13.734).unwrap();
     let s = Relaxation::none();
     assert!(afs.semi_axes(1.0, s).unbounded_branch);
     assert!(!afs.contains(&Vector3::new(0.0, 0.0, -1.0), s));
@@ -439,7 +441,7 @@ fn zero_thrust_for_a_non_zero_request_is_refused() {
 #[test]
 fn idle_thrust_keeps_the_commands_non_zero() {
     // With an idle thrust the downward request is answered at idle, never zero.
-    let limits = AgentLimits::new(0.5236, 0.7854, 13.734)
+    let limits = AgentLimits::new(FRAC_PI_6, FRAC_PI_4, 13.734)
         .unwrap()
         .with_min_thrust(0.5)
         .unwrap();

@@ -147,11 +147,12 @@ fn bounded_rhs<T: Real>(rhs: &Vector6<T>) -> Vector6<T> {
     }
 }
 
-/// Whether `force` must be saturated into `set`: outside it, or not finite (NaN compares false,
-/// so it is caught here rather than kept).
+/// Whether `force` must be saturated into `set`: outside it, or not finite (the gimbal inverse
+/// of a non-finite force is the idle command, which may lie inside, so it is caught here rather
+/// than kept).
 pub(crate) fn outside<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bool {
-    let v = set.violation(&GimbalCommand::from_force(force));
-    !(v <= T::zero()) || !force.iter().all(|x| x.is_finite())
+    !force.iter().all(|x| x.is_finite())
+        || set.violation(&GimbalCommand::from_force(force)) > T::zero()
 }
 
 /// `sum_{i free} M_i M_i^T / w_i`.

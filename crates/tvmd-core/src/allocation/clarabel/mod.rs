@@ -299,8 +299,8 @@ impl<T: Real, const N: usize> ClarabelAllocator<T, N> {
 }
 
 /// Whether every component of the request is at most `1e6` times the largest the working agents
-/// can produce, `sum_i sigma_Tf,i 3 max |M_i|` (a NaN request passes here and falls back as
-/// non-finite input).
+/// can produce, `sum_i sigma_Tf,i 3 max |M_i|` (a non-finite request passes here and falls back
+/// as non-finite input).
 fn within_range<T: Real, const N: usize>(request: &AllocationRequest<'_, T, N>) -> bool {
     let reach: f64 = request
         .effectiveness
@@ -313,7 +313,7 @@ fn within_range<T: Real, const N: usize>(request: &AllocationRequest<'_, T, N>) 
         .wrench
         .iter()
         .fold(0.0_f64, |m, x| m.max(to_f64(x.abs())));
-    !(largest > reach * 1e6)
+    largest <= reach * 1e6 || !largest.is_finite()
 }
 
 impl<T: Real, const N: usize> Default for ClarabelAllocator<T, N> {
