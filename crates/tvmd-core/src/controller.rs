@@ -408,47 +408,44 @@ fn input_limit<T: Real, const N: usize>(
     (max / linear).min((max / quadratic).sqrt()) / lit(64.0)
 }
 
-/// The first output field with a non-finite number (the cycle's safety net).
+/// The first output field with a non-finite number (the cycle's safety net). Cheap: each part
+/// sums `x * 0`, which is NaN exactly when some `x` is not finite (one multiply-add per number).
 fn first_non_finite<T: Real, const N: usize>(out: &ControlOutput<T, N>) -> Option<&'static str> {
-    let finite = |mut it: core::slice::Iter<'_, T>| it.all(|x| x.is_finite());
-    let commands = out.commands.iter().all(|c| {
-        [c.eta_x, c.eta_y, c.thrust, c.omega]
-            .iter()
-            .all(|x| x.is_finite())
-    });
+    let zero = T::zero();
+    let probe = |values: &[T]| values.iter().fold(zero, |acc, x| acc + *x * zero) == zero;
+    let commands = out.commands.iter().fold(zero, |acc, c| {
+        acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * zero
+    }) == zero;
     let forces = out
         .allocation
         .forces
         .iter()
-        .all(|f| finite(f.as_slice().iter()));
+        .fold(zero, |acc, f| acc + (f.x + f.y + f.z) * zero)
+        == zero;
     let law = &out.law;
-    let checks = [
-        (commands, "output.commands"),
-        (forces, "output.allocation.forces"),
-        (
-            finite(out.allocation.wrench.as_slice().iter())
-                && out.allocation.e_f.is_finite()
-                && out.allocation.wrench_error.is_finite(),
-            "output.allocation",
-        ),
-        (
-            finite(out.planner.r_d.as_slice().iter()) && out.planner.theta.is_finite(),
-            "output.planner",
-        ),
-        (
-            finite(out.projection.force.as_slice().iter()) && finite(out.f_r.as_slice().iter()),
-            "output.projection",
-        ),
-        (
-            finite(law.u_r.as_slice().iter())
-                && finite(law.u_d.as_slice().iter())
-                && finite(law.e_xi.as_slice().iter())
-                && finite(law.e_r.as_slice().iter())
-                && finite(law.e_x.as_slice().iter())
-                && law.v_r.is_finite()
-                && law.v_x.is_finite(),
-            "output.law",
-        ),
-    ];
-    checks.iter().find(|(ok, _)| !ok).map(|(_, field)| *field)
+    if !commands {
+        return Some("output.commands");
+    }
+    if !forces
+        || !probe(out.allocation.wrench.as_slice())
+        || !probe(&[out.allocation.e_f, out.allocation.wrench_error])
+    {
+        return Some("output.allocation");
+    }
+    if !probe(out.planner.r_d.as_slice()) || !probe(&[out.planner.theta]) {
+        return Some("output.planner");
+    }
+    if !probe(out.projection.force.as_slice()) || !probe(out.f_r.as_slice()) {
+        return Some("output.projection");
+    }
+    if !probe(law.u_r.as_slice())
+        || !probe(law.u_d.as_slice())
+        || !probe(law.e_xi.as_slice())
+        || !probe(law.e_r.as_slice())
+        || !probe(law.e_x.as_slice())
+        || !probe(&[law.v_r, law.v_x])
+    {
+        return Some("output.law");
+    }
+    None
 }

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use crate::linalg::max_abs;
+use crate::linalg::{max_abs, plain_is_exact};
 use crate::real::Real;
 
 /// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
@@ -44,12 +44,17 @@ impl<T: Real> GimbalCommand<T> {
     /// first, so the angles are exact to round-off at any magnitude (no overflow at `1e155`, no
     /// underflow at `1e-160` in `f64`); `T` is `+inf` only when `||f||` exceeds the type's `MAX`.
     pub fn from_force(force: &Vector3<T>) -> Self {
-        let m = max_abs(force);
-        if m == T::zero() || !m.is_finite() {
-            return Self::idle();
-        }
-        let unit_scaled = force / m;
-        let n = unit_scaled.norm();
+        let squared = force.norm_squared();
+        let (unit_scaled, n, m) = if plain_is_exact(squared) {
+            (*force, squared.sqrt(), T::one())
+        } else {
+            let m = max_abs(force);
+            if m == T::zero() || !m.is_finite() {
+                return Self::idle();
+            }
+            let unit_scaled = force / m;
+            (unit_scaled, unit_scaled.norm(), m)
+        };
         // Rounding can push |f_y|/T a hair above 1.
         let sin_x = (-unit_scaled.y / n).clamp(-T::one(), T::one());
         Self {
