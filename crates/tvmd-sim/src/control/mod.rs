@@ -104,7 +104,7 @@ impl<T: CoreFloat> TvmdController<T> {
             let _ = mask.set(i, *f);
         }
         match self.inner.set_failures(mask) {
-            Ok(()) => {
+            Ok(_) => {
                 self.failure_note = None;
             }
             Err(e) => {
