@@ -12,6 +12,7 @@ use crate::allocation::{Allocation, AllocationRequest, Allocator};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField, InputError};
+use crate::hover::{hover_capability, HoverCapability};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::{project_force_in, ForceProjection};
@@ -119,6 +120,8 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     planner_cone: EllipticCone<T>,
     effectiveness: Effectiveness<T, N>,
     admissible: AdmissibleSet<T>,
+    /// The classification of the working agents, computed when the mask is set.
+    hover: HoverCapability<T>,
     previous: [AgentCommand<T>; N],
     /// The bound on every input component ([`Self::input_limit`]).
     input_limit: T,
@@ -132,25 +135,26 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         allocator: A,
     ) -> Result<Self, ConfigError> {
         settings.validate()?;
+        // Also rejects a gravity whose weight m_C g overflows.
+        let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
         let failures = FailureMask::none();
         let afs = team.afs(&failures)?;
         let effectiveness = team.effectiveness(&failures);
         let mut allocator = allocator;
         allocator.configure(&effectiveness);
         let input_limit = input_limit(&team, &settings);
+        let admissible = AdmissibleSet::from_limits(team.limits());
+        let hover = hover_capability(&effectiveness, &admissible, plant.weight());
         Ok(Self {
             input_limit,
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
             afs,
-            plant: Plant {
-                mass: team.mass(),
-                inertia: team.inertia(),
-                gravity: settings.gravity,
-            },
+            plant,
             planner: AttitudePlanner::new(settings.relaxation),
             effectiveness,
-            admissible: AdmissibleSet::from_limits(team.limits()),
+            admissible,
+            hover,
             team,
             settings,
             allocator,
@@ -159,17 +163,44 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         })
     }
 
-    /// Tells the controller which agents failed. Errors (and keeps the old mask) if the
-    /// remaining team cannot produce every wrench.
-    pub fn set_failures(&mut self, failures: FailureMask<N>) -> Result<(), ConfigError> {
+    /// Tells the controller which agents failed, and classifies the working agents: whether
+    /// they can hold hover with a margin ([`crate::hover`]), so a caller can decide to land.
+    /// The classification is computed here, once per mask, and kept
+    /// ([`Self::hover_capability`]). Errors (and keeps the old mask) if the remaining team
+    /// cannot produce every wrench.
+    ///
+    /// ```
+    /// use tvmd_core::{team::presets, Controller, ControllerSettings, FailureMask};
+    /// use tvmd_core::RedistributedPseudoInverse;
+    /// let team = presets::a4_inc::<f32, 4>()?;
+    /// let mut controller =
+    ///     Controller::new(team, ControllerSettings::paper(), RedistributedPseudoInverse)?;
+    /// assert!(controller.hover_capability().capable);
+    /// // Rank 6 is kept, but three agents at z = 0 cannot hold hover with a margin.
+    /// let hover = controller.set_failures(FailureMask::with_failed(&[2])?)?;
+    /// assert!(!hover.capable);
+    /// assert_eq!(controller.hover_capability(), &hover);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn set_failures(
+        &mut self,
+        failures: FailureMask<N>,
+    ) -> Result<HoverCapability<T>, ConfigError> {
         self.team.validate_failures(&failures)?;
         self.afs = self.team.afs(&failures)?;
         self.full_cone = self.afs.cone(Relaxation::none());
         self.planner_cone = self.afs.cone(self.settings.relaxation);
         self.effectiveness = self.team.effectiveness(&failures);
         self.allocator.configure(&self.effectiveness);
+        self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
         self.failures = failures;
-        Ok(())
+        Ok(self.hover)
+    }
+
+    /// Whether the working agents can hold hover with a margin, as classified when the
+    /// failure mask was last set (or at [`Self::new`] for the full team).
+    pub fn hover_capability(&self) -> &HoverCapability<T> {
+        &self.hover
     }
 
     /// Replaces the planner (e.g. another tolerance); its relaxation becomes the controller's.

@@ -69,6 +69,12 @@ pub enum ConfigField {
     GainKv,
     /// `g`.
     Gravity,
+    /// `m_C` of a [`crate::law::Plant`].
+    PlantMass,
+    /// `J_C` of a [`crate::law::Plant`].
+    PlantInertia,
+    /// `J_C` derived by [`crate::TeamConfig::new`].
+    TeamInertia,
     /// The control period `dt`.
     Period,
     /// The gimbal rate limits.
@@ -111,6 +117,9 @@ impl ConfigField {
             Self::GainKomega => "gains.k_omega",
             Self::GainKv => "gains.k_v",
             Self::Gravity => "gravity",
+            Self::PlantMass => "plant.mass",
+            Self::PlantInertia => "plant.inertia",
+            Self::TeamInertia => "team.inertia",
             Self::Period => "period",
             Self::RateLimits => "rate_limits",
             Self::PlannerTolerance => "planner.tolerance",
@@ -174,6 +183,25 @@ pub enum ConfigError {
     },
     /// The navigator inertia is not symmetric positive semi-definite.
     NavigatorInertia,
+    /// Agent `agent`'s inertia `J_i` is not symmetric positive semi-definite.
+    AgentInertia {
+        /// The agent's index in the team's agent list.
+        agent: usize,
+    },
+    /// A matrix that must be symmetric positive definite (a gain, the plant's or the team's
+    /// inertia) is not: it is not symmetric, or it has a non-positive eigenvalue.
+    NotSymmetricPositiveDefinite {
+        /// The matrix, e.g. [`ConfigField::GainKr`].
+        field: ConfigField,
+    },
+    /// Finite inputs whose derived quantity (a sum, a product, `M M^T`) is not finite in the
+    /// float type: the values are too large to be carried through the cycle.
+    Overflow {
+        /// The derived quantity, e.g. `"team mass m_C"`.
+        quantity: &'static str,
+        /// The input it is derived from.
+        field: ConfigField,
+    },
     /// `M(Xi)` of eq. (4) does not have rank 6: the team cannot produce every wrench.
     RankDeficient {
         /// Smallest over largest eigenvalue of `M M^T` (0 when exactly singular).
@@ -222,6 +250,8 @@ impl ConfigError {
     pub fn field(&self) -> Option<ConfigField> {
         match *self {
             Self::NonFinite { field }
+            | Self::NotSymmetricPositiveDefinite { field }
+            | Self::Overflow { field, .. }
             | Self::NonPositiveThrust { field, .. }
             | Self::Parameter { field }
             | Self::UnusedOption { field } => Some(field),
@@ -243,6 +273,7 @@ impl ConfigError {
             } => Some(ConfigField::NavigatorMass),
             Self::IdleThrust { .. } => Some(ConfigField::MinThrust),
             Self::NavigatorInertia => Some(ConfigField::NavigatorInertia),
+            Self::AgentInertia { .. } => Some(ConfigField::AgentInertia),
             Self::Relaxation { .. } => Some(ConfigField::Relaxation),
             Self::NoAgents
             | Self::TooManyAgents { .. }
@@ -287,6 +318,17 @@ impl fmt::Display for ConfigError {
             Self::NavigatorInertia => write!(
                 f,
                 "the navigator inertia must be symmetric positive semi-definite"
+            ),
+            Self::AgentInertia { agent } => write!(
+                f,
+                "agent {agent}'s inertia must be symmetric positive semi-definite"
+            ),
+            Self::NotSymmetricPositiveDefinite { field } => {
+                write!(f, "`{field}` must be a symmetric positive definite matrix")
+            }
+            Self::Overflow { quantity, field } => write!(
+                f,
+                "the {quantity} derived from `{field}` is not finite in this float type (values too large)"
             ),
             Self::RankDeficient { conditioning } => write!(
                 f,

@@ -7,7 +7,7 @@
 //! non-rotation), and asserts per step:
 //! - no panic; on `Ok` every output number is finite;
 //! - every working agent's command is inside its `E_f` (`AdmissibleSet::contains` with
-//!   `command_tolerance`);
+//!   `command_tolerance`), and the inversion clamped at most `command_tolerance`;
 //! - `e_f` is what the forces produce: it equals `||u_fd - (M f)_f||` recomputed here from the
 //!   allocation's forces (relative `64 eps`), and from the commands through the effectiveness
 //!   (relative `1e4 eps` of the request plus what the agents can produce, the gimbal inverse's
@@ -228,7 +228,9 @@ fn allocator<T: Real>(rng: &mut StdRng, clarabel: bool) -> AnyAllocator<T, N> {
     AnyAllocator::from_name(name, &options).expect("the names and options are valid")
 }
 
-fn settings<T: Real>(rng: &mut StdRng) -> ControllerSettings<T> {
+/// Random settings; gains the validation refuses (e.g. too ill-conditioned to certify as
+/// positive definite in the type) come back as the `ConfigError`.
+fn settings<T: Real>(rng: &mut StdRng) -> Result<ControllerSettings<T>, tvmd_core::ConfigError> {
     let mut s = ControllerSettings::paper();
     if rng.random_bool(0.5) {
         let mut d = || conv(log_uniform(rng, 1e-2, 1e2));
@@ -236,16 +238,15 @@ fn settings<T: Real>(rng: &mut StdRng) -> ControllerSettings<T> {
             [d(), d(), d()],
             [d(), d(), d()],
             [d(), d(), d(), d(), d(), d()],
-        )
-        .expect("positive diagonal gains");
+        )?;
     }
     if rng.random_bool(0.3) {
         s.gravity = conv(rng.random_range(1.0..30.0));
     }
     if rng.random_bool(0.3) {
-        s.rate_limits = Some(RateLimits::new(conv(5.0), conv(5.0)).expect("positive rates"));
+        s.rate_limits = Some(RateLimits::new(conv(5.0), conv(5.0))?);
     }
-    s
+    Ok(s)
 }
 
 /// Counts of one run.
@@ -259,6 +260,7 @@ struct Counts {
     controllers: u64,
     clarabel_steps: u64,
     unusable: u64,
+    settings_rejected: u64,
 }
 
 /// `||v||` scaled (the test's own, independent of the crate's).
@@ -309,6 +311,13 @@ fn check_ok<T: Real>(
     context: &dyn Fn() -> String,
 ) {
     assert!(all_finite(out), "non-finite output: {}", context());
+    // Allocators return admissible forces: the inversion clamps round-off only.
+    assert!(
+        out.command_clamp <= command_tolerance::<T>(),
+        "clamp {:?}: {}",
+        out.command_clamp,
+        context()
+    );
     let e = c.effectiveness();
     let tol = command_tolerance::<T>();
     let mut from_commands = [Vector3::zeros(); N];
@@ -383,14 +392,20 @@ fn fuzz<T: Real>(label: &str, steps: u64, seed: u64, clarabel: bool) -> Counts {
             }
         };
         let use_clarabel = clarabel && rng.random_range(0..10) == 0;
-        let mut c =
-            match Controller::new(team, settings(&mut rng), allocator(&mut rng, use_clarabel)) {
-                Ok(c) => c,
-                Err(_) => {
-                    counts.teams_rejected += 1;
-                    continue;
-                }
-            };
+        let settings = match settings(&mut rng) {
+            Ok(s) => s,
+            Err(_) => {
+                counts.settings_rejected += 1;
+                continue;
+            }
+        };
+        let mut c = match Controller::new(team, settings, allocator(&mut rng, use_clarabel)) {
+            Ok(c) => c,
+            Err(_) => {
+                counts.teams_rejected += 1;
+                continue;
+            }
+        };
         counts.controllers += 1;
         if rng.random_bool(0.3) {
             let mut mask = FailureMask::<N>::none();
@@ -404,8 +419,8 @@ fn fuzz<T: Real>(label: &str, steps: u64, seed: u64, clarabel: bool) -> Counts {
         let limit = to_f64(c.input_limit());
         assert!(limit.is_finite() && limit >= 0.0, "input limit {limit}");
         if limit == 0.0 {
-            // A team whose totals overflow (e.g. an agent of mass MAX): the stricter team
-            // validation of branch hover-validate refuses it; this branch's core accepts it.
+            // A team whose totals overflow (e.g. an agent of mass MAX) is refused by the team
+            // and plant validation, so a usable controller always has a positive bound.
             counts.unusable += 1;
             continue;
         }
@@ -523,13 +538,14 @@ fn fuzz<T: Real>(label: &str, steps: u64, seed: u64, clarabel: bool) -> Counts {
         }
     }
     println!(
-        "cycle_fuzz {label}: {} steps ({} with clarabel), {} Ok, errors {:?}; {} controllers, {} teams and {} failure masks rejected with a ConfigError, {} teams with overflowing totals skipped",
+        "cycle_fuzz {label}: {} steps ({} with clarabel), {} Ok, errors {:?}; {} controllers, {} teams, {} settings and {} failure masks rejected with a ConfigError, {} teams with overflowing totals skipped",
         counts.steps,
         counts.clarabel_steps,
         counts.ok,
         counts.errors,
         counts.controllers,
         counts.teams_rejected,
+        counts.settings_rejected,
         counts.masks_rejected,
         counts.unusable
     );

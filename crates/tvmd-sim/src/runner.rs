@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use crate::control::TvmdController;
+use crate::control::AnyTvmdController;
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
 use crate::log::{McapLog, METADATA_SCENARIO};
@@ -55,7 +55,7 @@ pub fn write_scenario_metadata(log: &mut McapLog, scenario: &Scenario) -> Result
     log.write_metadata(METADATA_SCENARIO, meta)
 }
 
-/// Runs `scenario` with [`TvmdController`] to its end.
+/// Runs `scenario` with [`AnyTvmdController`] (in the scenario's `controller_precision`) to its end.
 ///
 /// With `log`, writes an MCAP file there (parent directories created, the scenario stored as
 /// metadata); the file is finalised even if the run fails. `progress(t)` is called at every
@@ -65,7 +65,7 @@ pub fn run_scenario(
     log: Option<&Path>,
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<RunResult, SimError> {
-    let mut controller = TvmdController::from_scenario(scenario)?;
+    let mut controller = AnyTvmdController::from_scenario(scenario)?;
     let mut sim = Simulation::with_options(scenario, SimOptions::default())?;
     let mut mcap = match log {
         Some(path) => {

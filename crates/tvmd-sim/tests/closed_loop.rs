@@ -193,7 +193,7 @@ fn a6_agent_failure_in_hover_is_survived() {
 fn a4_agent_failure_leaves_no_margin() {
     let mut s = Scenario::builtin("agent-failure").unwrap();
     s.duration = 9.0;
-    let mut ctl = TvmdController::from_scenario(&s).unwrap();
+    let mut ctl = TvmdController::<f64>::from_scenario(&s).unwrap();
     let mut sim = Simulation::new(&s).unwrap();
     let r = sim.run(&mut ctl, None).unwrap();
     // The controller did take the failure into account.
@@ -240,6 +240,8 @@ fn clarabel_allocator_completes_a_run() {
 fn clarabel_allocator_needs_the_feature() {
     let mut s = Scenario::builtin("paper-tilt").unwrap();
     s.allocator = "clarabel".into();
-    let e = TvmdController::from_scenario(&s).unwrap_err().to_string();
+    let e = TvmdController::<f64>::from_scenario(&s)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("allocator") && e.contains("clarabel"), "{e}");
 }

@@ -124,19 +124,19 @@ fn state_conversion_uses_body_velocity() {
         velocity: Vector3::new(0.5, -0.1, 0.2),
         omega: Vector3::new(0.01, 0.02, 0.03),
     };
-    let c = core_state(&s);
+    let c = core_state::<f64>(&s);
     assert!((r * c.velocity - s.velocity).norm() < 1e-15);
     assert_eq!(c.angular_velocity, s.omega);
     assert_eq!(c.attitude, r);
     let reference = ReferenceConfig::default().at(6.0);
-    let cr = core_reference(&reference);
+    let cr = core_reference::<f64>(&reference);
     assert_eq!(cr.attitude, reference.rotation);
     assert_eq!(cr.velocity, reference.velocity);
 }
 
 #[test]
 fn scenario_errors_name_the_field() {
-    let field_of = |s: &Scenario| match TvmdController::from_scenario(s).unwrap_err() {
+    let field_of = |s: &Scenario| match TvmdController::<f64>::from_scenario(s).unwrap_err() {
         SimError::InvalidScenario { field, .. } => field,
         e => panic!("unexpected error {e}"),
     };
@@ -164,7 +164,7 @@ fn scenario_errors_name_the_field() {
 #[test]
 fn failures_reach_the_core_and_bad_inputs_hold_the_commands() {
     let s = Scenario::builtin("a6-agent-failure").unwrap();
-    let mut ctl = TvmdController::from_scenario(&s).unwrap();
+    let mut ctl = TvmdController::<f64>::from_scenario(&s).unwrap();
     let state = PlantState::at_rest(Vector3::new(0.0, 0.0, 1.5));
     let reference = ReferenceConfig::Hover {
         position: [0.0, 0.0, 1.5],

@@ -12,6 +12,7 @@
 //! initial_position = [0.5, -0.5, 0.0]
 //! relaxation = 0.5
 //! allocator = "redistributed-pseudo-inverse"   # "pseudo-inverse", "clarabel", ...
+//! controller_precision = "f64"               # or "f32": the flight configuration
 //! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
 //!
 //! [physics]
@@ -71,6 +72,52 @@ use validate::invalid;
 /// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
 /// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
 pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
+
+/// The float type the controller runs in (the physics is always f64).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// `f64`: `tvmd_core::Controller<f64, ..>` (analysis; the default).
+    #[default]
+    F64,
+    /// `f32`: `tvmd_core::Controller<f32, ..>`, the type a flight controller runs.
+    F32,
+}
+
+impl Precision {
+    /// Every precision, in the order `f64`, `f32`.
+    pub const ALL: [Precision; 2] = [Precision::F64, Precision::F32];
+
+    /// The name used in scenarios, on the command line and in summaries: `"f64"` or `"f32"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        }
+    }
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Precision {
+    type Err = SimError;
+
+    /// Parses `"f64"` or `"f32"`; anything else is an invalid `controller_precision`.
+    fn from_str(s: &str) -> Result<Self, SimError> {
+        match s {
+            "f64" => Ok(Precision::F64),
+            "f32" => Ok(Precision::F32),
+            other => Err(invalid(
+                "controller_precision",
+                format!("unknown precision `{other}` (known: f64, f32)"),
+            )),
+        }
+    }
+}
 
 /// The team: a preset or explicit agents.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -310,6 +357,9 @@ pub struct Scenario {
     /// plant's: give both to model a servo the controller knows about.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controller_rate_limits: Option<[f64; 2]>,
+    /// The float type the controller runs in, `"f64"` (default) or `"f32"` (the flight
+    /// configuration: `tvmd_core::Controller<f32, ..>`). The physics stays f64.
+    pub controller_precision: Precision,
     /// Physics settings (step, gravity, ground, friction).
     pub physics: PhysicsConfig,
     /// The team.
@@ -341,6 +391,7 @@ impl Default for Scenario {
             relaxation: 0.5,
             allocator: "redistributed-pseudo-inverse".into(),
             controller_rate_limits: None,
+            controller_precision: Precision::F64,
             physics: PhysicsConfig::default(),
             team: TeamSpec::default(),
             limits: LimitsConfig::default(),

@@ -1,0 +1,161 @@
+//! The core's configuration of a scenario, in the controller's float type `T`: team
+//! ([`team_config`]), settings ([`controller_settings`]) and allocator ([`allocator`]), with
+//! the core's configuration errors mapped to the scenario field they refer to.
+
+use tvmd_core::error::{ConfigError, ConfigField};
+use tvmd_core::{
+    AgentLimits, AgentSpec, AnyAllocator, ControllerSettings, FailureMask, Gains, Navigator,
+    RateLimits, Relaxation, TeamConfig,
+};
+
+use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
+use super::MAX_AGENTS;
+use crate::math::from_rows;
+use crate::scenario::Scenario;
+use crate::SimError;
+
+pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
+    SimError::InvalidScenario {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+/// The scenario field a core configuration error refers to.
+fn config_field(e: &ConfigError) -> &'static str {
+    match e {
+        ConfigError::TooManyAgents { .. } => return "team.agents",
+        ConfigError::UnknownAllocator | ConfigError::AllocatorUnavailable { .. } => {
+            return "allocator"
+        }
+        _ => {}
+    }
+    match e.field() {
+        Some(ConfigField::SigmaX) => "limits.sigma_x",
+        Some(ConfigField::SigmaY) => "limits.sigma_y",
+        Some(
+            ConfigField::MaxThrust
+            | ConfigField::MinThrust
+            | ConfigField::ThrustCoefficient
+            | ConfigField::Rho
+            | ConfigField::RotorDiameter
+            | ConfigField::LiftCoefficient
+            | ConfigField::MaxRotorSpeed,
+        ) => "limits.max_thrust",
+        Some(ConfigField::Relaxation) => "relaxation",
+        Some(ConfigField::NavigatorInertia) if matches!(e, ConfigError::NavigatorInertia) => {
+            "team.navigator_inertia"
+        }
+        Some(ConfigField::GainKx) => "gains.k_x",
+        Some(ConfigField::GainKr) => "gains.k_r",
+        Some(ConfigField::GainKomega | ConfigField::GainKv) => "gains.k_xi",
+        Some(ConfigField::RateLimits) => "controller_rate_limits",
+        Some(ConfigField::Period) => "controller_period",
+        Some(ConfigField::Gravity) => "physics.gravity",
+        Some(
+            ConfigField::AllocatorWeights
+            | ConfigField::ClarabelLambda
+            | ConfigField::ClarabelWeights
+            | ConfigField::ClarabelTolerance
+            | ConfigField::PlannerTolerance
+            | ConfigField::PlannerMaxIterations,
+        ) => "allocator",
+        _ => "team",
+    }
+}
+
+pub(super) fn config_error(e: ConfigError) -> SimError {
+    invalid(config_field(&e), format!("rejected by the controller: {e}"))
+}
+
+/// The core's team configuration of a scenario in `T`: agents in the scenario's order, with
+/// their quarter turns and masses, the navigator, and the limits (`sigma_x`, `sigma_y`,
+/// `sigma_Tf`).
+pub fn team_config<T: CoreFloat>(
+    scenario: &Scenario,
+) -> Result<TeamConfig<T, MAX_AGENTS>, SimError> {
+    let body = scenario.team_body()?;
+    if body.len() > MAX_AGENTS {
+        return Err(invalid(
+            "team.agents",
+            format!(
+                "{} agents exceed the controller's capacity of {MAX_AGENTS}",
+                body.len()
+            ),
+        ));
+    }
+    let agents: Vec<AgentSpec<T>> = body
+        .agents
+        .iter()
+        .map(|a| {
+            AgentSpec::new(
+                vector_to_core(&a.position_vector()),
+                a.quarter_turns,
+                to_core(a.mass),
+            )
+        })
+        .collect();
+    let limits = AgentLimits::new(
+        to_core(scenario.limits.sigma_x),
+        to_core(scenario.limits.sigma_y),
+        to_core(scenario.max_thrust()?),
+    )
+    .map_err(config_error)?;
+    let navigator = Navigator {
+        mass: to_core(body.navigator_mass),
+        inertia: matrix_to_core(&from_rows(&body.navigator_inertia)),
+    };
+    TeamConfig::new(&agents, limits, navigator).map_err(config_error)
+}
+
+/// The core's controller settings of a scenario in `T`: gains, relaxation, gravity, period and
+/// the optional controller rate limits.
+pub fn controller_settings<T: CoreFloat>(
+    scenario: &Scenario,
+) -> Result<ControllerSettings<T>, SimError> {
+    let g = &scenario.gains;
+    let gains = Gains::diagonal(g.k_x.map(to_core), g.k_r.map(to_core), g.k_xi.map(to_core))
+        .map_err(config_error)?;
+    let relaxation = Relaxation::new(to_core(scenario.relaxation)).map_err(config_error)?;
+    let rate_limits = scenario
+        .controller_rate_limits
+        .map(|[x, y]| RateLimits::new(to_core(x), to_core(y)))
+        .transpose()
+        .map_err(config_error)?;
+    Ok(ControllerSettings {
+        gains,
+        relaxation,
+        gravity: to_core(scenario.physics.gravity),
+        period: to_core(scenario.controller_period),
+        rate_limits,
+    })
+}
+
+/// The allocator named by `scenario.allocator`, in `T`.
+pub fn allocator<T: CoreFloat>(name: &str) -> Result<AnyAllocator<T, MAX_AGENTS>, SimError> {
+    AnyAllocator::from_name(name, &Default::default()).map_err(|e| match e {
+        ConfigError::UnknownAllocator => invalid(
+            "allocator",
+            format!(
+                "unknown allocator `{name}` (known: {})",
+                crate::scenario::ALLOCATOR_NAMES.join(", ")
+            ),
+        ),
+        ConfigError::AllocatorUnavailable { .. } => invalid(
+            "allocator",
+            "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
+             (cargo build --features clarabel)",
+        ),
+        e => config_error(e),
+    })
+}
+
+/// `atan(c_y(1, s))`: the planned roll at which the planner saturates in hover for the
+/// scenario's team, limits and relaxation `s` (a reproduction target, see `docs/method.md`),
+/// computed in f64 whatever the scenario's precision.
+pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
+    let team = team_config::<f64>(scenario)?;
+    let afs = team.afs(&FailureMask::none()).map_err(config_error)?;
+    let s = Relaxation::new(s).map_err(config_error)?;
+    Ok(afs.semi_axes(1.0, s).c_y.atan())
+}

@@ -1,0 +1,69 @@
+//! The [`Diagnostics`] of one core cycle, converted to f64 (planner, control law, allocation,
+//! Lyapunov values).
+
+use std::collections::BTreeMap;
+
+use super::convert::{array_to_sim, matrix_to_sim, to_sim, vector_to_sim, CoreFloat};
+use super::CoreOutput;
+use crate::diagnostics::{
+    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics, PlannerDiagnostics,
+};
+use crate::math::{planned_roll, to_rows};
+use tvmd_core::PlannerStatus;
+
+/// The diagnostics of `out` for a team of `n` agents, with the controller's failure note.
+pub(super) fn cycle_diagnostics<T: CoreFloat>(
+    out: &CoreOutput<T>,
+    n: usize,
+    failure_note: Option<String>,
+) -> Diagnostics {
+    let r_d = matrix_to_sim(&out.planner.r_d);
+    let law = &out.law;
+    let e = array_to_sim::<T, 6>(law.e_xi.into());
+    let alloc = &out.allocation;
+    let mut extra = BTreeMap::new();
+    extra.insert("f_r", serde_json::json!(vector_to_sim(&out.f_r)));
+    extra.insert(
+        "command_clamp",
+        serde_json::json!(to_sim(out.command_clamp)),
+    );
+    Diagnostics {
+        planner: Some(PlannerDiagnostics {
+            r_d: to_rows(&r_d),
+            theta: to_sim(out.planner.theta),
+            t_tf: to_sim(out.projection.t_tf),
+            t_eta: to_sim(out.projection.t_eta),
+            reference_feasible: out.planner.status == PlannerStatus::AlreadyFeasible,
+            planned_roll: planned_roll(&r_d),
+            status: out.planner.status.as_str().to_string(),
+            iterations: out.planner.iterations,
+        }),
+        control: Some(ControlDiagnostics {
+            u_r: array_to_sim(law.u_r.into()),
+            u_d: array_to_sim(law.u_d.into()),
+            e_x: vector_to_sim(&law.e_x),
+            e_v: [e[3], e[4], e[5]],
+            e_r: vector_to_sim(&law.e_r),
+            e_omega: [e[0], e[1], e[2]],
+            t_tf: to_sim(out.projection.t_tf),
+            t_eta: to_sim(out.projection.t_eta),
+            extra: serde_json::json!(extra),
+        }),
+        allocation: Some(AllocationDiagnostics {
+            wrench: array_to_sim(alloc.wrench.into()),
+            e_f: to_sim(alloc.e_f),
+            saturated: alloc.saturated[..n].to_vec(),
+            wrench_error: to_sim(alloc.wrench_error),
+            rounds: alloc.rounds,
+            fallback: alloc.fallback,
+            forces: alloc.forces[..n].iter().map(vector_to_sim).collect(),
+            rotor_speeds: out.commands[..n].iter().map(|c| to_sim(c.omega)).collect(),
+        }),
+        lyapunov: Some(LyapunovDiagnostics {
+            v_x: to_sim(law.v_x),
+            v_r: to_sim(law.v_r),
+        }),
+        cycle_error: None,
+        failure_note,
+    }
+}

@@ -1,0 +1,212 @@
+//! The tvmd controller in the loop: an adapter from [`tvmd_core::Controller`] to
+//! [`FlightController`], in f64 or in f32 (the flight configuration).
+//!
+//! [`TvmdController<T>`] wraps `tvmd_core::Controller<T, 16, AnyAllocator<T, 16>>` unchanged,
+//! for `T = f64` or `T = f32` ([`CoreFloat`]); [`AnyTvmdController`] is the one the scenario's
+//! `controller_precision` picks. The controller is built from the scenario (module `config`:
+//! same agent order, quarter turns, masses, navigator, gains with `K_xi` diagonal in the order
+//! `[Omega; v]`, relaxation `s`, controller period, optional controller rate limits and
+//! allocator, each rounded to `T`); then at each tick:
+//!
+//! 1. converts the simulator's state (world velocity `x_dot`, body `Omega`) into the core's
+//!    state with the body-frame velocity `v = R^T x_dot`, and the reference likewise, rounding
+//!    to `T` (module `convert`: the only place precisions meet);
+//! 2. passes a changed failure mask (the failures the controller is told of) to
+//!    [`tvmd_core::Controller::set_failures`]; if the core refuses it (the remaining team cannot
+//!    produce every wrench) the old mask stays and the reason is reported in
+//!    [`Diagnostics::failure_note`];
+//! 3. runs one [`tvmd_core::Controller::step`] in `T`; on a [`tvmd_core::CycleError`] it holds
+//!    the commands the error carries and reports the error in [`Diagnostics::cycle_error`];
+//! 4. converts the commands and every part of [`Diagnostics`] (planner, control law,
+//!    allocation, Lyapunov values) back to f64 (exact).
+
+use tvmd_core::{AnyAllocator, FailureMask};
+
+use crate::diagnostics::Diagnostics;
+use crate::error::BoxedError;
+use crate::flight::{FlightController, FlightOutput};
+use crate::physics::PlantState;
+use crate::reference::ReferenceSample;
+use crate::scenario::{Precision, Scenario};
+use crate::SimError;
+
+mod config;
+mod convert;
+mod diagnostics;
+
+pub use config::{allocator, controller_settings, hover_roll_limit, team_config};
+pub use convert::{core_reference, core_state, sim_command, CoreFloat};
+
+/// Agent capacity of the controller the simulator runs (the core's const generic `N`).
+pub const MAX_AGENTS: usize = 16;
+
+/// The core controller type the simulator runs, in `T` (f32: the type a flight controller runs).
+pub type CoreController<T> = tvmd_core::Controller<T, MAX_AGENTS, AnyAllocator<T, MAX_AGENTS>>;
+
+/// The core's output of one cycle.
+pub type CoreOutput<T> = tvmd_core::ControlOutput<T, MAX_AGENTS>;
+
+/// [`tvmd_core::Controller`] in `T` as a [`FlightController`].
+#[derive(Debug)]
+pub struct TvmdController<T: CoreFloat> {
+    inner: CoreController<T>,
+    n: usize,
+    mask: Vec<bool>,
+    failure_note: Option<String>,
+    last: Option<CoreOutput<T>>,
+}
+
+impl<T: CoreFloat> TvmdController<T> {
+    /// The controller of a scenario in `T` (team, limits, gains, relaxation, period, rate limits
+    /// and allocator), whatever the scenario's `controller_precision` (see
+    /// [`AnyTvmdController::from_scenario`] for the one it names). Errors name the scenario
+    /// field the core rejected.
+    pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
+        let team = config::team_config::<T>(scenario)?;
+        let settings = config::controller_settings::<T>(scenario)?;
+        let alloc = config::allocator::<T>(&scenario.allocator)?;
+        let n = team.len();
+        let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
+        Ok(Self::new(inner, n))
+    }
+
+    /// Wraps a core controller for a team of `n` agents.
+    pub fn new(inner: CoreController<T>, n: usize) -> Self {
+        Self {
+            inner,
+            n,
+            mask: vec![false; n],
+            failure_note: None,
+            last: None,
+        }
+    }
+
+    /// The wrapped core controller.
+    pub fn core(&self) -> &CoreController<T> {
+        &self.inner
+    }
+
+    /// The core's output of the last successful cycle.
+    pub fn last_output(&self) -> Option<&CoreOutput<T>> {
+        self.last.as_ref()
+    }
+
+    fn update_failures(&mut self, failed: &[bool]) {
+        let wanted: Vec<bool> = (0..self.n)
+            .map(|i| failed.get(i).copied().unwrap_or(false))
+            .collect();
+        if wanted == self.mask {
+            return;
+        }
+        let mut mask = FailureMask::<MAX_AGENTS>::none();
+        for (i, f) in wanted.iter().enumerate() {
+            // i < n <= MAX_AGENTS, so this cannot fail.
+            let _ = mask.set(i, *f);
+        }
+        match self.inner.set_failures(mask) {
+            Ok(_) => {
+                self.failure_note = None;
+            }
+            Err(e) => {
+                self.failure_note = Some(format!(
+                    "failure mask {wanted:?} refused, keeping {:?}: {e}",
+                    self.mask
+                ));
+            }
+        }
+        self.mask = self.inner.failures().as_array()[..self.n].to_vec();
+        if self.mask != wanted && self.failure_note.is_none() {
+            self.failure_note = Some(format!("failure mask {wanted:?} not applied"));
+        }
+    }
+}
+
+impl<T: CoreFloat> FlightController for TvmdController<T> {
+    fn step(
+        &mut self,
+        _t: f64,
+        state: &PlantState,
+        reference: &ReferenceSample,
+        failed: &[bool],
+    ) -> Result<FlightOutput, BoxedError> {
+        self.update_failures(failed);
+        let n = self.n;
+        match self.inner.step(
+            &convert::core_state(state),
+            &convert::core_reference(reference),
+        ) {
+            Ok(out) => {
+                let diagnostics =
+                    diagnostics::cycle_diagnostics(&out, n, self.failure_note.clone());
+                let commands = out.commands[..n].iter().map(sim_command).collect();
+                self.last = Some(out);
+                Ok(FlightOutput {
+                    commands,
+                    diagnostics,
+                })
+            }
+            Err(e) => Ok(FlightOutput {
+                commands: e.commands[..n].iter().map(sim_command).collect(),
+                diagnostics: Diagnostics {
+                    cycle_error: Some(e.to_string()),
+                    failure_note: self.failure_note.clone(),
+                    ..Default::default()
+                },
+            }),
+        }
+    }
+}
+
+/// The tvmd controller in the precision a scenario names (`controller_precision`): one
+/// [`TvmdController`] type per float, the same logic.
+// One per run: the f64 variant's extra 4 kB is not worth a box.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub enum AnyTvmdController {
+    /// `TvmdController<f64>`.
+    F64(TvmdController<f64>),
+    /// `TvmdController<f32>`, the type a flight controller runs.
+    F32(TvmdController<f32>),
+}
+
+impl AnyTvmdController {
+    /// The controller of a scenario, in its `controller_precision`. Errors name the scenario
+    /// field the core rejected.
+    pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
+        Ok(match scenario.controller_precision {
+            Precision::F64 => Self::F64(TvmdController::from_scenario(scenario)?),
+            Precision::F32 => Self::F32(TvmdController::from_scenario(scenario)?),
+        })
+    }
+
+    /// The precision the controller runs in.
+    pub fn precision(&self) -> Precision {
+        match self {
+            Self::F64(_) => Precision::F64,
+            Self::F32(_) => Precision::F32,
+        }
+    }
+
+    /// The agents the core currently treats as failed (the mask it accepted).
+    pub fn failures(&self) -> FailureMask<MAX_AGENTS> {
+        match self {
+            Self::F64(c) => *c.core().failures(),
+            Self::F32(c) => *c.core().failures(),
+        }
+    }
+}
+
+impl FlightController for AnyTvmdController {
+    fn step(
+        &mut self,
+        t: f64,
+        state: &PlantState,
+        reference: &ReferenceSample,
+        failed: &[bool],
+    ) -> Result<FlightOutput, BoxedError> {
+        match self {
+            Self::F64(c) => c.step(t, state, reference, failed),
+            Self::F32(c) => c.step(t, state, reference, failed),
+        }
+    }
+}
