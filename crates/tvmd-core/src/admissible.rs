@@ -154,6 +154,13 @@ impl<T: Real> AdmissibleSet<T> {
         } else {
             T::zero()
         };
+        // A thrust below the range's resolution (`eps sigma_Tf`) is zero: its force would be
+        // subnormal, and its gimbal inverse no longer exact.
+        let along = if along <= self.thrust.hi * T::default_epsilon() {
+            T::zero()
+        } else {
+            along
+        };
         direction * self.thrust.clamp(along)
     }
 }
