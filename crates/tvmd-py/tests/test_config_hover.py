@@ -152,3 +152,12 @@ def test_team_hover_capability_gravity_and_errors():
         A4.hover_capability(failed=[0, 1, 2, 3])
     with pytest.raises(tvmd.ConfigError):
         A4.hover_capability(failed=[7])
+
+
+def test_simulator_reports_the_classification_of_a_failure():
+    lost = tvmd.sim.run("agent-failure").summary["hover_classifications"]
+    assert len(lost) == 1 and lost[0]["time"] == pytest.approx(5.0)
+    assert not lost[0]["capable"] and abs(lost[0]["margin"]) < 1e-9 and not lost[0]["landing"]
+    kept = tvmd.sim.run("a6-agent-failure").summary["hover_classifications"]
+    assert len(kept) == 1 and kept[0]["capable"]
+    assert kept[0]["margin"] == pytest.approx(0.4, abs=1e-6)
