@@ -98,7 +98,9 @@ mod tests {
         assert!(is_symmetric_pd(&(d(1.0, 2.0, 3.0) * 1e300)));
         assert!(is_symmetric_pd(&(d(1.0, 2.0, 3.0) * 1e-300)));
         assert!(is_symmetric_pd(&(Matrix3::<f32>::identity() * 1e30)));
-        assert!(is_symmetric_pd(&Matrix3::<f32>::from_diagonal(&Vector3::new(1e-6, 1.0, 1.0))));
+        assert!(is_symmetric_pd(&Matrix3::<f32>::from_diagonal(
+            &Vector3::new(1e-6, 1.0, 1.0)
+        )));
         // Singular up to rounding: refused.
         assert!(!is_symmetric_pd(&d(1e-17, 1.0, 1.0)));
         assert!(!is_symmetric_psd(&d(f64::NAN, 1.0, 1.0)));
