@@ -21,12 +21,13 @@ pub(crate) fn is_symmetric_psd<T: Real>(j: &Matrix3<T>) -> bool {
 }
 
 /// `true` if `j` is finite, symmetric and positive definite: after scaling, the leading
-/// principal minors are `> 64 eps` (so a matrix singular up to rounding is refused).
+/// principal minors are `> eps` (so a matrix singular up to rounding is refused, while an
+/// eigenvalue ratio down to about `eps`, e.g. `diag(1e-6, 1, 1)` in f32, is accepted).
 pub(crate) fn is_symmetric_pd<T: Real>(j: &Matrix3<T>) -> bool {
     match scaled(j) {
         Some(Scaled::Unit(a)) => {
             let [m11, _, _, m12, _, _, det] = principal_minors(&a);
-            [m11, m12, det].iter().all(|m| *m > tolerance::<T>())
+            [m11, m12, det].iter().all(|m| *m > eps::<T>())
         }
         _ => false,
     }
@@ -97,6 +98,11 @@ mod tests {
         assert!(is_symmetric_pd(&(d(1.0, 2.0, 3.0) * 1e300)));
         assert!(is_symmetric_pd(&(d(1.0, 2.0, 3.0) * 1e-300)));
         assert!(is_symmetric_pd(&(Matrix3::<f32>::identity() * 1e30)));
+        assert!(is_symmetric_pd(&Matrix3::<f32>::from_diagonal(
+            &Vector3::new(1e-6, 1.0, 1.0)
+        )));
+        // Singular up to rounding: refused.
+        assert!(!is_symmetric_pd(&d(1e-17, 1.0, 1.0)));
         assert!(!is_symmetric_psd(&d(f64::NAN, 1.0, 1.0)));
         assert!(!is_symmetric_pd(&d(f64::INFINITY, 1.0, 1.0)));
     }

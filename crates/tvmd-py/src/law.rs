@@ -11,7 +11,7 @@ use tvmd_core::law::{control_wrench as core_control_wrench, force_request as cor
 use tvmd_core::law::{LawOutput, Plant};
 use tvmd_core::{Gains, Reference, RigidState};
 
-use crate::convert::{arg, array, check_finite, class_arg, finite, matrix};
+use crate::convert::{arg, array, check_finite, class_arg, finite, finite_scalar, matrix};
 use crate::convert::{matrix3_or_diagonal, opt_arg, shape_error};
 use crate::errors::OrRaise;
 use crate::record::record;
@@ -246,6 +246,9 @@ impl PyPlant {
     /// A validated plant: `mass > 0`, `inertia` symmetric positive definite, `gravity > 0`,
     /// all finite (the core's checks, raised as `ConfigError`).
     pub(crate) fn create(mass: f64, inertia: Matrix3<f64>, gravity: f64) -> PyResult<Self> {
+        finite_scalar(mass, "mass")?;
+        check_finite(inertia.iter(), "inertia")?;
+        finite_scalar(gravity, "gravity")?;
         Ok(Self {
             inner: Plant::new(mass, inertia, gravity).or_raise()?,
         })
