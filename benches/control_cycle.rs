@@ -63,11 +63,8 @@ fn bench_size<T: Real, const N: usize>(c: &mut Criterion, float: &str) {
     g.bench_with_input(BenchmarkId::new("planner", N), &f_r, |b, f_r| {
         b.iter(|| planner.plan(&afs, black_box(&reference.attitude), black_box(f_r)))
     });
-    let plant = tvmd::core::law::Plant {
-        mass: team.mass(),
-        inertia: team.inertia(),
-        gravity: lit(9.81),
-    };
+    let plant = tvmd::core::law::Plant::new(team.mass(), team.inertia(), lit(9.81))
+        .expect("the preset team's plant is valid");
     let r_d = roll(lit(0.33));
     g.bench_with_input(BenchmarkId::new("control_law", N), &state, |b, state| {
         b.iter(|| {

@@ -4,10 +4,11 @@
 use nalgebra::Vector3;
 
 use crate::error::{ConfigError, ConfigField};
-use crate::gimbal::GimbalCommand;
+use crate::gimbal::{thrust_direction, GimbalCommand};
 use crate::limits::AgentLimits;
 /// The interval and rate limits, at their old paths (now in [`crate::limits`]).
 pub use crate::limits::{Interval, RateLimits};
+use crate::linalg::max_abs;
 use crate::real::Real;
 
 /// Each agent's admissible set for one period: `base` everywhere, narrowed around each agent's
@@ -137,8 +138,29 @@ impl<T: Real> AdmissibleSet<T> {
         }
     }
 
-    /// The agent-frame force `f` saturated into the set (through [`Self::clamp`]).
+    /// The agent-frame force `f` saturated into the set: the gimbal angles clamped
+    /// ([`Self::clamp`]), then the point of the clamped direction's ray `T a_hat`,
+    /// `T in thrust`, closest to `f` (`T = clamp(f . a_hat)`). A force pointing away from the
+    /// clamped direction (e.g. downward) gets the least thrust, never its own norm along a
+    /// direction it does not have. A non-finite force gives the least thrust, gimbal clamped
+    /// from centre. Always finite and inside the set (up to the gimbal inverse's round-off).
     pub fn saturate(&self, force: &Vector3<T>) -> Vector3<T> {
-        self.clamp(&GimbalCommand::from_force(force)).force()
+        let g = self.clamp(&GimbalCommand::from_force(force));
+        let direction = thrust_direction(g.eta_x, g.eta_y);
+        let m = max_abs(force);
+        let along = if m > T::zero() && m.is_finite() {
+            // Scaled so that a huge force does not overflow the dot product into NaN.
+            (force / m).dot(&direction) * m
+        } else {
+            T::zero()
+        };
+        // A thrust below the range's resolution (`eps sigma_Tf`) is zero: its force would be
+        // subnormal, and its gimbal inverse no longer exact.
+        let along = if along <= self.thrust.hi * T::default_epsilon() {
+            T::zero()
+        } else {
+            along
+        };
+        direction * self.thrust.clamp(along)
     }
 }

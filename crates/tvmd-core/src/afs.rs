@@ -3,6 +3,7 @@
 use nalgebra::Vector3;
 
 use crate::error::{ConfigError, ConfigField};
+use crate::linalg::norm;
 use crate::real::{count, to_f64, Real};
 
 /// The AFS relaxation `s in (0, 1]`: gimbal limits are shrunk to `s sigma` when planning, which
@@ -42,8 +43,8 @@ pub struct SemiAxes<T: Real> {
     pub c_x: T,
     /// `c_y(z, s)`.
     pub c_y: T,
-    /// Whether a semi-axis comes from the `sigma >= pi/2` branch of eq. (8) (then the AFS is not
-    /// confined to `z > 0`).
+    /// Whether a semi-axis comes from the `sigma >= pi/2` branch of eq. (8) (then the AFS admits
+    /// forces at `z = 0` away from the apex; it never admits `z < 0`).
     pub unbounded_branch: bool,
 }
 
@@ -51,9 +52,12 @@ pub struct SemiAxes<T: Real> {
 /// `u_f in AFS  <=>  u_f^T C(u_fz) u_f <= 1  and  ||u_f|| <= n sigma_Tf` (eq. 7),
 /// with `C = diag(1/c_x^2, 1/c_y^2, 0)` and `c_x, c_y` from eq. (8).
 ///
-/// A force with `z <= 0` is outside unless a semi-axis comes from the `sigma >= pi/2` branch
-/// (the reading of `docs/method.md`; the authors' code checks `z > 0`). The thrust bound is closed (`<=`), where the
-/// paper writes `<`, so that the projection's output `t_Tf u` is a member.
+/// Every agent's thrust has `z = T cos(eta_x) cos(eta_y) >= 0`, so a force with `z < 0` is never
+/// a member, whatever the branch; `z = 0` is a member only where a semi-axis comes from the
+/// `sigma >= pi/2` branch, or at the apex `u = 0` (all thrusts zero). Otherwise membership needs
+/// `z > 0` (the reading of `docs/method.md`; the authors' code checks `z > 0`). The thrust bound
+/// is closed (`<=`), where the paper writes `<`, so that the projection's output `t_Tf u` is a
+/// member.
 ///
 /// ```
 /// use tvmd_core::nalgebra::Vector3;
@@ -199,26 +203,20 @@ impl<T: Real> EllipticCone<T> {
         ratio_squared(u.x, axes.c_x) + ratio_squared(u.y, axes.c_y)
     }
 
-    /// Membership: `||u|| <= n sigma_Tf`, `u^T C u <= 1`, and `z > 0` unless a semi-axis comes
-    /// from the `sigma >= pi/2` branch.
+    /// Membership: `||u|| <= n sigma_Tf` (an overflow-safe norm), `u^T C u <= 1`, never `z < 0`
+    /// (see the type's rustdoc).
     pub fn contains(&self, u: &Vector3<T>) -> bool {
-        u.iter().all(|x| x.is_finite()) && u.norm() <= self.max_force && self.admits(u)
+        u.iter().all(|x| x.is_finite()) && norm(u) <= self.max_force && self.admits(u)
     }
 
     /// Membership without the thrust bound (the planner checks `||u||` once per plan, as it is
-    /// invariant under rotation). Division-free: `x^2 c_y^2 + y^2 c_x^2 <= c_x^2 c_y^2`, with
-    /// the zero-semi-axis rule of [`Self::quadratic_form`].
+    /// invariant under rotation): `z >= 0` and `(u_x / c_x)^2 + (u_y / c_y)^2 <= 1`, with the
+    /// zero-semi-axis rule of [`Self::quadratic_form`]. At `z = 0` only the `sigma >= pi/2`
+    /// branch gives a non-zero semi-axis, so elsewhere only the apex passes. The ratios neither
+    /// overflow nor underflow where squares of the components would.
     pub fn admits(&self, u: &Vector3<T>) -> bool {
-        if !(u.z > T::zero() || self.unbounded_branch) {
-            return false;
-        }
-        let axes = self.semi_axes(u.z);
-        let (x2, y2) = (u.x * u.x, u.y * u.y);
-        let (cx2, cy2) = (axes.c_x * axes.c_x, axes.c_y * axes.c_y);
-        if cx2 == T::zero() || cy2 == T::zero() {
-            return self.quadratic_form(u) <= T::one();
-        }
-        x2 * cy2 + y2 * cx2 <= cx2 * cy2
+        // Written so a NaN height fails too.
+        u.z >= T::zero() && self.quadratic_form(u) <= T::one()
     }
 
     /// `n sigma_Tf`.

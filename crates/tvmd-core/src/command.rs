@@ -56,15 +56,26 @@ pub fn command_tolerance<T: Real>() -> T {
 
 /// Inverts an agent-frame force into a command inside `set`. Returns the command and the clamp
 /// it needed (normalized as [`AdmissibleSet::violation`]). Non-finite forces give the clamped
-/// idle command.
+/// idle command; a zero force, zero thrust with the gimbal clamped from centre into the set (no
+/// clamp counted for the angles, which a zero force does not have).
 pub fn invert<T: Real>(
     force: &Vector3<T>,
     set: &AdmissibleSet<T>,
     limits: &AgentLimits<T>,
 ) -> (AgentCommand<T>, T) {
     let raw = GimbalCommand::from_force(force);
-    let clamp = set.violation(&raw);
     let g = set.clamp(&raw);
+    // A zero force has no direction: every angle produces it at zero thrust, so the angles are
+    // taken inside the set (a rate window need not hold the centred gimbal) and only the thrust
+    // counts as a clamp.
+    let clamp = if raw.thrust == T::zero() {
+        set.violation(&GimbalCommand {
+            thrust: raw.thrust,
+            ..g
+        })
+    } else {
+        set.violation(&raw)
+    };
     (
         AgentCommand {
             eta_x: g.eta_x,

@@ -12,10 +12,11 @@ use crate::allocation::{Allocation, AllocationRequest, Allocator};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField, InputError};
+use crate::hover::{hover_capability, HoverCapability};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::{project_force_in, ForceProjection};
-use crate::real::{lit, Real};
+use crate::real::{count, lit, to_f64, Real};
 use crate::team::{FailureMask, TeamConfig};
 
 /// Settings of a [`Controller`] besides the team and the allocator.
@@ -119,7 +120,11 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     planner_cone: EllipticCone<T>,
     effectiveness: Effectiveness<T, N>,
     admissible: AdmissibleSet<T>,
+    /// The classification of the working agents, computed when the mask is set.
+    hover: HoverCapability<T>,
     previous: [AgentCommand<T>; N],
+    /// The bound on every input component ([`Self::input_limit`]).
+    input_limit: T,
 }
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
@@ -130,23 +135,26 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         allocator: A,
     ) -> Result<Self, ConfigError> {
         settings.validate()?;
+        // Also rejects a gravity whose weight m_C g overflows.
+        let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
         let failures = FailureMask::none();
         let afs = team.afs(&failures)?;
         let effectiveness = team.effectiveness(&failures);
         let mut allocator = allocator;
         allocator.configure(&effectiveness);
+        let input_limit = input_limit(&team, &settings);
+        let admissible = AdmissibleSet::from_limits(team.limits());
+        let hover = hover_capability(&effectiveness, &admissible, plant.weight());
         Ok(Self {
+            input_limit,
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
             afs,
-            plant: Plant {
-                mass: team.mass(),
-                inertia: team.inertia(),
-                gravity: settings.gravity,
-            },
+            plant,
             planner: AttitudePlanner::new(settings.relaxation),
             effectiveness,
-            admissible: AdmissibleSet::from_limits(team.limits()),
+            admissible,
+            hover,
             team,
             settings,
             allocator,
@@ -155,17 +163,44 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         })
     }
 
-    /// Tells the controller which agents failed. Errors (and keeps the old mask) if the
-    /// remaining team cannot produce every wrench.
-    pub fn set_failures(&mut self, failures: FailureMask<N>) -> Result<(), ConfigError> {
+    /// Tells the controller which agents failed, and classifies the working agents: whether
+    /// they can hold hover with a margin ([`crate::hover`]), so a caller can decide to land.
+    /// The classification is computed here, once per mask, and kept
+    /// ([`Self::hover_capability`]). Errors (and keeps the old mask) if the remaining team
+    /// cannot produce every wrench.
+    ///
+    /// ```
+    /// use tvmd_core::{team::presets, Controller, ControllerSettings, FailureMask};
+    /// use tvmd_core::RedistributedPseudoInverse;
+    /// let team = presets::a4_inc::<f32, 4>()?;
+    /// let mut controller =
+    ///     Controller::new(team, ControllerSettings::paper(), RedistributedPseudoInverse)?;
+    /// assert!(controller.hover_capability().capable);
+    /// // Rank 6 is kept, but three agents at z = 0 cannot hold hover with a margin.
+    /// let hover = controller.set_failures(FailureMask::with_failed(&[2])?)?;
+    /// assert!(!hover.capable);
+    /// assert_eq!(controller.hover_capability(), &hover);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn set_failures(
+        &mut self,
+        failures: FailureMask<N>,
+    ) -> Result<HoverCapability<T>, ConfigError> {
         self.team.validate_failures(&failures)?;
         self.afs = self.team.afs(&failures)?;
         self.full_cone = self.afs.cone(Relaxation::none());
         self.planner_cone = self.afs.cone(self.settings.relaxation);
         self.effectiveness = self.team.effectiveness(&failures);
         self.allocator.configure(&self.effectiveness);
+        self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
         self.failures = failures;
-        Ok(())
+        Ok(self.hover)
+    }
+
+    /// Whether the working agents can hold hover with a margin, as classified when the
+    /// failure mask was last set (or at [`Self::new`] for the full team).
+    pub fn hover_capability(&self) -> &HoverCapability<T> {
+        &self.hover
     }
 
     /// Replaces the planner (e.g. another tolerance); its relaxation becomes the controller's.
@@ -210,6 +245,21 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         &self.allocator
     }
 
+    /// The bound `B` on `|component|` of every vector input of [`Self::step`] (positions,
+    /// velocities, accelerations, angular velocities and accelerations of state and reference):
+    /// beyond it the cycle returns [`InputError::OutOfRange`]. Derived once in [`Self::new`]
+    /// from the team's own scales so that every product of the cycle stays finite:
+    /// `B = (1/64) min(MAX / S1, sqrt(MAX / S2))`, with `S1` the largest linear coefficient
+    /// (`1`, `m_C`, `m_C g`, `n sigma_Tf` and `3 max|.|` of `J_C`, `K_x`, `K_R`, `K_Omega`,
+    /// `K_v`) and `S2` the largest quadratic one (`1`, `m_C` and `3 max|.|` of `J_C`, `K_x`,
+    /// `K_Omega`, `K_v`: `[J Omega]x Omega_d` and the Lyapunov values). The allocators take any
+    /// finite wrench (they scale a huge one, `docs/method.md`), so the Gram matrix's
+    /// conditioning does not enter. For the paper's A4-Inc with the paper's settings:
+    /// `5.9e16` in `f32` and `4.3e151` in `f64` (`S2 = 24`, from `K_Omega`).
+    pub fn input_limit(&self) -> T {
+        self.input_limit
+    }
+
     /// The previous period's commands.
     pub fn previous_commands(&self) -> &[AgentCommand<T>; N] {
         &self.previous
@@ -231,8 +281,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// One control period: `u_fr`, projection `t_Tf`, planner (`R_d`), `K_f` and the torque part,
     /// allocation, and inversion to commands inside `E_f`.
     ///
-    /// A non-finite or non-rotation input is rejected with a [`CycleError`] that carries the
-    /// previous commands to hold.
+    /// A non-finite or non-rotation input, or a component beyond [`Self::input_limit`]
+    /// ([`InputError::OutOfRange`]), is rejected with a [`CycleError`] that carries the previous
+    /// commands to hold. So is a period whose only answer to a finite, non-zero force request
+    /// `u_fr` is zero thrust on every agent ([`InputError::Unattainable`]: never a silent free
+    /// fall), and, as a safety net, one with a non-finite output ([`InputError::Overflow`]).
     ///
     /// ```
     /// use tvmd_core::nalgebra::Vector3;
@@ -266,6 +319,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         };
         state.validate().map_err(reject)?;
         reference.validate().map_err(reject)?;
+        self.check_range(state, reference).map_err(reject)?;
         let gains = &self.settings.gains;
         let u_fr = force_request(&self.plant, gains, state, reference);
         let projection = project_force_in(&self.full_cone, &u_fr);
@@ -303,8 +357,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                 command_clamp = command_clamp.max(clamp);
             }
         }
-        self.previous = commands;
-        Ok(ControlOutput {
+        let output = ControlOutput {
             planner,
             projection,
             f_r,
@@ -312,6 +365,118 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             allocation,
             commands,
             command_clamp,
-        })
+        };
+        // Never a silent free fall: zero thrust everywhere for a finite, non-zero request.
+        if u_fr != Vector3::zeros() && commands.iter().all(|c| c.thrust == T::zero()) {
+            return Err(reject(InputError::Unattainable {
+                field: "force_request",
+            }));
+        }
+        if let Some(field) = first_non_finite(&output) {
+            return Err(reject(InputError::Overflow { field }));
+        }
+        self.previous = commands;
+        Ok(output)
     }
+
+    /// [`InputError::OutOfRange`] for the first vector input with a component beyond
+    /// [`Self::input_limit`].
+    fn check_range(
+        &self,
+        state: &RigidState<T>,
+        reference: &Reference<T>,
+    ) -> Result<(), InputError> {
+        for (v, field) in [
+            (&state.position, "state.position"),
+            (&state.angular_velocity, "state.angular_velocity"),
+            (&state.velocity, "state.velocity"),
+            (&reference.position, "reference.position"),
+            (&reference.velocity, "reference.velocity"),
+            (&reference.acceleration, "reference.acceleration"),
+            (&reference.angular_velocity, "reference.angular_velocity"),
+            (
+                &reference.angular_acceleration,
+                "reference.angular_acceleration",
+            ),
+        ] {
+            if v.iter().any(|x| x.abs() > self.input_limit) {
+                return Err(InputError::OutOfRange {
+                    field,
+                    limit: to_f64(self.input_limit),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `B` of [`Controller::input_limit`].
+fn input_limit<T: Real, const N: usize>(
+    team: &TeamConfig<T, N>,
+    settings: &ControllerSettings<T>,
+) -> T {
+    let row = |k: &nalgebra::Matrix3<T>| k.amax() * lit(3.0);
+    let gains = &settings.gains;
+    let mass = team.mass();
+    let quadratic = [
+        row(&team.inertia()),
+        row(&gains.k_x()),
+        row(&gains.k_omega()),
+        row(&gains.k_v()),
+        mass,
+    ]
+    .iter()
+    .fold(T::one(), |m, x| m.max(*x));
+    let linear = [
+        quadratic,
+        row(&gains.k_r()),
+        mass * settings.gravity,
+        count::<T>(team.len()) * team.limits().max_thrust(),
+    ]
+    .iter()
+    .fold(T::one(), |m, x| m.max(*x));
+    let max = T::max_value().unwrap_or_else(T::one);
+    (max / linear).min((max / quadratic).sqrt()) / lit(64.0)
+}
+
+/// The first output field with a non-finite number (the cycle's safety net). Cheap: each part
+/// sums `x * 0`, which is NaN exactly when some `x` is not finite (one multiply-add per number).
+fn first_non_finite<T: Real, const N: usize>(out: &ControlOutput<T, N>) -> Option<&'static str> {
+    let zero = T::zero();
+    let probe = |values: &[T]| values.iter().fold(zero, |acc, x| acc + *x * zero) == zero;
+    let commands = out.commands.iter().fold(zero, |acc, c| {
+        acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * zero
+    }) == zero;
+    let forces = out
+        .allocation
+        .forces
+        .iter()
+        .fold(zero, |acc, f| acc + (f.x + f.y + f.z) * zero)
+        == zero;
+    let law = &out.law;
+    if !commands {
+        return Some("output.commands");
+    }
+    if !forces
+        || !probe(out.allocation.wrench.as_slice())
+        || !probe(&[out.allocation.e_f, out.allocation.wrench_error])
+    {
+        return Some("output.allocation");
+    }
+    if !probe(out.planner.r_d.as_slice()) || !probe(&[out.planner.theta]) {
+        return Some("output.planner");
+    }
+    if !probe(out.projection.force.as_slice()) || !probe(out.f_r.as_slice()) {
+        return Some("output.projection");
+    }
+    if !probe(law.u_r.as_slice())
+        || !probe(law.u_d.as_slice())
+        || !probe(law.e_xi.as_slice())
+        || !probe(law.e_r.as_slice())
+        || !probe(law.e_x.as_slice())
+        || !probe(&[law.v_r, law.v_x])
+    {
+        return Some("output.law");
+    }
+    None
 }

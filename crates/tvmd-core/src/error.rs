@@ -69,6 +69,12 @@ pub enum ConfigField {
     GainKv,
     /// `g`.
     Gravity,
+    /// `m_C` of a [`crate::law::Plant`].
+    PlantMass,
+    /// `J_C` of a [`crate::law::Plant`].
+    PlantInertia,
+    /// `J_C` derived by [`crate::TeamConfig::new`].
+    TeamInertia,
     /// The control period `dt`.
     Period,
     /// The gimbal rate limits.
@@ -111,6 +117,9 @@ impl ConfigField {
             Self::GainKomega => "gains.k_omega",
             Self::GainKv => "gains.k_v",
             Self::Gravity => "gravity",
+            Self::PlantMass => "plant.mass",
+            Self::PlantInertia => "plant.inertia",
+            Self::TeamInertia => "team.inertia",
             Self::Period => "period",
             Self::RateLimits => "rate_limits",
             Self::PlannerTolerance => "planner.tolerance",
@@ -174,6 +183,25 @@ pub enum ConfigError {
     },
     /// The navigator inertia is not symmetric positive semi-definite.
     NavigatorInertia,
+    /// Agent `agent`'s inertia `J_i` is not symmetric positive semi-definite.
+    AgentInertia {
+        /// The agent's index in the team's agent list.
+        agent: usize,
+    },
+    /// A matrix that must be symmetric positive definite (a gain, the plant's or the team's
+    /// inertia) is not: it is not symmetric, or it has a non-positive eigenvalue.
+    NotSymmetricPositiveDefinite {
+        /// The matrix, e.g. [`ConfigField::GainKr`].
+        field: ConfigField,
+    },
+    /// Finite inputs whose derived quantity (a sum, a product, `M M^T`) is not finite in the
+    /// float type: the values are too large to be carried through the cycle.
+    Overflow {
+        /// The derived quantity, e.g. `"team mass m_C"`.
+        quantity: &'static str,
+        /// The input it is derived from.
+        field: ConfigField,
+    },
     /// `M(Xi)` of eq. (4) does not have rank 6: the team cannot produce every wrench.
     RankDeficient {
         /// Smallest over largest eigenvalue of `M M^T` (0 when exactly singular).
@@ -222,6 +250,8 @@ impl ConfigError {
     pub fn field(&self) -> Option<ConfigField> {
         match *self {
             Self::NonFinite { field }
+            | Self::NotSymmetricPositiveDefinite { field }
+            | Self::Overflow { field, .. }
             | Self::NonPositiveThrust { field, .. }
             | Self::Parameter { field }
             | Self::UnusedOption { field } => Some(field),
@@ -243,6 +273,7 @@ impl ConfigError {
             } => Some(ConfigField::NavigatorMass),
             Self::IdleThrust { .. } => Some(ConfigField::MinThrust),
             Self::NavigatorInertia => Some(ConfigField::NavigatorInertia),
+            Self::AgentInertia { .. } => Some(ConfigField::AgentInertia),
             Self::Relaxation { .. } => Some(ConfigField::Relaxation),
             Self::NoAgents
             | Self::TooManyAgents { .. }
@@ -288,6 +319,17 @@ impl fmt::Display for ConfigError {
                 f,
                 "the navigator inertia must be symmetric positive semi-definite"
             ),
+            Self::AgentInertia { agent } => write!(
+                f,
+                "agent {agent}'s inertia must be symmetric positive semi-definite"
+            ),
+            Self::NotSymmetricPositiveDefinite { field } => {
+                write!(f, "`{field}` must be a symmetric positive definite matrix")
+            }
+            Self::Overflow { quantity, field } => write!(
+                f,
+                "the {quantity} derived from `{field}` is not finite in this float type (values too large)"
+            ),
             Self::RankDeficient { conditioning } => write!(
                 f,
                 "M(Xi) is not rank 6 (eig_min/eig_max of M M^T = {conditioning:e}): the team cannot produce every wrench"
@@ -313,7 +355,9 @@ impl fmt::Display for ConfigError {
 }
 
 /// A control-cycle input that cannot be used. The cycle still returns a safe output with it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+///
+/// Not `Eq`: [`InputError::OutOfRange`] carries the bound as an `f64`.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InputError {
     /// A NaN or infinite number in the named input.
     NonFinite {
@@ -325,6 +369,40 @@ pub enum InputError {
         /// The input, e.g. `"state.attitude"`.
         field: &'static str,
     },
+    /// A finite input too large for the float type to carry through the control cycle: a
+    /// component beyond the controller's bound ([`crate::Controller::input_limit`]).
+    OutOfRange {
+        /// The input, e.g. `"state.angular_velocity"`.
+        field: &'static str,
+        /// The bound on `|component|` (the input's unit).
+        limit: f64,
+    },
+    /// The force request `u_fr` is finite and non-zero, but the only admissible answer the
+    /// cycle finds is every thrust zero (a downward request with no torque, a request at the
+    /// cone's apex, or one that underflows): refused rather than commanding a free fall.
+    Unattainable {
+        /// The input, `"force_request"`.
+        field: &'static str,
+    },
+    /// A safety net: an output of the cycle was not finite although every input was within
+    /// its bound (should not happen; a bug report).
+    Overflow {
+        /// The output, e.g. `"output.commands"`.
+        field: &'static str,
+    },
+}
+
+impl InputError {
+    /// The input (or output, for [`InputError::Overflow`]) the error names.
+    pub const fn field(&self) -> &'static str {
+        match *self {
+            Self::NonFinite { field }
+            | Self::NotRotation { field }
+            | Self::OutOfRange { field, .. }
+            | Self::Unattainable { field }
+            | Self::Overflow { field } => field,
+        }
+    }
 }
 
 impl fmt::Display for InputError {
@@ -334,6 +412,18 @@ impl fmt::Display for InputError {
                 write!(f, "input `{field}` is not finite (NaN or infinite)")
             }
             Self::NotRotation { field } => write!(f, "input `{field}` is not a rotation matrix"),
+            Self::OutOfRange { field, limit } => write!(
+                f,
+                "input `{field}` has a component beyond {limit:e}, too large for the control cycle's float type"
+            ),
+            Self::Unattainable { field } => write!(
+                f,
+                "`{field}` is non-zero but no admissible command other than zero thrust answers it"
+            ),
+            Self::Overflow { field } => write!(
+                f,
+                "`{field}` overflowed although every input was within bounds (a bug)"
+            ),
         }
     }
 }

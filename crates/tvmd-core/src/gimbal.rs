@@ -3,6 +3,7 @@
 
 use nalgebra::Vector3;
 
+use crate::linalg::{max_abs, plain_is_exact};
 use crate::real::Real;
 
 /// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
@@ -38,19 +39,28 @@ impl<T: Real> GimbalCommand<T> {
     /// `eta_y = atan2(f_x / sgn(cos eta_x), f_z / sgn(cos eta_x))`.
     ///
     /// `asin` returns `|eta_x| <= pi/2`, so `cos eta_x >= 0` and the paper's sign is `+1`
-    /// (taken as `+1` at `cos eta_x = 0` too, where `eta_y` is arbitrary). A zero force gives
-    /// zero thrust with a centred gimbal.
+    /// (taken as `+1` at `cos eta_x = 0` too, where `eta_y` is arbitrary). A zero or non-finite
+    /// force gives zero thrust with a centred gimbal. The force is scaled by its largest component
+    /// first, so the angles are exact to round-off at any magnitude (no overflow at `1e155`, no
+    /// underflow at `1e-160` in `f64`); `T` is `+inf` only when `||f||` exceeds the type's `MAX`.
     pub fn from_force(force: &Vector3<T>) -> Self {
-        let thrust = force.norm();
-        if thrust == T::zero() || !thrust.is_finite() {
-            return Self::idle();
-        }
+        let squared = force.norm_squared();
+        let (unit_scaled, n, m) = if plain_is_exact(squared) {
+            (*force, squared.sqrt(), T::one())
+        } else {
+            let m = max_abs(force);
+            if m == T::zero() || !m.is_finite() {
+                return Self::idle();
+            }
+            let unit_scaled = force / m;
+            (unit_scaled, unit_scaled.norm(), m)
+        };
         // Rounding can push |f_y|/T a hair above 1.
-        let sin_x = (-force.y / thrust).clamp(-T::one(), T::one());
+        let sin_x = (-unit_scaled.y / n).clamp(-T::one(), T::one());
         Self {
-            thrust,
+            thrust: n * m,
             eta_x: sin_x.asin(),
-            eta_y: force.x.atan2(force.z),
+            eta_y: unit_scaled.x.atan2(unit_scaled.z),
         }
     }
 

@@ -3,9 +3,10 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
+use crate::definite::is_symmetric_pd;
 use crate::error::{ConfigError, ConfigField, InputError};
 use crate::real::{lit, Real};
-use crate::rotation::vee;
+use crate::rotation::{validate_rotation as rotation, vee};
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
 /// block-diagonal one keeps the force request independent of the planned attitude (the order of `docs/method.md`).
@@ -30,8 +31,11 @@ impl<T: Real> Gains<T> {
         )
     }
 
-    /// Full gain matrices, each symmetric with a positive diagonal (positive definiteness of the
-    /// closed loop is the user's choice; symmetric so the Lyapunov values are quadratic forms).
+    /// Full gain matrices, each symmetric positive definite (symmetric so the Lyapunov values
+    /// are quadratic forms, definite so each term of `Phi` is a norm).
+    ///
+    /// Errors: [`ConfigError::NonFinite`] or [`ConfigError::NotSymmetricPositiveDefinite`]
+    /// naming the gain.
     pub fn new(
         k_x: Matrix3<T>,
         k_r: Matrix3<T>,
@@ -44,11 +48,11 @@ impl<T: Real> Gains<T> {
             (&k_omega, ConfigField::GainKomega),
             (&k_v, ConfigField::GainKv),
         ] {
-            let symmetric =
-                (k - k.transpose()).amax() <= k.amax() * T::default_epsilon() * lit(16.0);
-            let positive = k.diagonal().iter().all(|d| *d > T::zero());
-            if !k.iter().all(|x| x.is_finite()) || !symmetric || !positive {
-                return Err(ConfigError::Parameter { field });
+            if !k.iter().all(|x| x.is_finite()) {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if !is_symmetric_pd(k) {
+                return Err(ConfigError::NotSymmetricPositiveDefinite { field });
             }
         }
         Ok(Self {
@@ -175,30 +179,77 @@ fn finite3<T: Real>(v: &Vector3<T>, field: &'static str) -> Result<(), InputErro
     }
 }
 
-/// Accepts rotations up to `1e-3` (f64) / `1e-3` (f32) of orthonormality error: state estimators
-/// renormalize, but not every period.
-fn rotation<T: Real>(r: &Matrix3<T>, field: &'static str) -> Result<(), InputError> {
-    if !r.iter().all(|x| x.is_finite()) {
-        return Err(InputError::NonFinite { field });
-    }
-    let tol: T = lit(1e-3);
-    let orthonormal = (r.transpose() * r - Matrix3::identity()).amax() <= tol;
-    if orthonormal && (r.determinant() - T::one()).abs() <= tol {
-        Ok(())
-    } else {
-        Err(InputError::NotRotation { field })
-    }
-}
-
-/// Rigid-body parameters of the law: `G = blockdiag(J_C, m_C I)` and gravity.
+/// Rigid-body parameters of the law: `G = blockdiag(J_C, m_C I)` and gravity, validated
+/// ([`Plant::new`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plant<T: Real> {
+    mass: T,
+    inertia: Matrix3<T>,
+    gravity: T,
+}
+
+impl<T: Real> Plant<T> {
+    /// `m_C > 0`, `J_C` symmetric positive definite, `g > 0`, all finite, and the weight
+    /// `m_C g` finite.
+    ///
+    /// Errors: [`ConfigError::NonFinite`], [`ConfigError::Parameter`] (a non-positive mass or
+    /// gravity), [`ConfigError::NotSymmetricPositiveDefinite`] (the inertia),
+    /// [`ConfigError::Overflow`] (the weight), naming [`ConfigField::PlantMass`],
+    /// [`ConfigField::PlantInertia`] or [`ConfigField::Gravity`].
+    pub fn new(mass: T, inertia: Matrix3<T>, gravity: T) -> Result<Self, ConfigError> {
+        for (value, field) in [
+            (mass, ConfigField::PlantMass),
+            (gravity, ConfigField::Gravity),
+        ] {
+            if !value.is_finite() {
+                return Err(ConfigError::NonFinite { field });
+            }
+            if value <= T::zero() {
+                return Err(ConfigError::Parameter { field });
+            }
+        }
+        if !inertia.iter().all(|x| x.is_finite()) {
+            return Err(ConfigError::NonFinite {
+                field: ConfigField::PlantInertia,
+            });
+        }
+        if !is_symmetric_pd(&inertia) {
+            return Err(ConfigError::NotSymmetricPositiveDefinite {
+                field: ConfigField::PlantInertia,
+            });
+        }
+        if !(mass * gravity).is_finite() {
+            return Err(ConfigError::Overflow {
+                quantity: "weight m_C g",
+                field: ConfigField::Gravity,
+            });
+        }
+        Ok(Self {
+            mass,
+            inertia,
+            gravity,
+        })
+    }
+
     /// `m_C` (kg).
-    pub mass: T,
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+
     /// `J_C` (kg m^2).
-    pub inertia: Matrix3<T>,
+    pub fn inertia(&self) -> Matrix3<T> {
+        self.inertia
+    }
+
     /// `g` (m/s^2), along `-e_3`.
-    pub gravity: T,
+    pub fn gravity(&self) -> T {
+        self.gravity
+    }
+
+    /// `m_C g` (N), finite by construction.
+    pub fn weight(&self) -> T {
+        self.mass * self.gravity
+    }
 }
 
 /// `u_fr`, the force part of `u_r` (team frame), which does not depend on `R_d`:
@@ -245,7 +296,7 @@ pub struct LawOutput<T: Real> {
 /// use tvmd_core::nalgebra::{Matrix3, Vector3};
 /// use tvmd_core::law::{control_wrench, force_request, Plant};
 /// use tvmd_core::{Gains, Reference, RigidState};
-/// let plant = Plant::<f64> { mass: 2.8, inertia: Matrix3::identity() * 0.1, gravity: 9.81 };
+/// let plant = Plant::<f64>::new(2.8, Matrix3::identity() * 0.1, 9.81)?;
 /// let gains = Gains::paper();
 /// let state = RigidState::at_rest(Vector3::new(0.2, 0.0, 1.5));
 /// let reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
@@ -256,6 +307,7 @@ pub struct LawOutput<T: Real> {
 ///     &Matrix3::identity());
 /// assert_eq!(law.u_d, law.u_r);
 /// assert!((law.v_x - 0.5 * 0.4 * 0.04).abs() < 1e-15 && law.v_r == 0.0);
+/// # Ok::<(), tvmd_core::ConfigError>(())
 /// ```
 pub fn control_wrench<T: Real>(
     plant: &Plant<T>,

@@ -16,7 +16,9 @@
 //! 8. [`command`]: inversion to gimbal angles and rotor speeds inside `E_f` (eq. 6), via
 //!    [`gimbal`] (eq. 1).
 //!
-//! [`Controller`] composes them into one `step` per control period.
+//! [`Controller`] composes them into one `step` per control period; [`hover`] classifies a
+//! degraded team when its failure mask is set (can the working agents hold hover, and with
+//! what margin).
 //!
 //! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
 //! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
@@ -48,10 +50,12 @@ pub mod afs;
 pub mod allocation;
 pub mod command;
 pub mod controller;
+mod definite;
 pub mod effectiveness;
 pub mod error;
 pub mod failure;
 pub mod gimbal;
+pub mod hover;
 pub mod law;
 pub mod limits;
 mod linalg;
@@ -75,6 +79,7 @@ pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
 pub use failure::FailureMask;
 pub use gimbal::GimbalCommand;
+pub use hover::{HoverCapability, HoverLimit};
 pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use limits::{AgentLimits, RateLimits};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};

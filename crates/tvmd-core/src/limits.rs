@@ -68,6 +68,8 @@ impl<T: Real> AgentLimits<T> {
 
     /// Limits from the rotor constants of eq. (5): air density `rho`, rotor diameter `d`,
     /// lift coefficient `c_l` and maximum rotor speed `sigma_omega`; `sigma_Tf = T(sigma_omega)`.
+    /// Finite constants whose `rho d^4 c_l`, `sigma_omega^2` or `sigma_Tf` overflow give
+    /// [`ConfigError::Overflow`].
     pub fn from_rotor(
         sigma_x: T,
         sigma_y: T,
@@ -93,6 +95,28 @@ impl<T: Real> AgentLimits<T> {
             }
         }
         let k = rho * d * d * d * d * c_l;
+        // Finite constants can overflow in the products the rotor model uses.
+        for (value, quantity, field) in [
+            (
+                k,
+                "thrust coefficient rho d^4 c_l",
+                ConfigField::RotorDiameter,
+            ),
+            (
+                sigma_omega * sigma_omega,
+                "squared rotor speed sigma_omega^2",
+                ConfigField::MaxRotorSpeed,
+            ),
+            (
+                k * sigma_omega * sigma_omega,
+                "maximum thrust sigma_Tf",
+                ConfigField::MaxRotorSpeed,
+            ),
+        ] {
+            if !value.is_finite() {
+                return Err(ConfigError::Overflow { quantity, field });
+            }
+        }
         let limits = Self {
             sigma_x,
             sigma_y,

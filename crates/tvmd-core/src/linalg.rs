@@ -4,9 +4,68 @@
 // Triangular solves read clearest with index loops over the fixed 6x6 arrays.
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
-use nalgebra::{Matrix6, Matrix6x3, Vector6};
+use nalgebra::{Matrix6, Matrix6x3, SVector, Vector6};
 
 use crate::real::{eps, lit, Real};
+
+/// `||v||` without overflow or underflow (hand-written: nalgebra's `norm()` squares the
+/// components, which overflows above `sqrt(MAX)` and underflows below `sqrt(MIN_POSITIVE)`).
+/// The plain `sqrt(v . v)` when `v . v` lies where squaring lost nothing, else scaled by
+/// `m = max |v_i|`: `m ||v / m||` (a max and a division per component, only then). Zero for
+/// `v = 0`; `+inf` only when the true norm exceeds `MAX`; NaN for a non-finite `v`.
+pub(crate) fn norm<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
+    let squared = v.norm_squared();
+    if plain_is_exact(squared) {
+        return squared.sqrt();
+    }
+    let m = max_abs(v);
+    if m == T::zero() {
+        return m;
+    }
+    // Divided, not multiplied by `1 / m`, which overflows for a subnormal `m`.
+    (v / m).norm() * m
+}
+
+/// `v / ||v||` through [`norm`]'s scaling (zero for `v = 0`, NaN for a non-finite `v`).
+pub(crate) fn normalize<T: Real, const D: usize>(v: &SVector<T, D>) -> SVector<T, D> {
+    let squared = v.norm_squared();
+    if plain_is_exact(squared) {
+        return v / squared.sqrt();
+    }
+    let m = max_abs(v);
+    if m == T::zero() {
+        return *v;
+    }
+    let u = v / m;
+    u / u.norm()
+}
+
+/// Whether a sum of squares `s` is finite and at least `MIN_POSITIVE / eps`: then no square
+/// that matters to `sqrt(s)` to round-off was subnormal, and none overflowed.
+pub(crate) fn plain_is_exact<T: Real>(s: T) -> bool {
+    // `MIN_POSITIVE` of `T` (the crate's floats are `f32` or `f64`, told apart by `eps`).
+    let min_positive: T = if eps::<T>() < lit(1e-10) {
+        lit(f64::MIN_POSITIVE)
+    } else {
+        lit(f64::from(f32::MIN_POSITIVE))
+    };
+    let min = min_positive / eps::<T>();
+    s >= min && s <= T::max_value().unwrap_or_else(T::zero)
+}
+
+/// `max |v_i|`; non-finite (the first non-finite `|v_i|`) if a component is, so callers'
+/// finiteness checks see it.
+pub(crate) fn max_abs<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
+    let mut m = T::zero();
+    for x in v.iter() {
+        let a = x.abs();
+        if !a.is_finite() {
+            return a;
+        }
+        m = m.max(a);
+    }
+    m
+}
 
 /// `A = L D L^T` of a symmetric 6x6 matrix, without pivoting. `None` unless every pivot is
 /// above `tol` (so `A` is numerically positive definite).

@@ -5,7 +5,9 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::error::{ConfigError, ConfigField, InputError};
+use crate::linalg::{norm, normalize};
 use crate::real::{eps, lit, Real};
+use crate::rotation::validate_rotation;
 
 /// How the planner reached its output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,7 +130,9 @@ impl<T: Real> AttitudePlanner<T> {
     }
 
     /// Plans `R_d` for the reference attitude `r_r` and the inertial force request `f_r`
-    /// (eq. 9: `f_r = t_Tf R u_fr`). Errors only on non-finite input.
+    /// (eq. 9: `f_r = t_Tf R u_fr`). Errors: [`InputError::NonFinite`] for a non-finite input,
+    /// [`InputError::NotRotation`] when `r_r` is not a rotation (the check of
+    /// [`crate::rotation::validate_rotation`]).
     pub fn plan(
         &self,
         afs: &AttainableForceSpace<T>,
@@ -146,11 +150,7 @@ impl<T: Real> AttitudePlanner<T> {
         r_r: &Matrix3<T>,
         f_r: &Vector3<T>,
     ) -> Result<PlannerOutput<T>, InputError> {
-        if !r_r.iter().all(|x| x.is_finite()) {
-            return Err(InputError::NonFinite {
-                field: "planner.r_r",
-            });
-        }
+        validate_rotation(r_r, "planner.r_r")?;
         if !f_r.iter().all(|x| x.is_finite()) {
             return Err(InputError::NonFinite {
                 field: "planner.f_r",
@@ -163,7 +163,7 @@ impl<T: Real> AttitudePlanner<T> {
             status,
         };
         // ||R^T f_r|| = ||f_r||: the thrust bound is checked once, the cross-section per attitude.
-        let norm = f_r.norm();
+        let norm = norm(f_r);
         let within_thrust = norm <= cone.max_force();
         let feasible = |r: &Matrix3<T>| within_thrust && cone.admits(&(r.transpose() * f_r));
         if norm == T::zero() {
@@ -172,7 +172,7 @@ impl<T: Real> AttitudePlanner<T> {
         if feasible(r_r) {
             return Ok(unchanged(PlannerStatus::AlreadyFeasible));
         }
-        let tilt = Tilt::new(r_r, f_r, norm);
+        let tilt = Tilt::new(r_r, f_r);
         let end = tilt.attitude(tilt.theta_max);
         if !feasible(&end) {
             return Ok(PlannerOutput {
@@ -222,11 +222,11 @@ impl<T: Real> AttitudePlanner<T> {
 /// searches (exposed for diagnostics and tests). `f_r` must be finite and non-zero; otherwise
 /// `R_r` is returned.
 pub fn tilted_attitude<T: Real>(r_r: &Matrix3<T>, f_r: &Vector3<T>, theta: T) -> Matrix3<T> {
-    let norm = f_r.norm();
+    let norm = norm(f_r);
     if norm == T::zero() || !norm.is_finite() || !theta.is_finite() {
         return *r_r;
     }
-    Tilt::new(r_r, f_r, norm).attitude(theta)
+    Tilt::new(r_r, f_r).attitude(theta)
 }
 
 /// The one-parameter family `R_d(theta)` of eqs. (10)-(11).
@@ -240,21 +240,23 @@ struct Tilt<T: Real> {
 }
 
 impl<T: Real> Tilt<T> {
-    fn new(r_r: &Matrix3<T>, f_r: &Vector3<T>, norm: T) -> Self {
+    fn new(r_r: &Matrix3<T>, f_r: &Vector3<T>) -> Self {
         let (b_xr, b_yr, b_zr) = (
             r_r.column(0).into_owned(),
             r_r.column(1).into_owned(),
             r_r.column(2).into_owned(),
         );
-        let cross = b_zr.cross(f_r);
+        // The direction of f_r only: scaled so a huge or tiny f_r neither overflows nor underflows.
+        let f_hat = normalize(f_r);
+        let cross = b_zr.cross(&f_hat);
         let cross_norm = cross.norm();
         // f_r (anti)parallel to b_zr: no unique axis; roll about b_xr (documented choice).
-        let k = if cross_norm > norm * eps::<T>() * lit(8.0) {
+        let k = if cross_norm > eps::<T>() * lit(8.0) {
             cross / cross_norm
         } else {
             b_xr
         };
-        let cos_max = (b_zr.dot(f_r) / norm).clamp(-T::one(), T::one());
+        let cos_max = b_zr.dot(&f_hat).clamp(-T::one(), T::one());
         Self {
             k_cross_bz: k.cross(&b_zr),
             b_xr,

@@ -3,7 +3,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::real::Real;
+use crate::linalg::{max_abs, norm};
+use crate::real::{eps, lit, Real};
 
 /// The projected force and the factors of `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +30,10 @@ impl<T: Real> ForceProjection<T> {
 /// part onto the ellipse at the resulting height (eqs. 12-13, `s = 1`).
 ///
 /// A non-finite `u_fr` projects to zero with both factors 0, so the output is never NaN.
+/// A request with a downward part (`u_fr,z < 0`) cannot be brought into the AFS by any `K_f`
+/// of this structure (it keeps the sign of `z`, and no agent pushes down): it projects to the
+/// apex, zero force, with `t_Tf = t_eta = 0` (the flag; the planner then sees `f_r = 0`). Every
+/// projected force is an AFS member at `s = 1` (to round-off of the `t_Tf` scaling).
 ///
 /// ```
 /// use tvmd_core::nalgebra::Vector3;
@@ -51,22 +56,30 @@ pub fn project_force<T: Real>(
 
 /// As [`project_force`] with the AFS already evaluated at `s = 1` (`afs.cone(Relaxation::none())`).
 pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> ForceProjection<T> {
-    if !u_fr.iter().all(|x| x.is_finite()) {
+    if !u_fr.iter().all(|x| x.is_finite()) || u_fr.z < T::zero() {
         return ForceProjection {
             force: Vector3::zeros(),
             t_tf: T::zero(),
             t_eta: T::zero(),
         };
     }
-    let norm = u_fr.norm();
+    // Scaled by the largest component so that neither the norm nor the ratio overflows.
+    let m = max_abs(u_fr);
     let limit = cone.max_force();
-    let t_tf = if norm > limit { limit / norm } else { T::one() };
+    // Both factors are shrunk by a few ulps so that the projected force is a member despite the
+    // rounding of the products (`contains` at `s = 1` holds exactly).
+    let shrink = T::one() - eps::<T>() * lit(4.0);
+    let t_tf = if m > T::zero() && norm(u_fr) > limit {
+        (limit / m) / (u_fr / m).norm() * shrink
+    } else {
+        T::one()
+    };
     let scaled = u_fr * t_tf;
     let q = cone.quadratic_form(&scaled);
     let t_eta = if q <= T::one() {
         T::one()
     } else if q.is_finite() {
-        (T::one() / q).sqrt()
+        (T::one() / q).sqrt() * shrink
     } else {
         T::zero()
     };
@@ -75,8 +88,21 @@ pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> F
         t_tf,
         t_eta,
     };
-    ForceProjection {
+    let projected = ForceProjection {
         force: projection.gain() * u_fr,
         ..projection
+    };
+    // Subnormal components round absolutely, beyond the shrink: then keep only the vertical
+    // part, which is always a member. (`t_eta = 1` needs no check: the force is `scaled`.)
+    if t_eta < T::one() && !cone.contains(&projected.force) {
+        let vertical = ForceProjection {
+            t_eta: T::zero(),
+            ..projection
+        };
+        return ForceProjection {
+            force: vertical.gain() * u_fr,
+            ..vertical
+        };
     }
+    projected
 }

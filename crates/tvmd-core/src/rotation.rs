@@ -3,7 +3,32 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::real::Real;
+use crate::error::InputError;
+use crate::real::{lit, Real};
+
+/// Checks that `r` is a rotation: finite ([`InputError::NonFinite`]), `R^T R = I` and
+/// `det R = 1` within `1e-3` ([`InputError::NotRotation`]), both naming `field`. The one
+/// rotation check of the crate (states, references, the planner's `R_r`): state estimators
+/// renormalize, but not every period.
+///
+/// ```
+/// use tvmd_core::nalgebra::Matrix3;
+/// use tvmd_core::rotation::{roll, validate_rotation};
+/// assert!(validate_rotation(&roll(0.3_f64), "r").is_ok());
+/// assert!(validate_rotation(&(Matrix3::<f64>::identity() * 2.0), "r").is_err());
+/// ```
+pub fn validate_rotation<T: Real>(r: &Matrix3<T>, field: &'static str) -> Result<(), InputError> {
+    if !r.iter().all(|x| x.is_finite()) {
+        return Err(InputError::NonFinite { field });
+    }
+    let tol: T = lit(1e-3);
+    let orthonormal = (r.transpose() * r - Matrix3::identity()).amax() <= tol;
+    if orthonormal && (r.determinant() - T::one()).abs() <= tol {
+        Ok(())
+    } else {
+        Err(InputError::NotRotation { field })
+    }
+}
 
 /// `R_x(phi)`, a roll about the body `x` axis (the paper's stage-B reference).
 ///

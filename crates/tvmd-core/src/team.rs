@@ -3,14 +3,18 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::admissible::AdmissibleSet;
 use crate::afs::AttainableForceSpace;
+use crate::definite::{is_symmetric_pd, is_symmetric_psd};
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField, MassOf};
 /// The failure mask, at its old path (now in [`crate::failure`]).
 pub use crate::failure::FailureMask;
+use crate::hover::{hover_capability, HoverCapability};
+use crate::law::Plant;
 /// The agent limits, at their old path (now in [`crate::limits`]).
 pub use crate::limits::AgentLimits;
-use crate::real::{eps, lit, Real};
+use crate::real::{count, lit, Real};
 
 /// One agent of the team: its frame in the team CoM frame `{C}`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,7 +114,10 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
     /// Errors: [`ConfigError::NoAgents`], [`ConfigError::TooManyAgents`],
     /// [`ConfigError::NonFinite`], [`ConfigError::GimbalLimit`], [`ConfigError::NonPositiveMass`],
     /// [`ConfigError::NonPositiveThrust`], [`ConfigError::IdleThrust`],
-    /// [`ConfigError::NavigatorInertia`], [`ConfigError::RankDeficient`].
+    /// [`ConfigError::NavigatorInertia`], [`ConfigError::AgentInertia`] (not symmetric positive
+    /// semi-definite), [`ConfigError::Overflow`] (finite values whose team mass, weight
+    /// `m_C g` at standard gravity, `J_C`, `M M^T` or `n sigma_Tf` is not finite),
+    /// [`ConfigError::RankDeficient`], [`ConfigError::NotSymmetricPositiveDefinite`] (`J_C`).
     pub fn new(
         agents: &[AgentSpec<T>],
         limits: AgentLimits<T>,
@@ -152,11 +159,29 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
                     value: crate::real::to_f64(agent.mass),
                 });
             }
+            if !is_symmetric_psd(&agent.inertia) {
+                return Err(ConfigError::AgentInertia { agent: i });
+            }
             let p = agent.position.cross_matrix();
             mass += agent.mass;
             inertia += agent.inertia - p * p * agent.mass;
             *slot = *agent;
         }
+        // Finite inputs can still overflow in the sums and products the cycle uses.
+        finite_derived([mass].iter(), "team mass m_C", ConfigField::AgentMass)?;
+        let weight = mass * lit(presets::GRAVITY);
+        finite_derived([weight].iter(), "weight m_C g", ConfigField::AgentMass)?;
+        finite_derived(
+            inertia.iter(),
+            "team inertia J_C",
+            ConfigField::AgentPosition,
+        )?;
+        let total_thrust = limits.max_thrust() * count::<T>(agents.len());
+        finite_derived(
+            [total_thrust].iter(),
+            "total thrust n sigma_Tf",
+            ConfigField::MaxThrust,
+        )?;
         let team = Self {
             agents: storage,
             len: agents.len(),
@@ -165,7 +190,20 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
             mass,
             inertia,
         };
-        team.effectiveness(&FailureMask::none()).check_rank()?;
+        let effectiveness = team.effectiveness(&FailureMask::none());
+        finite_derived(
+            effectiveness.gram().iter(),
+            "Gram matrix M M^T",
+            ConfigField::AgentPosition,
+        )?;
+        effectiveness.check_rank()?;
+        // Rank 6 rules out collinear teams, the only ones whose point masses alone give a
+        // singular J_C; this catches what rounding or a navigator inertia could still leave.
+        if !is_symmetric_pd(&inertia) {
+            return Err(ConfigError::NotSymmetricPositiveDefinite {
+                field: ConfigField::TeamInertia,
+            });
+        }
         Ok(team)
     }
 
@@ -259,15 +297,49 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         )
     }
 
+    /// Whether the working agents can hold hover at gravity `gravity` with a margin (see
+    /// [`crate::hover`]): the hover wrench `[0, 0, 0, 0, 0, m_C g]` strictly inside their
+    /// attainable wrench set. A rank-deficient degraded team is reported not capable.
+    ///
+    /// Errors: [`ConfigError::FailureIndex`] or [`ConfigError::NoAgents`] for the mask;
+    /// [`ConfigError::NonFinite`], [`ConfigError::Parameter`] or [`ConfigError::Overflow`]
+    /// (the weight) for `gravity`.
+    ///
+    /// ```
+    /// use tvmd_core::{team::presets, FailureMask, TeamConfig};
+    /// let team: TeamConfig<f64, 4> = presets::a4_inc()?;
+    /// let lost = team.hover_capability(&FailureMask::with_failed(&[1])?, 9.81)?;
+    /// assert!(!lost.capable);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn hover_capability(
+        &self,
+        failures: &FailureMask<N>,
+        gravity: T,
+    ) -> Result<HoverCapability<T>, ConfigError> {
+        self.check_mask(failures)?;
+        let weight = Plant::new(self.mass, self.inertia, gravity)?.weight();
+        Ok(hover_capability(
+            &self.effectiveness(failures),
+            &AdmissibleSet::from_limits(&self.limits),
+            weight,
+        ))
+    }
+
     /// Checks that a degraded team can still produce every wrench (rank-6 `M`).
     pub fn validate_failures(&self, failures: &FailureMask<N>) -> Result<(), ConfigError> {
+        self.check_mask(failures)?;
+        self.effectiveness(failures).check_rank()
+    }
+
+    fn check_mask(&self, failures: &FailureMask<N>) -> Result<(), ConfigError> {
         if let Some(agent) = (self.len..N).find(|&i| failures.is_failed(i)) {
             return Err(ConfigError::FailureIndex { agent });
         }
         if self.working(failures).next().is_none() {
             return Err(ConfigError::NoAgents);
         }
-        self.effectiveness(failures).check_rank()
+        Ok(())
     }
 }
 
@@ -288,35 +360,23 @@ fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigErr
             value: crate::real::to_f64(navigator.mass),
         });
     }
-    let j = navigator.inertia;
-    let scale = j.amax().max(T::one());
-    let tol = scale * eps::<T>() * lit(64.0);
-    if (j - j.transpose()).amax() > tol {
-        return Err(ConfigError::NavigatorInertia);
-    }
-    // Positive semi-definite iff every principal minor is >= 0 (3x3: Sylvester's criterion
-    // on all of them, not only the leading ones).
-    let minor2 = |a: usize, b: usize| {
-        let (x, y, z) = (
-            j.get((a, a)).copied().unwrap_or(T::zero()),
-            j.get((b, b)).copied().unwrap_or(T::zero()),
-            j.get((a, b)).copied().unwrap_or(T::zero()),
-        );
-        x * y - z * z
-    };
-    let minors = [
-        j.m11,
-        j.m22,
-        j.m33,
-        minor2(0, 1),
-        minor2(0, 2),
-        minor2(1, 2),
-        j.determinant(),
-    ];
-    if minors.iter().any(|m| *m < -tol * scale * scale) {
+    if !is_symmetric_psd(&navigator.inertia) {
         return Err(ConfigError::NavigatorInertia);
     }
     Ok(())
+}
+
+/// `Err(Overflow)` unless every entry of `values` is finite.
+fn finite_derived<'a, T: Real + 'a>(
+    values: impl IntoIterator<Item = &'a T>,
+    quantity: &'static str,
+    field: ConfigField,
+) -> Result<(), ConfigError> {
+    if values.into_iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(ConfigError::Overflow { quantity, field })
+    }
 }
 
 /// Team presets: the paper's A4 teams and ring layouts for tests and the simulator.

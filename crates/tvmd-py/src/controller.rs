@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 
 use tvmd_core::team::presets;
-use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings};
+use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, HoverCapability};
 
 use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};
@@ -65,11 +65,21 @@ impl PyController {
         })
     }
 
-    /// Marks agents failed (None or [] for none). See the stub.
+    /// Marks agents failed (None or [] for none); returns the `HoverCapability` of the
+    /// working agents. See the stub.
     #[pyo3(signature = (failed = None))]
-    fn set_failures(&mut self, failed: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    fn set_failures(&mut self, failed: Option<&Bound<'_, PyAny>>) -> PyResult<PyHoverCapability> {
         let mask = failure_mask(self.inner.team(), failed)?;
-        self.inner.set_failures(mask).or_raise()
+        let inner = self.inner.set_failures(mask).or_raise()?;
+        Ok(PyHoverCapability { inner })
+    }
+
+    /// The `HoverCapability` classified when the failures were last set.
+    #[getter]
+    fn hover_capability(&self) -> PyHoverCapability {
+        PyHoverCapability {
+            inner: *self.inner.hover_capability(),
+        }
     }
 
     /// Forgets the previous command.
@@ -193,6 +203,22 @@ pub(crate) struct StepData {
 }
 
 record! {
+    /// Whether the working agents can hold hover with a margin. See the stub.
+    "HoverCapability" in "tvmd" => PyHoverCapability(HoverCapability<f64>) |py, o| {
+        /// The hover wrench is strictly inside the working agents' attainable set.
+        capable => o.capable,
+        /// Smallest normalized slack of any working agent in the certifying allocation.
+        margin => o.margin,
+        /// The agent whose slack is `margin`, or None.
+        limiting_agent => o.limiting_agent,
+        /// The bound it is closest to: "max_thrust", "min_thrust", "gimbal_x" or "gimbal_y".
+        limit => o.limit.as_str(),
+        /// `m_C g` (N).
+        weight => o.weight,
+    }
+}
+
+record! {
     /// Everything one `Controller.step` computed, nested like the core's `ControlOutput`.
     "StepOutput" in "tvmd" => PyStepOutput(StepData) |py, o| {
         /// The planner's result (eqs. 9-11).
@@ -216,5 +242,6 @@ record! {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyController>()?;
     m.add_class::<PyStepOutput>()?;
+    m.add_class::<PyHoverCapability>()?;
     Ok(())
 }

@@ -16,7 +16,7 @@ pyo3::create_exception!(
     tvmd,
     InputError,
     PyValueError,
-    "A control-cycle input that cannot be used: not finite, or not a rotation."
+    "A control-cycle input that cannot be used: not finite, not a rotation, beyond the cycle's bound, or unattainable."
 );
 
 pyo3::create_exception!(
@@ -64,8 +64,7 @@ pub(crate) fn cycle_error(
 ) -> PyErr {
     let err = CycleError::new_err(error.to_string());
     let value = err.value(py);
-    let (tvmd_core::InputError::NonFinite { field } | tvmd_core::InputError::NotRotation { field }) =
-        error.error;
+    let field = error.error.field();
     let _ = crate::convert::commands_array(py, &error.commands, n)
         .map(|c| value.setattr("commands", c));
     let _ = value.setattr("field", field);

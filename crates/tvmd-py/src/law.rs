@@ -243,26 +243,23 @@ record! {
 }
 
 impl PyPlant {
-    /// A plant of finite parameters.
+    /// A validated plant: `mass > 0`, `inertia` symmetric positive definite, `gravity > 0`,
+    /// all finite (the core's checks, raised as `ConfigError`).
     pub(crate) fn create(mass: f64, inertia: Matrix3<f64>, gravity: f64) -> PyResult<Self> {
         finite_scalar(mass, "mass")?;
         check_finite(inertia.iter(), "inertia")?;
         finite_scalar(gravity, "gravity")?;
         Ok(Self {
-            inner: Plant {
-                mass,
-                inertia,
-                gravity,
-            },
+            inner: Plant::new(mass, inertia, gravity).or_raise()?,
         })
     }
 }
 
 /// `Plant(mass=.., inertia=diag[..], gravity=..)`.
 fn plant_repr(p: &Plant<f64>) -> String {
-    let j = &p.inertia;
+    let j = &p.inertia();
     let off = if is_diagonal(j) { "" } else { "+offdiag" };
-    let (m, g) = (p.mass, p.gravity);
+    let (m, g) = (p.mass(), p.gravity());
     format!(
         "Plant(mass={m}, inertia=diag[{}, {}, {}]{off}, gravity={g})",
         j.m11, j.m22, j.m33
@@ -273,11 +270,11 @@ record! {
     /// Rigid-body parameters `m_C`, `J_C` and gravity `g`. See the stub for arguments.
     "Plant" in "tvmd" => PyPlant(Plant<f64>) repr plant_repr |py, o| {
         /// `m_C` (kg).
-        mass => o.mass,
+        mass => o.mass(),
         /// `J_C` (3, 3) (kg m^2).
-        inertia => matrix(py, &o.inertia)?,
+        inertia => matrix(py, &o.inertia())?,
         /// `g` (m/s^2).
-        gravity => o.gravity,
+        gravity => o.gravity(),
     }
     methods {
         #[new]

@@ -9,6 +9,7 @@ use tvmd_core::team::presets;
 use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};
 
 use crate::afs::PyAfs;
+use crate::controller::PyHoverCapability;
 use crate::convert::{array, check_finite, count, indices, int_array, matrix, opt_arg};
 use crate::convert::{shape_error, shape_str, shaped, table};
 use crate::errors::{ConfigError, OrRaise};
@@ -284,6 +285,18 @@ record! {
     #[pyo3(signature = (gravity = presets::GRAVITY))]
     fn plant(&self, gravity: f64) -> PyResult<PyPlant> {
         PyPlant::create(self.inner.mass(), self.inner.inertia(), gravity)
+    }
+
+    /// Whether the working agents can hold hover with a margin. See the stub.
+    #[pyo3(signature = (failed = None, gravity = presets::GRAVITY))]
+    fn hover_capability(
+        &self,
+        failed: Option<&Bound<'_, PyAny>>,
+        gravity: f64,
+    ) -> PyResult<PyHoverCapability> {
+        let mask = failure_mask(&self.inner, failed)?;
+        let inner = self.inner.hover_capability(&mask, gravity).or_raise()?;
+        Ok(PyHoverCapability { inner })
     }
     }
 }

@@ -284,14 +284,15 @@ def afs_contains(u, n, n_x, sigma_x, sigma_y, s, max_thrust):
       * ||u|| <= n sigma_Tf (the paper writes a strict "<"; we accept the boundary so that a
         force scaled by t_Tf to exactly n sigma_Tf is attainable),
       * u^T C(u_z) u <= 1, and
-      * u_z > 0, unless some semi-axis comes from the sigma >= pi/2 branch of g (docs/method.md reading;
-        the tan-branch cone would otherwise be mirrored below the x-y plane by |z|).
+      * u_z >= 0: no agent pushes down (z = T cos(eta_x) cos(eta_y) >= 0), whatever the branch
+        of g (docs/method.md reading). At u_z = 0 the tan branch gives zero semi-axes, so only
+        the apex u = 0 passes there unless some semi-axis comes from the sigma >= pi/2 branch.
     """
     u = np.asarray(u, dtype=float)
     if float(np.linalg.norm(u)) > n * max_thrust:
         return False
-    c_x, c_y, wide = _semi_axes_and_wide(n, n_x, sigma_x, sigma_y, s, u[2], max_thrust)
-    if not wide and not u[2] > 0.0:
+    c_x, c_y, _ = _semi_axes_and_wide(n, n_x, sigma_x, sigma_y, s, u[2], max_thrust)
+    if u[2] < 0.0:
         return False
     q = _ellipse_term(u[0], c_x) + _ellipse_term(u[1], c_y)
     return q <= 1.0
@@ -310,8 +311,12 @@ def force_projection(u, n, n_x, sigma_x, sigma_y, max_thrust):
     t_eta = min(1, sqrt(1 / u'^T C(u'_z) u'))       with s = 1 (the full AFS);
             t_eta = 1 when the quadratic form is 0, 0 when it is inf
     u_projected = K_f u = diag(t_eta t_Tf, t_eta t_Tf, t_Tf) u.
+    A request with u_z < 0 is not brought into the AFS by any K_f of this structure: it
+    projects to the apex, zero force, with t_Tf = t_eta = 0 (docs/method.md).
     """
     u = np.asarray(u, dtype=float)
+    if u[2] < 0.0:
+        return np.zeros(3), 0.0, 0.0
     norm = float(np.linalg.norm(u))
     t_tf = 1.0 if norm == 0.0 else min(1.0, n * max_thrust / norm)
     u1 = t_tf * u

@@ -202,15 +202,19 @@ def test_paper_team_mass_inertia():
 def test_afs_contains_edge_cases():
     args = (4, 2, math.pi / 6, math.pi / 4, 1.0, 10.0)
     assert ri.afs_contains([0.0, 0.0, 5.0], *args)
-    assert not ri.afs_contains([0.0, 0.0, 0.0], *args)  # z = 0: outside (tan branch only)
+    # z = 0 in the tan branch: only the apex (all thrusts zero) is attainable.
+    assert ri.afs_contains([0.0, 0.0, 0.0], *args)
+    assert not ri.afs_contains([0.1, 0.0, 0.0], *args)
+    assert not ri.afs_contains([0.0, 0.0, -1e-300], *args)
     assert not ri.afs_contains([0.0, 0.0, -5.0], *args)  # below the x-y plane
     assert not ri.afs_contains([0.0, 0.0, 41.0], *args)  # ||u|| > n sigma_Tf = 40
     assert ri.afs_contains([0.0, 0.0, 40.0], *args)  # boundary is attainable
-    # A sigma >= pi/2 branch lifts the z > 0 requirement (agents can thrust sideways).
+    # A sigma >= pi/2 branch admits z = 0 (agents can thrust sideways), never z < 0.
     wide = (1, 1, 0.3, math.pi / 2, 1.0, 10.0)
     assert ri.afs_semi_axes(1, 1, 0.3, math.pi / 2, 1.0, 0.0, 10.0) == (10.0, 0.0)
     assert ri.afs_contains([5.0, 0.0, 0.0], *wide)
     assert not ri.afs_contains([5.0, 0.1, 0.0], *wide)  # zero semi-axis, non-zero component
+    assert not ri.afs_contains([0.0, 0.0, -1.0], *wide)
     # Kronecker delta: no agents of a kind, no contribution.
     c_x, c_y = ri.afs_semi_axes(3, 3, 0.5, 0.7, 1.0, 2.0, 5.0)
     assert (c_x, c_y) == pytest.approx((2.0 * math.tan(0.7), 2.0 * math.tan(0.5)))

@@ -35,8 +35,8 @@ RUN_SUMMARY_FIELDS = {
     "final_position_error", "horizontal_error_at_4s", "horizontal_error_at_12s", "max_tilt",
     "max_roll", "max_planned_roll", "max_e_f", "max_e_f_time", "max_e_f_over_weight",
     "final_v_x", "final_v_r", "min_thrust", "max_thrust", "max_abs_eta_x", "max_abs_eta_y",
-    "saturated_periods", "cycle_errors", "controller_calls", "physics_steps", "wall_time",
-    "real_time_factor",
+    "saturated_periods", "cycle_errors", "hover_classifications", "controller_calls",
+    "physics_steps", "wall_time", "real_time_factor",
 }  # fmt: skip
 
 

@@ -90,6 +90,25 @@ pub struct LyapunovDiagnostics {
     pub v_r: f64,
 }
 
+/// The hover classification of the working agents (logged on `/hover`), reported at the tick
+/// the controller accepted a new failure mask ([`tvmd_core::Controller::set_failures`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HoverDiagnostics {
+    /// The hover wrench is strictly inside the working agents' attainable wrench set.
+    pub capable: bool,
+    /// The certified margin (smallest normalized slack of any working agent; `<= 0`: none).
+    pub margin: f64,
+    /// The agent whose slack is the margin.
+    #[serde(default)]
+    pub limiting_agent: Option<usize>,
+    /// The bound it is closest to (`max_thrust`, `min_thrust`, `gimbal_x`, `gimbal_y`).
+    #[serde(default)]
+    pub limit: String,
+    /// The scenario's `failure_response` started a landing on this classification.
+    #[serde(default)]
+    pub landing: bool,
+}
+
 /// Optional diagnostics returned by a controller; every present part is logged and recorded.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Diagnostics {
@@ -107,4 +126,7 @@ pub struct Diagnostics {
     /// A note on the failure mask (e.g. the controller could not use the reported failures).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure_note: Option<String>,
+    /// The hover classification, at the tick a new failure mask was accepted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hover: Option<HoverDiagnostics>,
 }

@@ -11,6 +11,7 @@
 //! | `/allocation` | `tvmd.Allocation` | allocation diagnostics (`e_f`) |
 //! | `/actuators` | `tvmd.Actuators` | commanded and actual agent commands, failures |
 //! | `/lyapunov` | `tvmd.Lyapunov` | `V_x`, `V_R` |
+//! | `/hover` | `tvmd.Hover` | hover classification when the failure mask changes |
 //! | `/tf` | `foxglove.FrameTransform` | pose of frame `team` in frame `world` |
 //! | `/scene` | `foxglove.SceneUpdate` | one entity per agent (cube at `p_i`, thrust arrow) |
 //!
@@ -55,11 +56,13 @@ pub enum LogKind {
     Actuators,
     /// Lyapunov candidates ([`crate::diagnostics::LyapunovDiagnostics`]).
     Lyapunov,
+    /// Hover classification ([`crate::diagnostics::HoverDiagnostics`]).
+    Hover,
 }
 
 impl LogKind {
     /// All kinds, in channel order.
-    pub const ALL: [LogKind; 7] = [
+    pub const ALL: [LogKind; 8] = [
         LogKind::State,
         LogKind::Reference,
         LogKind::Planner,
@@ -67,6 +70,7 @@ impl LogKind {
         LogKind::Allocation,
         LogKind::Actuators,
         LogKind::Lyapunov,
+        LogKind::Hover,
     ];
 
     /// The channel's topic.
@@ -79,6 +83,7 @@ impl LogKind {
             Self::Allocation => "/allocation",
             Self::Actuators => "/actuators",
             Self::Lyapunov => "/lyapunov",
+            Self::Hover => "/hover",
         }
     }
 
@@ -92,6 +97,7 @@ impl LogKind {
             Self::Allocation => "tvmd.Allocation",
             Self::Actuators => "tvmd.Actuators",
             Self::Lyapunov => "tvmd.Lyapunov",
+            Self::Hover => "tvmd.Hover",
         }
     }
 
@@ -148,6 +154,12 @@ impl LogKind {
                 vec!["t", "commanded", "actual", "failed"],
             ),
             Self::Lyapunov => (json!({"t": num, "v_x": num, "v_r": num}), vec!["t"]),
+            Self::Hover => (
+                json!({"t": num, "capable": {"type": "boolean"}, "margin": num,
+                       "limiting_agent": {"type": ["integer", "null"]},
+                       "limit": {"type": "string"}, "landing": {"type": "boolean"}}),
+                vec!["t", "capable", "margin"],
+            ),
         };
         json!({"title": self.schema_name(), "type": "object",
                "properties": props, "required": required})

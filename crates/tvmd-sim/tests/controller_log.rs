@@ -21,7 +21,8 @@ fn tmp_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
-const TOPICS: [&str; 9] = [
+const TOPICS: [&str; 10] = [
+    "/hover",
     "/state",
     "/reference",
     "/planner",

@@ -24,7 +24,8 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
-use crate::linalg::{solve_gram, weighted_gram, GramSolver};
+use crate::gimbal::GimbalCommand;
+use crate::linalg::{max_abs, norm, solve_gram, weighted_gram, GramSolver};
 use crate::real::Real;
 
 /// What an allocator is asked to do.
@@ -58,7 +59,9 @@ pub struct Allocation<T: Real, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Allocation<T, N> {
-    /// Completes an allocation from admissible forces: wrench and errors.
+    /// Completes an allocation from admissible forces: the wrench they produce and the errors
+    /// against the request (overflow-safe norms: `e_f` is what these forces leave, at any
+    /// magnitude of the request).
     pub fn from_forces(
         request: &AllocationRequest<'_, T, N>,
         forces: [Vector3<T>; N],
@@ -70,8 +73,8 @@ impl<T: Real, const N: usize> Allocation<T, N> {
         Self {
             forces,
             wrench,
-            e_f: error.fixed_rows::<3>(3).norm(),
-            wrench_error: error.norm(),
+            e_f: norm(&error.fixed_rows::<3>(3).into_owned()),
+            wrench_error: norm(&error),
             rounds,
             saturated,
             fallback: false,
@@ -112,6 +115,7 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
     out: &mut [Vector3<T>; N],
 ) {
     let weight = |i: usize| weights.and_then(|w| w.get(i)).copied().unwrap_or(T::one());
+    let rhs = &bounded_rhs(rhs);
     let lambda = match factor {
         Some(f) => f.solve(rhs),
         None => solve_gram(&gram_of(effectiveness, free, weights), rhs),
@@ -127,6 +131,28 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
             *slot = b.tr_mul(&lambda) / weight(i);
         }
     }
+}
+
+/// `rhs` scaled down, in its direction, to a largest component of `sqrt(MAX)` (`1.8e19` in
+/// `f32`, `1.3e154` in `f64`): the Gram solve and `M_i^T lambda` then stay finite, and a request
+/// that large saturates every agent it loads anyway. The allocation's errors are still taken
+/// against the full request.
+fn bounded_rhs<T: Real>(rhs: &Vector6<T>) -> Vector6<T> {
+    let cap = T::max_value().unwrap_or_else(T::one).sqrt();
+    let m = max_abs(rhs);
+    if m > cap && m.is_finite() {
+        rhs * (cap / m)
+    } else {
+        *rhs
+    }
+}
+
+/// Whether `force` must be saturated into `set`: outside it, or not finite (the gimbal inverse
+/// of a non-finite force is the idle command, which may lie inside, so it is caught here rather
+/// than kept).
+pub(crate) fn outside<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bool {
+    !force.iter().all(|x| x.is_finite())
+        || set.violation(&GimbalCommand::from_force(force)) > T::zero()
 }
 
 /// `sum_{i free} M_i M_i^T / w_i`.

@@ -3,11 +3,10 @@
 use nalgebra::Vector3;
 
 use super::{
-    gram_of, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
+    gram_of, outside, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
 };
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField};
-use crate::gimbal::GimbalCommand;
 use crate::linalg::GramSolver;
 use crate::real::Real;
 
@@ -138,7 +137,7 @@ fn saturated_pseudo_inverse<T: Real, const N: usize>(
         .zip(saturated.iter_mut())
         .zip(working)
     {
-        if ok && set.violation(&GimbalCommand::from_force(f)) > T::zero() {
+        if ok && outside(set, f) {
             *f = set.saturate(f);
             *sat = true;
         }

@@ -2,7 +2,9 @@
 
 use nalgebra::Vector3;
 
-use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
+use super::{
+    outside, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
+};
 use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
@@ -59,8 +61,19 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
                 .zip(&free)
                 .enumerate()
                 .filter(|(_, (_, is_free))| **is_free)
-                .map(|(i, ((f, set), _))| (i, set.violation(&GimbalCommand::from_force(f))))
-                .filter(|(_, v)| *v > T::zero())
+                .filter(|(_, ((f, set), _))| outside(set, f))
+                // A non-finite force counts as the worst.
+                .map(|(i, ((f, set), _))| {
+                    let v = set.violation(&GimbalCommand::from_force(f));
+                    (
+                        i,
+                        if f.iter().all(|x| x.is_finite()) {
+                            v
+                        } else {
+                            T::one() / T::zero()
+                        },
+                    )
+                })
                 .fold(None, |best: Option<(usize, T)>, (i, v)| match best {
                     Some((_, bv)) if bv >= v => best,
                     _ => Some((i, v)),
@@ -86,7 +99,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
             .zip(&free)
             .zip(saturated.iter_mut())
         {
-            if *is_free && set.violation(&GimbalCommand::from_force(f)) > T::zero() {
+            if *is_free && outside(set, f) {
                 *f = set.saturate(f);
                 *sat = true;
             }

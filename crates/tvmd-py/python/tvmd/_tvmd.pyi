@@ -50,7 +50,8 @@ class ConfigError(ValueError):
     field: Optional[str]
 
 class InputError(ValueError):
-    """A control-cycle input that cannot be used: not finite, or not a rotation."""
+    """A control-cycle input that cannot be used: not finite, not a rotation, beyond the cycle's
+    bound for its float type, or a non-zero force request answered only by zero thrust."""
 
 class CycleError(InputError):
     """``Controller.step`` rejected its input.
@@ -80,7 +81,11 @@ class Team:
         navigator_mass: ``m_0`` (kg), >= 0.
         navigator_inertia: ``J_0`` (3, 3), symmetric positive semi-definite; default 0.
         agent_inertias: optional (n, 3, 3) inertias of the agents about their own CoM, in {C}
-            axes (extension of the paper's point-mass model).
+            axes (extension of the paper's point-mass model), each symmetric positive
+            semi-definite.
+
+    Finite values whose team mass, weight ``m_C g`` at standard gravity, ``J_C``, ``M M^T`` or
+    ``n sigma_Tf`` would not be finite are rejected (``ConfigError`` naming the field).
 
     Team mass ``m_C = m_0 + sum m_i``, inertia ``J_C = J_0 + sum (J_i - m_i [p_i]x [p_i]x)``.
 
@@ -226,6 +231,14 @@ class Team:
         """
     def plant(self, gravity: float = ...) -> "Plant":
         """The rigid-body parameters of the control law."""
+    def hover_capability(self, failed: _Failed = None, gravity: float = ...) -> "HoverCapability":
+        """Whether the working agents can hold hover at ``gravity`` with a margin (see
+        ``HoverCapability``). A mask that leaves ``M`` rank-deficient is classified not capable.
+
+        Raises:
+            ConfigError: every agent failed, a failure index the team does not have, or a
+                gravity that is not positive and finite (or whose weight overflows).
+        """
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
 
@@ -609,12 +622,14 @@ class Plant:
     (eqs. 2-3). ``team.plant(gravity=9.81)`` builds it from a team.
 
     Args:
-        mass: ``m_C`` (kg).
-        inertia: ``J_C`` (3, 3) (kg m^2).
-        gravity: ``g`` (m/s^2).
+        mass: ``m_C`` (kg), > 0.
+        inertia: ``J_C`` (3, 3) (kg m^2), symmetric positive definite.
+        gravity: ``g`` (m/s^2), > 0.
 
     Raises:
         ValueError: NaN/inf values or a wrong shape.
+        ConfigError (a ValueError): a mass or gravity that is not positive, an inertia that is
+            not symmetric positive definite, or a weight ``m_C g`` that overflows.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -860,14 +875,22 @@ class Controller:
         *,
         s: Optional[float] = None,
     ) -> "Controller": ...
-    def set_failures(self, failed: _Failed = None) -> None:
+    def set_failures(self, failed: _Failed = None) -> "HoverCapability":
         """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``
         and is commanded idle.
+
+        Returns:
+            HoverCapability: whether the working agents can hold hover with a margin, computed
+            now (once per mask) and kept as ``hover_capability``, so a caller can decide to land.
 
         Raises:
             ConfigError: an index the team does not have, or a remaining team that cannot
                 produce every wrench (the previous mask is kept).
         """
+    @property
+    def hover_capability(self) -> "HoverCapability":
+        """The classification of the working agents when the failures were last set (the full
+        team's after construction)."""
     def reset(self) -> None:
         """Forgets the previous command (rate limits restart from centred gimbals; a rejected
         cycle then holds idle commands).
@@ -885,8 +908,10 @@ class Controller:
             StepOutput.
 
         Raises:
-            CycleError (a ValueError): NaN/inf input or a non-rotation attitude; the exception's
-                ``commands`` (n, 4) are the previous period's commands to hold.
+            CycleError (a ValueError): NaN/inf input, a non-rotation attitude, a component beyond
+                the cycle's input bound (``tvmd_core::Controller::input_limit``, 4.3e151 for the
+                paper's team in f64), or a non-zero force request that only zero thrust answers;
+                the exception's ``commands`` (n, 4) are the previous period's commands to hold.
             ValueError / TypeError: wrong shapes or argument types.
         """
     @property
@@ -922,6 +947,48 @@ class Controller:
     @property
     def previous_commands(self) -> _F64:
         """(n, 4) previous period's commands."""
+
+@final
+class HoverCapability:
+    """Whether the working agents of a team can hold hover with a margin: the hover wrench
+    ``[0, 0, 0, 0, 0, m_C g]`` strictly inside their attainable wrench set (``tvmd_core::hover``,
+    docs/method.md "Hover capability").
+
+    The margin is certified by an allocation ``f`` with ``M f = w_hover`` inside every working
+    agent's exact ``E_f`` (eq. 6): the smallest normalized slack of any agent (thrust to both
+    ends of its range, each gimbal angle to its limit, each over the range's half-width; 1 means
+    every agent at the centre). It is a lower bound of the best slack over all allocations, exact
+    when the vertical forces are determined (e.g. three agents at ``z = 0``). A4-Inc minus any
+    one agent: not capable, margin 0; A6-Inc minus one: capable, margin 0.4.
+
+    Attributes:
+        capable: rank-6 ``M``, the allocation produces the hover wrench, and ``margin`` exceeds
+            ``sqrt(eps)``.
+        margin: the certified margin (<= 0: a bound is touched or exceeded).
+        limiting_agent: the agent whose slack is ``margin`` (None without working agents).
+        limit: the bound it is closest to.
+        weight: ``m_C g`` (N).
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+
+    @property
+    def capable(self) -> bool:
+        """The hover wrench is strictly inside the working agents' attainable set."""
+    @property
+    def margin(self) -> float:
+        """Smallest normalized slack of any working agent in the certifying allocation."""
+    @property
+    def limiting_agent(self) -> Optional[int]:
+        """The agent whose slack is ``margin``, or None."""
+    @property
+    def limit(self) -> Literal["max_thrust", "min_thrust", "gimbal_x", "gimbal_y"]:
+        """The bound that agent is closest to."""
+    @property
+    def weight(self) -> float:
+        """``m_C g`` (N)."""
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict."""
 
 @final
 class StepOutput:

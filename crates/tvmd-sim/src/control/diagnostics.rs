@@ -65,5 +65,6 @@ pub(super) fn cycle_diagnostics<T: CoreFloat>(
         }),
         cycle_error: None,
         failure_note,
+        hover: None,
     }
 }

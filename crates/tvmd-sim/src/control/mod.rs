@@ -14,7 +14,10 @@
 //! 2. passes a changed failure mask (the failures the controller is told of) to
 //!    [`tvmd_core::Controller::set_failures`]; if the core refuses it (the remaining team cannot
 //!    produce every wrench) the old mask stays and the reason is reported in
-//!    [`Diagnostics::failure_note`];
+//!    [`Diagnostics::failure_note`]; an accepted mask's hover classification is reported in
+//!    [`Diagnostics::hover`], and with `failure_response.on_hover_loss = "land"` a team
+//!    classified not hover-capable flies a level descent to `z = 0` from then on (module
+//!    `landing`);
 //! 3. runs one [`tvmd_core::Controller::step`] in `T`; on a [`tvmd_core::CycleError`] it holds
 //!    the commands the error carries and reports the error in [`Diagnostics::cycle_error`];
 //! 4. converts the commands and every part of [`Diagnostics`] (planner, control law,
@@ -22,17 +25,20 @@
 
 use tvmd_core::{AnyAllocator, FailureMask};
 
-use crate::diagnostics::Diagnostics;
+use crate::diagnostics::{Diagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
-use crate::scenario::{Precision, Scenario};
+use crate::scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
 use crate::SimError;
 
 mod config;
 mod convert;
 mod diagnostics;
+mod landing;
+
+pub use landing::Landing;
 
 pub use config::{allocator, controller_settings, hover_roll_limit, team_config};
 pub use convert::{core_reference, core_state, sim_command, CoreFloat};
@@ -54,6 +60,10 @@ pub struct TvmdController<T: CoreFloat> {
     mask: Vec<bool>,
     failure_note: Option<String>,
     last: Option<CoreOutput<T>>,
+    response: FailureResponse,
+    /// The classification of the mask accepted this tick, reported once.
+    hover: Option<HoverDiagnostics>,
+    landing: Option<Landing>,
 }
 
 impl<T: CoreFloat> TvmdController<T> {
@@ -67,7 +77,18 @@ impl<T: CoreFloat> TvmdController<T> {
         let alloc = config::allocator::<T>(&scenario.allocator)?;
         let n = team.len();
         let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
-        Ok(Self::new(inner, n))
+        Ok(Self::new(inner, n).with_failure_response(scenario.failure_response))
+    }
+
+    /// The same controller with another response to a hover-capability loss.
+    pub fn with_failure_response(mut self, response: FailureResponse) -> Self {
+        self.response = response;
+        self
+    }
+
+    /// The landing started on a hover-capability loss, if any.
+    pub fn landing(&self) -> Option<&Landing> {
+        self.landing.as_ref()
     }
 
     /// Wraps a core controller for a team of `n` agents.
@@ -78,6 +99,9 @@ impl<T: CoreFloat> TvmdController<T> {
             mask: vec![false; n],
             failure_note: None,
             last: None,
+            response: FailureResponse::default(),
+            hover: None,
+            landing: None,
         }
     }
 
@@ -91,7 +115,7 @@ impl<T: CoreFloat> TvmdController<T> {
         self.last.as_ref()
     }
 
-    fn update_failures(&mut self, failed: &[bool]) {
+    fn update_failures(&mut self, t: f64, state: &PlantState, failed: &[bool]) {
         let wanted: Vec<bool> = (0..self.n)
             .map(|i| failed.get(i).copied().unwrap_or(false))
             .collect();
@@ -104,8 +128,25 @@ impl<T: CoreFloat> TvmdController<T> {
             let _ = mask.set(i, *f);
         }
         match self.inner.set_failures(mask) {
-            Ok(()) => {
+            Ok(hover) => {
                 self.failure_note = None;
+                let land = !hover.capable
+                    && self.response.on_hover_loss == OnHoverLoss::Land
+                    && self.landing.is_none();
+                if land {
+                    self.landing = Some(Landing::start(
+                        t,
+                        &state.position,
+                        self.response.landing_acceleration,
+                    ));
+                }
+                self.hover = Some(HoverDiagnostics {
+                    capable: hover.capable,
+                    margin: convert::to_sim(hover.margin),
+                    limiting_agent: hover.limiting_agent,
+                    limit: hover.limit.as_str().to_string(),
+                    landing: land,
+                });
             }
             Err(e) => {
                 self.failure_note = Some(format!(
@@ -124,20 +165,39 @@ impl<T: CoreFloat> TvmdController<T> {
 impl<T: CoreFloat> FlightController for TvmdController<T> {
     fn step(
         &mut self,
-        _t: f64,
+        t: f64,
         state: &PlantState,
         reference: &ReferenceSample,
         failed: &[bool],
     ) -> Result<FlightOutput, BoxedError> {
-        self.update_failures(failed);
+        self.update_failures(t, state, failed);
         let n = self.n;
+        if let Some(landing) = &mut self.landing {
+            landing.disarmed |= landing.touched_down(t, &state.position);
+            if landing.disarmed {
+                return Ok(FlightOutput {
+                    commands: vec![sim_command(&tvmd_core::AgentCommand::<T>::idle()); n],
+                    diagnostics: Diagnostics {
+                        failure_note: Some(
+                            "landed after a hover-capability loss: rotors idle".into(),
+                        ),
+                        hover: self.hover.take(),
+                        ..Default::default()
+                    },
+                });
+            }
+        }
+        let landing_reference = self.landing.as_ref().map(|l| l.reference(t));
+        let reference = landing_reference.as_ref().unwrap_or(reference);
+        let hover = self.hover.take();
         match self.inner.step(
             &convert::core_state(state),
             &convert::core_reference(reference),
         ) {
             Ok(out) => {
-                let diagnostics =
+                let mut diagnostics =
                     diagnostics::cycle_diagnostics(&out, n, self.failure_note.clone());
+                diagnostics.hover = hover;
                 let commands = out.commands[..n].iter().map(sim_command).collect();
                 self.last = Some(out);
                 Ok(FlightOutput {
@@ -150,6 +210,7 @@ impl<T: CoreFloat> FlightController for TvmdController<T> {
                 diagnostics: Diagnostics {
                     cycle_error: Some(e.to_string()),
                     failure_note: self.failure_note.clone(),
+                    hover,
                     ..Default::default()
                 },
             }),

@@ -45,6 +45,10 @@
 //! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal"
 //! controller_informed = true
 //!
+//! [failure_response]
+//! on_hover_loss = "land"     # default "continue"; "land": fall level to the ground when the
+//! landing_acceleration = 2.5 # working agents are classified not hover-capable (m/s^2)
+//!
 //! [disturbances]
 //! wind = [0.5, 0.0, 0.0]
 //! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
@@ -264,6 +268,42 @@ fn default_true() -> bool {
     true
 }
 
+/// What the controller does when an accepted failure mask leaves a team that cannot hold hover
+/// with a margin ([`tvmd_core::Controller::set_failures`]'s classification).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OnHoverLoss {
+    /// Keep flying the scenario's reference (the default; the classification is only logged).
+    #[default]
+    Continue,
+    /// Replace the reference by a level descent at the current `x`, `y` to the rest height
+    /// `z = 0` at the downward acceleration `landing_acceleration`, then idle the rotors.
+    Land,
+}
+
+/// The scenario's response to a hover-capability loss (`[failure_response]`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FailureResponse {
+    /// `"continue"` (default) or `"land"`.
+    pub on_hover_loss: OnHoverLoss,
+    /// Downward acceleration of the landing reference (m/s^2); 2.5. The reference falls from
+    /// where the loss was classified to `z = 0` (asking the agents for `m_C (g - a)`, which
+    /// leaves a margin of about `a / g` for the attitude), touching down at `sqrt(2 a z_0)`
+    /// (2.7 m/s from 1.5 m). Measured on `agent-failure` (A4-Inc minus one): 2.5 lands level
+    /// in f64 and f32; 1.5 lands in f64 but tilts 0.58 rad in f32; 0.5 and 1.0 flip in f32.
+    pub landing_acceleration: f64,
+}
+
+impl Default for FailureResponse {
+    fn default() -> Self {
+        Self {
+            on_hover_loss: OnHoverLoss::Continue,
+            landing_acceleration: 2.5,
+        }
+    }
+}
+
 /// A constant external wrench over a time window.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -374,6 +414,8 @@ pub struct Scenario {
     pub actuators: ActuatorModel,
     /// Agent failures.
     pub failures: Vec<Failure>,
+    /// What to do when a failure leaves a team that cannot hold hover.
+    pub failure_response: FailureResponse,
     /// Disturbances.
     pub disturbances: Disturbances,
 }
@@ -399,6 +441,7 @@ impl Default for Scenario {
             reference: ReferenceConfig::default(),
             actuators: ActuatorModel::default(),
             failures: Vec::new(),
+            failure_response: FailureResponse::default(),
             disturbances: Disturbances::default(),
         }
     }

@@ -47,6 +47,10 @@ impl Scenario {
         check_nonneg("physics.gravity", &[self.physics.gravity])?;
         check_nonneg("physics.friction", &[self.physics.friction])?;
         check_finite("initial_position", &self.initial_position)?;
+        check_pos(
+            "failure_response.landing_acceleration",
+            self.failure_response.landing_acceleration,
+        )?;
         if !(self.relaxation > 0.0 && self.relaxation <= 1.0) {
             return Err(invalid(
                 "relaxation",

@@ -4,6 +4,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::actuators::ActuatorCommand;
+use crate::diagnostics::HoverDiagnostics;
 use crate::flight::FlightOutput;
 use crate::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
 use crate::physics::PlantState;
@@ -44,6 +45,8 @@ pub struct Sample {
     pub v_r: Option<f64>,
     /// The controller skipped this cycle (held its previous commands).
     pub cycle_error: bool,
+    /// The hover classification, at the tick a new failure mask was accepted.
+    pub hover: Option<HoverDiagnostics>,
     /// Commands returned at this tick.
     pub commands: Vec<ActuatorCommand>,
     /// Actual actuator outputs at this tick (before the new commands act).
@@ -98,6 +101,7 @@ impl Sample {
             v_x: d.lyapunov.map(|l| l.v_x),
             v_r: d.lyapunov.map(|l| l.v_r),
             cycle_error: d.cycle_error.is_some(),
+            hover: d.hover.clone(),
             commands: out.commands.clone(),
             actual,
             failed,

@@ -136,6 +136,19 @@ pub struct RunTotals {
     pub wall_time: f64,
 }
 
+/// One hover classification of a run: when the controller accepted a new failure mask.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HoverClassification {
+    /// Time (s) of the controller tick that accepted the mask.
+    pub time: f64,
+    /// Whether the working agents can hold hover with a margin.
+    pub capable: bool,
+    /// The certified margin (`<= 0`: none).
+    pub margin: f64,
+    /// Whether the scenario's `failure_response` started a landing on it.
+    pub landing: bool,
+}
+
 /// Summary of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunSummary {
@@ -191,6 +204,8 @@ pub struct RunSummary {
     pub saturated_periods: usize,
     /// Controller periods the controller skipped (held commands).
     pub cycle_errors: usize,
+    /// The hover classifications, one per accepted change of the failure mask.
+    pub hover_classifications: Vec<HoverClassification>,
     /// Number of controller calls.
     pub controller_calls: usize,
     /// Number of physics steps.
@@ -263,6 +278,17 @@ impl RunSummary {
                 .filter(|x| x.saturated_agents.is_some_and(|n| n > 0))
                 .count(),
             cycle_errors: samples.iter().filter(|x| x.cycle_error).count(),
+            hover_classifications: samples
+                .iter()
+                .filter_map(|x| {
+                    x.hover.as_ref().map(|h| HoverClassification {
+                        time: x.t,
+                        capable: h.capable,
+                        margin: h.margin,
+                        landing: h.landing,
+                    })
+                })
+                .collect(),
             controller_calls: totals.controller_calls,
             physics_steps: totals.physics_steps,
             wall_time: totals.wall_time,
@@ -433,6 +459,7 @@ mod tests {
             v_x: Some(x),
             v_r: None,
             cycle_error: false,
+            hover: None,
             commands: Vec::new(),
             actual: Vec::new(),
             failed: Vec::new(),

@@ -102,6 +102,9 @@ impl Tick<'_> {
         if let Some(l) = &d.lyapunov {
             log.write(LogKind::Lyapunov, t, l)?;
         }
+        if let Some(h) = &d.hover {
+            log.write(LogKind::Hover, t, h)?;
+        }
         log.write(
             LogKind::Actuators,
             t,

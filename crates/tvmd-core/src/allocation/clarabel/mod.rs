@@ -86,7 +86,8 @@ use settings::{default_settings, DEFAULT_LAMBDA};
 ///   through [`AdmissibleSet::saturate`] (round-off), so it satisfies the allocation contract.
 ///   `saturated[i]` flags an agent with a constraint active within `1e-6` of its maximum thrust.
 /// - **Fallback**: if Clarabel ends other than `Solved` or `AlmostSolved` (iteration or time
-///   limit, numerical trouble), or the input is not finite, or no agent works, the allocator
+///   limit, numerical trouble), or the input is not finite, or the request is beyond `1e6`
+///   times what the agents can produce ([`FallbackReason::OutOfRange`]), or no agent works, the allocator
 ///   returns [`RedistributedPseudoInverse`]'s answer with [`Allocation::fallback`] set;
 ///   [`Self::last_report`] says why.
 ///
@@ -297,6 +298,24 @@ impl<T: Real, const N: usize> ClarabelAllocator<T, N> {
     }
 }
 
+/// Whether every component of the request is at most `1e6` times the largest the working agents
+/// can produce, `sum_i sigma_Tf,i 3 max |M_i|` (a non-finite request passes here and falls back
+/// as non-finite input).
+fn within_range<T: Real, const N: usize>(request: &AllocationRequest<'_, T, N>) -> bool {
+    let reach: f64 = request
+        .effectiveness
+        .blocks()
+        .iter()
+        .zip(request.sets)
+        .filter_map(|(b, set)| b.as_ref().map(|b| to_f64(set.thrust().hi * b.amax()) * 3.0))
+        .sum();
+    let largest = request
+        .wrench
+        .iter()
+        .fold(0.0_f64, |m, x| m.max(to_f64(x.abs())));
+    largest <= reach * 1e6 || !largest.is_finite()
+}
+
 impl<T: Real, const N: usize> Default for ClarabelAllocator<T, N> {
     /// `lambda = 1e-6`, `W = I`, 100 iterations, tolerance `1e-9`, no time limit.
     fn default() -> Self {
@@ -355,6 +374,10 @@ impl<T: Real, const N: usize> Allocator<T, N> for ClarabelAllocator<T, N> {
             polished: false,
             fallback: None,
         };
+        if !within_range(request) {
+            report.fallback = Some(FallbackReason::OutOfRange);
+            return self.fallback(request, report, started);
+        }
         let Some(problem) = Problem::new(request, &self.weights, self.lambda) else {
             report.fallback = Some(FallbackReason::NonFiniteInput);
             return self.fallback(request, report, started);

@@ -24,6 +24,10 @@ pub enum FallbackReason {
     Status,
     /// Clarabel reported a solution containing NaN or infinity.
     NonFiniteSolution,
+    /// The request exceeds `1e6` times the largest wrench component the agents can produce
+    /// ([`ClarabelAllocator`]'s range): its squares would swamp the solver's scaling, and every
+    /// agent saturates anyway.
+    OutOfRange,
 }
 
 impl fmt::Display for FallbackReason {
@@ -34,6 +38,7 @@ impl fmt::Display for FallbackReason {
             Self::Setup => "solver setup failed",
             Self::Status => "solver did not converge",
             Self::NonFiniteSolution => "non-finite solution",
+            Self::OutOfRange => "request out of the solver's range",
         })
     }
 }

@@ -1,0 +1,108 @@
+//! The landing reference flown after a hover-capability loss when the scenario asks for it
+//! (`failure_response.on_hover_loss = "land"`): level, at the `x`, `y` where the loss was
+//! classified, falling with a constant downward acceleration `a` to the rest height `z = 0`
+//! (the team resting on the ground, see [`crate::physics`]); once the reference is down and
+//! the team is within [`TOUCHDOWN_HEIGHT`] of it, the rotors go idle (disarmed, as PX4's land
+//! detector does).
+//!
+//! Why an accelerating descent and not a constant rate: a team classified not hover-capable
+//! has no margin at the hover wrench (A4-Inc minus one: two agents at `sigma_Tf`, one at zero),
+//! and a constant-rate descent needs that same wrench, so it flips as hover does. Falling at
+//! `a` asks for `m_C (g - a)` only, which leaves the working agents a margin of about `a / g`
+//! to hold the attitude; the price is a touchdown at `sqrt(2 a z_0)` (no deceleration, which
+//! would need more than the weight).
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::reference::ReferenceSample;
+
+/// Height (m) above the rest height under which a landed team is disarmed.
+pub const TOUCHDOWN_HEIGHT: f64 = 0.05;
+
+/// A landing started at time `start` from `from`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Landing {
+    /// Time (s) the landing started.
+    pub start: f64,
+    /// Position (m) the landing started from.
+    pub from: Vector3<f64>,
+    /// Downward acceleration of the reference (m/s^2), `> 0`.
+    pub acceleration: f64,
+    /// Touched down: the rotors are idle from then on.
+    pub disarmed: bool,
+}
+
+impl Landing {
+    /// A landing from `position` at time `t`.
+    pub fn start(t: f64, position: &Vector3<f64>, acceleration: f64) -> Self {
+        Self {
+            start: t,
+            from: *position,
+            acceleration,
+            disarmed: false,
+        }
+    }
+
+    /// Whether the team has touched down at time `t`: the reference is down and the team's
+    /// centre of mass is within [`TOUCHDOWN_HEIGHT`] of the rest height.
+    pub fn touched_down(&self, t: f64, position: &Vector3<f64>) -> bool {
+        t >= self.touchdown_time() && position.z <= TOUCHDOWN_HEIGHT
+    }
+
+    /// Time (s) the reference reaches `z = 0`: `start + sqrt(2 z_0 / a)`.
+    pub fn touchdown_time(&self) -> f64 {
+        self.start + (2.0 * self.from.z.max(0.0) / self.acceleration).sqrt()
+    }
+
+    /// The reference's speed at touchdown (m/s), `sqrt(2 a z_0)`.
+    pub fn touchdown_speed(&self) -> f64 {
+        (2.0 * self.acceleration * self.from.z.max(0.0)).sqrt()
+    }
+
+    /// The reference at time `t`: level, at the start's `x`, `y`, with
+    /// `z = z_0 - a tau^2 / 2` (`tau = t - start`) and its velocity and acceleration as
+    /// feed-forward until `z = 0`; then at rest at `z = 0`.
+    pub fn reference(&self, t: f64) -> ReferenceSample {
+        let tau = (t - self.start).max(0.0);
+        let falling = t < self.touchdown_time();
+        let a = self.acceleration;
+        let (z, vz, az) = if falling {
+            (self.from.z - 0.5 * a * tau * tau, -a * tau, -a)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        ReferenceSample {
+            t,
+            position: Vector3::new(self.from.x, self.from.y, z),
+            velocity: Vector3::new(0.0, 0.0, vz),
+            acceleration: Vector3::new(0.0, 0.0, az),
+            rotation: Matrix3::identity(),
+            omega: Vector3::zeros(),
+            omega_dot: Vector3::zeros(),
+            roll: 0.0,
+            roll_rate: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn falls_level_to_rest_height_and_holds() {
+        let l = Landing::start(5.0, &Vector3::new(0.1, -0.2, 2.0), 1.0);
+        assert_eq!(l.touchdown_time(), 7.0);
+        assert_eq!(l.touchdown_speed(), 2.0);
+        let mid = l.reference(6.0);
+        assert_eq!(mid.position, Vector3::new(0.1, -0.2, 1.5));
+        assert_eq!((mid.velocity.z, mid.acceleration.z), (-1.0, -1.0));
+        assert_eq!(mid.rotation, Matrix3::identity());
+        let after = l.reference(8.0);
+        assert_eq!(after.position.z, 0.0);
+        assert_eq!(after.velocity, Vector3::zeros());
+        assert!(!l.touched_down(6.9, &Vector3::new(0.0, 0.0, 0.0)));
+        assert!(!l.touched_down(8.0, &Vector3::new(0.0, 0.0, 0.2)));
+        assert!(l.touched_down(8.0, &Vector3::new(0.0, 0.0, 0.01)));
+    }
+}
