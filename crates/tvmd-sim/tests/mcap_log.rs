@@ -63,7 +63,8 @@ fn small_log_reads_back() {
     assert!(log.write(LogKind::State, 1.0, &1.0).is_err());
     let bytes = std::fs::read(&path).unwrap();
     let summary = Summary::read(&bytes).unwrap().expect("summary present");
-    assert_eq!(summary.channels.len(), 9);
+    // LogKind::ALL (8, /hover included), /tf and /scene.
+    assert_eq!(summary.channels.len(), 10);
     assert_eq!(summary.stats.as_ref().unwrap().message_count, 9);
     let mut schema_names: Vec<_> = summary
         .schemas
