@@ -53,9 +53,9 @@ cargo test -p tvmd-sim --features clarabel --test closed_loop
 
 step "randomized control cycle: 1,000,000 steps per type (f32, f64), then 200,000 per type with clarabel"
 # Release build; prints the counts (steps, Ok, each error variant, rejected teams).
-# Measured on the 2-core development machine after the builds: about 20 s for both types, and
-# about 7 s for the clarabel run (a tenth of its controllers use Clarabel, at a quarter of the
-# steps: about 5,500 Clarabel steps per type).
+# Measured on the 2-core development machine: 9 s for both types and 4 s for the clarabel run
+# (a tenth of its controllers use Clarabel, at a quarter of the steps: about 5,400 Clarabel
+# steps per type), plus about 40 s of release build each.
 TVMD_FUZZ_STEPS=1000000 cargo test --release -p tvmd-core --test cycle_fuzz -- --nocapture
 TVMD_FUZZ_STEPS=200000 cargo test --release -p tvmd-core --features clarabel --test cycle_fuzz -- --nocapture
 

@@ -29,8 +29,11 @@ fn a4_inc_failure_is_classified_not_capable_and_keeps_flying_by_default() {
             "{c:?}"
         );
         assert!(c[0].margin.abs() < 1e-3, "{c:?}");
-        // The default response is unchanged: the README's flip after the failure.
-        assert!(r.summary.max_tilt > 3.0, "{}", r.summary.max_tilt);
+        // The default response keeps flying. With honest saturation (issue 13: a saturated
+        // force projected onto its clamped direction) the noise-free flight balances on the
+        // zero margin instead of flipping (measured max tilt 0.085 rad); the flip was an
+        // artifact of saturated forces keeping their norm along a direction they lacked.
+        assert!(r.summary.max_tilt < 0.15, "{}", r.summary.max_tilt);
     }
 }
 

@@ -313,7 +313,8 @@ fn within_range<T: Real, const N: usize>(request: &AllocationRequest<'_, T, N>) 
         .wrench
         .iter()
         .fold(0.0_f64, |m, x| m.max(to_f64(x.abs())));
-    largest <= reach * 1e6 || !largest.is_finite()
+    // No working agent (`reach = 0`) falls back as such, after this check.
+    reach == 0.0 || largest <= reach * 1e6 || !largest.is_finite()
 }
 
 impl<T: Real, const N: usize> Default for ClarabelAllocator<T, N> {
