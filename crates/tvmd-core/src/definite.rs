@@ -20,17 +20,27 @@ pub(crate) fn is_symmetric_psd<T: Real>(j: &Matrix3<T>) -> bool {
     }
 }
 
-/// `true` if `j` is finite, symmetric and positive definite: after scaling, the leading
-/// principal minors are `> eps` (so a matrix singular up to rounding is refused, while an
-/// eigenvalue ratio down to about `eps`, e.g. `diag(1e-6, 1, 1)` in f32, is accepted).
+/// `true` if `j` is finite, symmetric and positive definite, judged on its correlation form
+/// `C = D^-1/2 j D^-1/2` (`D = diag(j)`, every diagonal entry `> 0`): the leading principal
+/// minors of `C` must exceed `8 eps`. Definiteness is invariant under this scaling, so any
+/// positive diagonal matrix is accepted whatever its eigenvalue ratio (`diag(1e-2, 1, 1e2)`
+/// in f32, `diag(1e-17, 1, 1)` in f64), while a dense matrix singular up to rounding is refused.
 pub(crate) fn is_symmetric_pd<T: Real>(j: &Matrix3<T>) -> bool {
-    match scaled(j) {
-        Some(Scaled::Unit(a)) => {
-            let [m11, _, _, m12, _, _, det] = principal_minors(&a);
-            [m11, m12, det].iter().all(|m| *m > eps::<T>())
-        }
-        _ => false,
+    let Some(Scaled::Unit(a)) = scaled(j) else {
+        return false;
+    };
+    let d = a.diagonal();
+    if !d.iter().all(|x| *x > T::zero()) {
+        return false;
     }
+    let inv_sqrt = d.map(|x| T::one() / x.sqrt());
+    if !inv_sqrt.iter().all(|x| x.is_finite()) {
+        return false;
+    }
+    let c = a.component_mul(&(inv_sqrt * inv_sqrt.transpose()));
+    let minor2 = c.m11 * c.m22 - c.m12 * c.m12;
+    let threshold = eps::<T>() * lit(8.0);
+    minor2 > threshold && c.determinant() > threshold
 }
 
 fn tolerance<T: Real>() -> T {
@@ -101,8 +111,15 @@ mod tests {
         assert!(is_symmetric_pd(&Matrix3::<f32>::from_diagonal(
             &Vector3::new(1e-6, 1.0, 1.0)
         )));
+        // Positive diagonals are definite whatever their ratios (congruence-invariant test).
+        assert!(is_symmetric_pd(&d(1e-17, 1.0, 1.0)));
+        assert!(is_symmetric_pd(&Matrix3::<f32>::from_diagonal(
+            &Vector3::new(1e-2, 1.0, 1e2)
+        )));
         // Singular up to rounding: refused.
-        assert!(!is_symmetric_pd(&d(1e-17, 1.0, 1.0)));
+        let rank_one = Vector3::new(1.0, 2.0, 3.0) * Vector3::new(1.0, 2.0, 3.0).transpose();
+        assert!(!is_symmetric_pd(&rank_one));
+        assert!(!is_symmetric_pd(&(rank_one + Matrix3::identity() * 1e-17)));
         assert!(!is_symmetric_psd(&d(f64::NAN, 1.0, 1.0)));
         assert!(!is_symmetric_pd(&d(f64::INFINITY, 1.0, 1.0)));
     }

@@ -228,8 +228,8 @@ fn allocator<T: Real>(rng: &mut StdRng, clarabel: bool) -> AnyAllocator<T, N> {
     AnyAllocator::from_name(name, &options).expect("the names and options are valid")
 }
 
-/// Random settings; gains the validation refuses (e.g. too ill-conditioned to certify as
-/// positive definite in the type) come back as the `ConfigError`.
+/// Random settings; gains the validation refuses (e.g. a product that overflows the type)
+/// come back as the `ConfigError`.
 fn settings<T: Real>(rng: &mut StdRng) -> Result<ControllerSettings<T>, tvmd_core::ConfigError> {
     let mut s = ControllerSettings::paper();
     if rng.random_bool(0.5) {

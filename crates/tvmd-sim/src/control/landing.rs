@@ -7,10 +7,10 @@
 //!
 //! Why an accelerating descent and not a constant rate: a team classified not hover-capable
 //! has no margin at the hover wrench (A4-Inc minus one: two agents at `sigma_Tf`, one at zero),
-//! and a constant-rate descent needs that same wrench, so it flips as hover does. Falling at
-//! `a` asks for `m_C (g - a)` only, which leaves the working agents a margin of about `a / g`
-//! to hold the attitude; the price is a touchdown at `sqrt(2 a z_0)` (no deceleration, which
-//! would need more than the weight).
+//! and a constant-rate descent needs that same wrench, with nothing left to correct a tilt.
+//! Falling at `a` asks for `m_C (g - a)` only, which leaves the working agents a margin of
+//! about `a / g` to hold the attitude; the price is a touchdown at `sqrt(2 a z_0)` (no
+//! deceleration, which would need more than the weight).
 
 use nalgebra::{Matrix3, Vector3};
 
