@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Runs the f32 core on emulated Cortex-M4F (QEMU mps2-an386) and Cortex-M7 (mps2-an500): the
+# firmware in embedded/target-tests checks every reference vector against the host's f32 result
+# and the file's f64 result, and exits through semihosting; QEMU's exit status decides.
+# Installs qemu-system-arm with apt-get when it is missing (as root, or through sudo).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! command -v qemu-system-arm >/dev/null 2>&1; then
+  echo "==> qemu-system-arm not found: installing it with apt-get"
+  if [ "$(id -u)" -eq 0 ]; then
+    as_root=()
+  elif command -v sudo >/dev/null 2>&1; then
+    as_root=(sudo)
+  else
+    echo "error: qemu-system-arm is missing and this user can neither install packages (not root) nor use sudo; install qemu-system-arm (Debian/Ubuntu package of that name) and rerun" >&2
+    exit 1
+  fi
+  if ! { "${as_root[@]}" apt-get update -q && DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -q qemu-system-arm; }; then
+    echo "error: apt-get could not install qemu-system-arm; install it by hand and rerun" >&2
+    exit 1
+  fi
+  command -v qemu-system-arm >/dev/null 2>&1 || {
+    echo "error: qemu-system-arm still not on PATH after apt-get install" >&2
+    exit 1
+  }
+fi
+qemu-system-arm --version | head -n 1
+
+rustup target add thumbv7em-none-eabihf
+cargo build --release --locked --manifest-path embedded/target-tests/Cargo.toml --target thumbv7em-none-eabihf
+target_dir=${CARGO_TARGET_DIR:-embedded/target-tests/target}
+elf="$target_dir/thumbv7em-none-eabihf/release/tvmd-target-tests"
+
+status=0
+for machine in mps2-an386 mps2-an500; do
+  echo "==> $machine"
+  # The firmware runs in well under a second; the timeout only catches a hang (e.g. a fault).
+  rc=0
+  timeout 300 qemu-system-arm -machine "$machine" -nographic -monitor none \
+    -semihosting-config enable=on,target=native -kernel "$elf" || rc=$?
+  if [ "$rc" -eq 124 ]; then
+    echo "error: $machine timed out (the firmware hung)" >&2
+    status=1
+  elif [ "$rc" -ne 0 ]; then
+    echo "error: $machine: target tests failed (exit status $rc)" >&2
+    status=1
+  fi
+done
+[ "$status" -eq 0 ] && echo "target tests passed on mps2-an386 (Cortex-M4F) and mps2-an500 (Cortex-M7)"
+exit "$status"
