@@ -77,6 +77,36 @@ fn flatten(family: Family, c: &Value) -> (Vec<f64>, Vec<f64>, Vec<(usize, bool)>
             want.push(planned);
             (x, want, vec![(1, true), (9, false), (1, true)])
         }
+        Family::ControlCycle => (get(c, &["x"]), vec![], vec![]),
+    }
+}
+
+/// Appends one `Case` per entry of `list`, with the host's f32 outputs.
+fn emit(src: &mut String, key: &str, family: Family, list: &[Value]) {
+    for (i, c) in list.iter().enumerate() {
+        let (x, want, groups) = flatten(family, c);
+        let mut out = [0.0f32; MAX_OUTPUTS];
+        let k = cases::run(family, &x, &mut out)
+            .unwrap_or_else(|e| panic!("host run of {key}[{i}]: {e}"));
+        let host: Vec<String> = out[..k]
+            .iter()
+            .map(|o| format!("{:#010x}", o.to_bits()))
+            .collect();
+        let f = |a: &[f64]| {
+            a.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        writeln!(
+            src,
+            "    Case {{ name: \"{key}[{i}]\", family: Family::{family:?}, input: &[{}], \
+                 expected: &[{}], groups: &{groups:?}, host: &[{}] }},",
+            f(&x),
+            f(&want),
+            host.join(", ")
+        )
+        .unwrap();
     }
 }
 
@@ -102,32 +132,41 @@ fn main() {
         let list = v[key]
             .as_array()
             .unwrap_or_else(|| panic!("missing family {key}"));
-        for (i, c) in list.iter().enumerate() {
-            let (x, want, groups) = flatten(family, c);
-            let mut out = [0.0f32; MAX_OUTPUTS];
-            let k = cases::run(family, &x, &mut out)
-                .unwrap_or_else(|e| panic!("host run of {key}[{i}]: {e}"));
-            let host: Vec<String> = out[..k]
-                .iter()
-                .map(|o| format!("{:#010x}", o.to_bits()))
-                .collect();
-            let f = |a: &[f64]| {
-                a.iter()
-                    .map(|x| format!("{x:?}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            writeln!(
-                src,
-                "    Case {{ name: \"{key}[{i}]\", family: Family::{family:?}, input: &[{}], \
-                 expected: &[{}], groups: &{groups:?}, host: &[{}] }},",
-                f(&x),
-                f(&want),
-                host.join(", ")
-            )
-            .unwrap();
-        }
+        emit(&mut src, key, family, list);
     }
+    // Control cycles of the paper's team (not in the vectors file): hover at the reference, an
+    // offset, a moving team, and roll references from feasible to planner-saturated (bisecting).
+    let mut cycles = Vec::new();
+    for (p, w, vel, roll, ref_roll) in [
+        ([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3], 0.0, 0.0),
+        ([0.3, -0.2, 0.8], [0.0; 3], [0.0; 3], 0.0, 0.0),
+        (
+            [0.0, 0.0, 1.0],
+            [0.1, -0.2, 0.05],
+            [0.2, 0.1, -0.3],
+            0.05,
+            0.0,
+        ),
+        ([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3], 0.0, 0.2),
+        ([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3], 0.0, 0.5),
+        ([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3], 0.3, 0.8),
+        (
+            [0.1, 0.1, 1.2],
+            [0.3, 0.0, -0.1],
+            [0.5, 0.0, 0.0],
+            -0.2,
+            1.2,
+        ),
+    ] {
+        let mut x: Vec<f64> = Vec::new();
+        x.extend(p);
+        x.extend(w);
+        x.extend(vel);
+        x.push(roll);
+        x.extend([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, ref_roll]);
+        cycles.push(serde_json::json!({ "x": x }));
+    }
+    emit(&mut src, "control_cycle", Family::ControlCycle, &cycles);
     src.push_str("];\n");
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     std::fs::write(out_dir.join("vectors.rs"), src).unwrap();

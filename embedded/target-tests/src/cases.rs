@@ -3,13 +3,17 @@
 //! f32 inputs. Inputs are the f64 numbers of `core_vectors.json`, flattened per family (see
 //! `build.rs`); outputs are f32, written into `out`.
 
+use tvmd_core::controller::roll;
 use tvmd_core::effectiveness::agent_block;
 use tvmd_core::nalgebra::{Matrix3, Vector3};
+use tvmd_core::team::presets;
 use tvmd_core::{
-    project_force, AttainableForceSpace, AttitudePlanner, GimbalCommand, PlannerStatus, Relaxation,
+    project_force, AttainableForceSpace, AttitudePlanner, Controller, ControllerSettings,
+    GimbalCommand, PlannerStatus, RedistributedPseudoInverse, Reference, Relaxation, RigidState,
 };
 
 /// Longest output of any case: the effectiveness case of 12 agents (6 wrench + 18 per agent).
+/// (A control cycle writes 4 x 4 commands, `theta` and the status.)
 pub const MAX_OUTPUTS: usize = 6 + 18 * 12;
 
 /// The five families of `core_vectors.json`.
@@ -25,6 +29,9 @@ pub enum Family {
     ForceProjection,
     /// eqs. (9)-(11).
     AttitudePlanner,
+    /// One whole control cycle of the paper's four-agent team (`Controller::step`), from a
+    /// fresh controller; no f64 reference, compared with the host only.
+    ControlCycle,
 }
 
 fn v3(x: &[f64], at: usize) -> Option<Vector3<f32>> {
@@ -118,6 +125,33 @@ pub fn run(family: Family, x: &[f64], out: &mut [f32; MAX_OUTPUTS]) -> Result<us
             put(&mut core::iter::once(plan.theta)
                 .chain(r.iter().copied())
                 .chain(core::iter::once(planned)))
+        }
+        // x = [position(3), angular_velocity(3), velocity(3), roll, ref position(3),
+        //      ref acceleration(3), ref roll]; out = [4 x (eta_x, eta_y, thrust, omega),
+        //      planner theta, 0 if Ok else 1]
+        Family::ControlCycle => {
+            let team = presets::a4_inc::<f32, 4>().map_err(|_| "preset team refused")?;
+            let mut controller = Controller::new(
+                team,
+                ControllerSettings::paper(),
+                RedistributedPseudoInverse,
+            )
+            .map_err(|_| "controller refused the preset")?;
+            let mut state = RigidState::at_rest(v3(x, 0).ok_or(BAD)?);
+            state.angular_velocity = v3(x, 3).ok_or(BAD)?;
+            state.velocity = v3(x, 6).ok_or(BAD)?;
+            state.attitude = roll(*x.get(9).ok_or(BAD)? as f32);
+            let mut reference = Reference::hover(v3(x, 10).ok_or(BAD)?);
+            reference.acceleration = v3(x, 13).ok_or(BAD)?;
+            reference.attitude = roll(*x.get(16).ok_or(BAD)? as f32);
+            let (commands, theta, held) = match controller.step(&state, &reference) {
+                Ok(o) => (o.commands, o.planner.theta, 0.0),
+                Err(e) => (e.commands, 0.0, 1.0),
+            };
+            put(&mut commands
+                .iter()
+                .flat_map(|c| [c.eta_x, c.eta_y, c.thrust, c.omega])
+                .chain([theta, held]))
         }
     }
 }
