@@ -73,6 +73,12 @@ step "panic-free link check: f32 control cycle on thumbv7em with an undefined pa
 # Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).
 cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf
 
+step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"
+# See scripts/target.sh. Measured on the 2-core development machine: 50 s to apt-get install
+# qemu-system-arm where it is missing, about 70 s to build the firmware from scratch, and under
+# a second per board to run it.
+bash scripts/target.sh
+
 step "Python wheel (maturin, abi3) and pytest"
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
