@@ -64,7 +64,7 @@ pub struct PlannerOutput<T: Real> {
 }
 
 /// The attitude planner of eqs. (9)-(11), with the improvements recorded in `docs/method.md`: a
-/// bracketed search on `theta` (regula falsi with the Illinois fix, bisection as safeguard) in
+/// bracketed search on `theta` (regula falsi, Anderson-Bjorck variant, bisection as safeguard) in
 /// place of the paper's bisection; it returns the last *feasible* point, stops on a tolerance or
 /// an iteration cap, and tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
 ///
@@ -208,18 +208,29 @@ impl<T: Real> AttitudePlanner<T> {
             }
             cone.quadratic_form(u).sqrt() - T::one()
         };
-        // Regula falsi with the Illinois fix on `phi(theta)`, bracketed by the membership test.
-        // Invariant: `lo` infeasible, `hi` feasible; `hi` is returned.
+        // Regula falsi on `phi(theta)` with the Anderson-Bjorck fix against a stalled end,
+        // bracketed by the membership test. Invariant: `lo` infeasible, `hi` feasible; `hi` is
+        // returned.
         let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
         let (mut z_lo, mut z_hi) = (tilt.b_zr, end.column(2).into_owned());
         let (mut phi_lo, mut phi_hi) =
             (phi(&(r_r.transpose() * f_r)), phi(&(end.transpose() * f_r)));
-        // Which end moved last (Illinois: a second move of the same end halves the other's phi).
+        // Which end moved last: a second move of the same end scales the other end's phi by
+        // `1 - phi_new / phi_old` (Anderson-Bjorck; by 1/2, the Illinois factor, when that is
+        // not positive). Illinois's fixed 1/2 stalls where phi is steep near `z = 0`.
         let mut last_moved_hi: Option<bool> = None;
         // Bisection's bracket after the same number of steps, times 2^4: a secant step is taken
         // only while it cannot fall behind it, so at most 4 steps more than bisection are used.
         let mut budget = tilt.theta_max * lit(16.0);
         let half = lit::<T>(0.5);
+        let shrink = |new: T, old: T| {
+            let m = T::one() - new / old;
+            if m > T::zero() {
+                m
+            } else {
+                half
+            }
+        };
         let mut iterations = 0;
         while hi - lo > self.tolerance && iterations < self.max_iterations {
             iterations += 1;
@@ -257,13 +268,13 @@ impl<T: Real> AttitudePlanner<T> {
             let value = phi(&u);
             if cone.admits(&u) {
                 if last_moved_hi == Some(true) {
-                    phi_lo *= half;
+                    phi_lo *= shrink(value, phi_hi);
                 }
                 (hi, z_hi, r_hi, phi_hi) = (theta, z, r, value);
                 last_moved_hi = Some(true);
             } else {
                 if last_moved_hi == Some(false) {
-                    phi_hi *= half;
+                    phi_hi *= shrink(value, phi_lo);
                 }
                 (lo, z_lo, phi_lo) = (theta, z, value);
                 last_moved_hi = Some(false);
