@@ -14,7 +14,7 @@ use crate::rotation::validate_rotation;
 pub enum PlannerStatus {
     /// `R_r^T f_r` was already in the AFS: `R_d = R_r`, `theta = 0`.
     AlreadyFeasible,
-    /// Bisection found the smallest feasible tilt (within the tolerance).
+    /// The search found the smallest feasible tilt (within the tolerance).
     Planned,
     /// `f_r = 0`: there is no direction to tilt toward; `R_d = R_r`.
     ZeroForce,
@@ -57,15 +57,16 @@ pub struct PlannerOutput<T: Real> {
     pub r_d: Matrix3<T>,
     /// `theta*`, the tilt from `b_zr` toward `f_r` (rad).
     pub theta: T,
-    /// Bisection iterations used (0 unless [`PlannerStatus::Planned`]).
+    /// Search steps (membership tests) used (0 unless [`PlannerStatus::Planned`]).
     pub iterations: u32,
     /// How the output was reached.
     pub status: PlannerStatus,
 }
 
-/// The bisection attitude planner of eqs. (9)-(11), with the improvements recorded in `docs/method.md`:
-/// it returns the last *feasible* bisection point, stops on a tolerance or an iteration cap, and
-/// tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
+/// The attitude planner of eqs. (9)-(11), with the improvements recorded in `docs/method.md`: a
+/// bracketed search on `theta` (regula falsi, Anderson-Bjorck variant, bisection as safeguard) in
+/// place of the paper's bisection; it returns the last *feasible* point, stops on a tolerance or
+/// an iteration cap, and tilts about `b_xr` when `f_r` is (anti)parallel to `b_zr`.
 ///
 /// ```
 /// use tvmd_core::nalgebra::Vector3;
@@ -98,7 +99,7 @@ impl<T: Real> AttitudePlanner<T> {
         }
     }
 
-    /// Sets the bisection tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
+    /// Sets the search tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
     pub fn with_tolerance(
         mut self,
         tolerance: T,
@@ -124,7 +125,7 @@ impl<T: Real> AttitudePlanner<T> {
         self.relaxation
     }
 
-    /// The bisection tolerance (rad).
+    /// The search tolerance on `theta` (rad).
     pub fn tolerance(&self) -> T {
         self.tolerance
     }
@@ -182,39 +183,109 @@ impl<T: Real> AttitudePlanner<T> {
                 status: PlannerStatus::Unreachable,
             });
         }
-        // Invariant: `lo` infeasible, `hi` feasible; `hi` is returned. `b_zd(theta)` moves on a
-        // great circle, so the midpoint direction is the normalized sum of the end directions:
-        // no trigonometry inside the loop.
+        Ok(self.search(cone, r_r, f_r, &tilt, end))
+    }
+
+    /// The search between `theta = 0` (infeasible) and `theta_max` (`end`, feasible; so
+    /// `||f_r||` is within the thrust bound and only the cross-section is tested).
+    fn search(
+        &self,
+        cone: &EllipticCone<T>,
+        r_r: &Matrix3<T>,
+        f_r: &Vector3<T>,
+        tilt: &Tilt<T>,
+        end: Matrix3<T>,
+    ) -> PlannerOutput<T> {
+        // The search's guide: `phi = sqrt(u^T C u) - 1` at `u = R_d(theta)^T f_r`, continuous in
+        // `theta`, positive outside the cross-section and `<= 0` inside (for a round cone of
+        // half-angle `alpha`, `tan(angle) / tan(alpha) - 1`: nearer linear in `theta` than
+        // `u^T C u - 1` or the cone's division-free margin, so fewer secant steps). The ratios
+        // of `quadratic_form` neither overflow nor underflow. Where it cannot guide (`z < 0`,
+        // where `|z|` mirrors the cone; a zero semi-axis, `+inf`), the search bisects.
+        let phi = |u: &Vector3<T>| {
+            if u.z < T::zero() {
+                return T::one() / T::zero();
+            }
+            cone.quadratic_form(u).sqrt() - T::one()
+        };
+        // Regula falsi on `phi(theta)` with the Anderson-Bjorck fix against a stalled end,
+        // bracketed by the membership test. Invariant: `lo` infeasible, `hi` feasible; `hi` is
+        // returned.
         let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
         let (mut z_lo, mut z_hi) = (tilt.b_zr, end.column(2).into_owned());
+        let (mut phi_lo, mut phi_hi) =
+            (phi(&(r_r.transpose() * f_r)), phi(&(end.transpose() * f_r)));
+        // Which end moved last: a second move of the same end scales the other end's phi by
+        // `1 - phi_new / phi_old` (Anderson-Bjorck; by 1/2, the Illinois factor, when that is
+        // not positive). Illinois's fixed 1/2 stalls where phi is steep near `z = 0`.
+        let mut last_moved_hi: Option<bool> = None;
+        // Bisection's bracket after the same number of steps, times 2^4: a secant step is taken
+        // only while it cannot fall behind it, so at most 4 steps more than bisection are used.
+        let mut budget = tilt.theta_max * lit(16.0);
+        let half = lit::<T>(0.5);
+        let shrink = |new: T, old: T| {
+            let m = T::one() - new / old;
+            if m > T::zero() {
+                m
+            } else {
+                half
+            }
+        };
         let mut iterations = 0;
         while hi - lo > self.tolerance && iterations < self.max_iterations {
             iterations += 1;
-            let mid = (lo + hi) * lit(0.5);
-            let sum = z_lo + z_hi;
-            let norm = sum.norm();
-            // |sum| = 2 cos((hi - lo) / 2) vanishes only for a half-turn bracket.
-            let z_mid = if norm > lit(0.5) {
-                sum * (T::one() / norm)
+            let width = hi - lo;
+            let guard = self.tolerance * half;
+            // The secant point needs phi(lo) > 0 >= phi(hi); a `z < 0` or zero-semi-axis end
+            // (phi <= 0 while infeasible) or an overflow has no usable value.
+            let secant = phi_lo > T::zero()
+                && phi_lo.is_finite()
+                && phi_hi <= T::zero()
+                && width <= budget * half
+                && width > self.tolerance * lit(2.0);
+            budget *= half;
+            let (theta, z) = if secant {
+                let t = hi - phi_hi * width / (phi_hi - phi_lo);
+                // Kept a tolerance inside the bracket: a point landing next to `hi` then lets
+                // the next infeasible test close the bracket (the stop of Brent's method).
+                let t = t.max(lo + guard).min(hi - guard);
+                (t, tilt.direction(t))
             } else {
-                tilt.direction(mid)
+                let sum = z_lo + z_hi;
+                let norm = sum.norm();
+                // The great-circle midpoint without trigonometry; |sum| = 2 cos(width / 2)
+                // vanishes only for a half-turn bracket.
+                let mid = (lo + hi) * half;
+                let z_mid = if norm > half {
+                    sum * (T::one() / norm)
+                } else {
+                    tilt.direction(mid)
+                };
+                (mid, z_mid)
             };
-            let r_mid = tilt.frame(z_mid);
-            if feasible(&r_mid) {
-                hi = mid;
-                z_hi = z_mid;
-                r_hi = r_mid;
+            let r = tilt.frame(z);
+            let u = r.transpose() * f_r;
+            let value = phi(&u);
+            if cone.admits(&u) {
+                if last_moved_hi == Some(true) {
+                    phi_lo *= shrink(value, phi_hi);
+                }
+                (hi, z_hi, r_hi, phi_hi) = (theta, z, r, value);
+                last_moved_hi = Some(true);
             } else {
-                lo = mid;
-                z_lo = z_mid;
+                if last_moved_hi == Some(false) {
+                    phi_hi *= shrink(value, phi_lo);
+                }
+                (lo, z_lo, phi_lo) = (theta, z, value);
+                last_moved_hi = Some(false);
             }
         }
-        Ok(PlannerOutput {
+        PlannerOutput {
             r_d: r_hi,
             theta: hi,
             iterations,
             status: PlannerStatus::Planned,
-        })
+        }
     }
 }
 

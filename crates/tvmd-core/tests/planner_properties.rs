@@ -148,6 +148,14 @@ proptest! {
             PlannerStatus::Planned => {
                 prop_assert!(afs.contains(&(out.r_d.transpose() * f_r), relaxation));
                 prop_assert!(out.iterations <= 64);
+                // The search's safeguard: at most 4 steps more than bisection to the default
+                // tolerance (1e-10 rad) would need from [0, theta_max].
+                let theta_max = r_r.column(2).dot(&f_r.normalize()).clamp(-1.0, 1.0).acos();
+                let bisection_steps = (theta_max / 1e-10).log2().ceil().max(0.0) as u32;
+                prop_assert!(
+                    out.iterations <= bisection_steps + 4,
+                    "{} steps, bisection {}", out.iterations, bisection_steps
+                );
                 let earlier = tilted_attitude(&r_r, &f_r, out.theta - 1e-7);
                 prop_assert!(
                     !afs.contains(&(earlier.transpose() * f_r), relaxation),
