@@ -52,15 +52,15 @@ cargo test -p tvmd-core --features clarabel
 cargo test -p tvmd-sim --features clarabel --test closed_loop
 
 step "randomized control cycle: 1,000,000 steps per type (f32, f64), then 200,000 per type with clarabel"
-# Release build; prints the counts (steps, Ok, each error variant, rejected teams).
+# Optimized build (ci profile); prints the counts (steps, Ok, each error variant, rejected teams).
 # Measured on the 2-core development machine: 9 s for both types and 4 s for the clarabel run
 # (a tenth of its controllers use Clarabel, at a quarter of the steps: about 5,400 Clarabel
-# steps per type), plus about 40 s of release build each.
-TVMD_FUZZ_STEPS=1000000 cargo test --release -p tvmd-core --test cycle_fuzz -- --nocapture
-TVMD_FUZZ_STEPS=200000 cargo test --release -p tvmd-core --features clarabel --test cycle_fuzz -- --nocapture
+# steps per type), plus the optimized build.
+TVMD_FUZZ_STEPS=1000000 cargo test --profile ci -p tvmd-core --test cycle_fuzz -- --nocapture
+TVMD_FUZZ_STEPS=200000 cargo test --profile ci -p tvmd-core --features clarabel --test cycle_fuzz -- --nocapture
 
-step "benchmarks compile (cargo bench --no-run)"
-cargo bench --workspace --no-run
+step "benchmarks compile (cargo bench --no-run, in the ci profile: the same code without fat LTO)"
+cargo bench --workspace --no-run --profile ci
 
 step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
 cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
@@ -84,7 +84,9 @@ python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet -r crates/tvmd-py/requirements-test.txt
 rm -rf target/wheels
-.venv/bin/maturin build --release --features clarabel -m crates/tvmd-py/Cargo.toml -o target/wheels
+# The ci profile (release without fat LTO) keeps the cold build short; `maturin build --release`
+# builds the wheel users install.
+.venv/bin/maturin build --profile ci --features clarabel -m crates/tvmd-py/Cargo.toml -o target/wheels
 .venv/bin/python -m pip install --quiet --force-reinstall --no-deps target/wheels/tvmd-*.whl
 .venv/bin/python -m pytest -q crates/tvmd-py/tests
 
