@@ -53,17 +53,18 @@ cargo test -p tvmd-sim --features clarabel --test closed_loop
 
 step "randomized control cycle: 1,000,000 steps per type (f32, f64), then 200,000 per type with clarabel"
 # Optimized build (ci profile); prints the counts (steps, Ok, each error variant, rejected teams).
-# Measured on the 2-core development machine: 9 s for both types and 4 s for the clarabel run
-# (a tenth of its controllers use Clarabel, at a quarter of the steps: about 5,400 Clarabel
-# steps per type), plus the optimized build.
+# Measured on the 2-core development machine in the ci profile: 11 s for both types and 7 s for
+# the clarabel run (a tenth of its controllers use Clarabel, at a quarter of the steps: about
+# 5,400 Clarabel steps per type), plus the optimized build.
 TVMD_FUZZ_STEPS=1000000 cargo test --profile ci -p tvmd-core --test cycle_fuzz -- --nocapture
 TVMD_FUZZ_STEPS=200000 cargo test --profile ci -p tvmd-core --features clarabel --test cycle_fuzz -- --nocapture
 
 step "benchmarks compile (cargo bench --no-run, in the ci profile: the same code without fat LTO)"
 cargo bench --workspace --no-run --profile ci
 
-step "tvmd-core for thumbv7em-none-eabihf (no_std, no default features)"
-cargo build -p tvmd-core --no-default-features --target thumbv7em-none-eabihf --release
+step "tvmd-core and the C interface tvmd-ffi (staticlib) for thumbv7em-none-eabihf (no_std, no default features)"
+# cargo drops tvmd-ffi's cdylib crate type for this target, with a warning.
+cargo build --locked -p tvmd-core -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release
 
 step "cargo package -p tvmd-core (the core packages and builds alone)"
 # --allow-dirty: the test command also runs on uncommitted work (a CI checkout is clean).
@@ -78,11 +79,6 @@ step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"
 # qemu-system-arm where it is missing, about 70 s to build the firmware from scratch, and under
 # a second per board to run it.
 bash scripts/target.sh
-
-step "C interface: tvmd-ffi staticlib for thumbv7em-none-eabihf (no_std)"
-# The host build and tests of tvmd-ffi run with the workspace above. Measured on the 2-core
-# development machine: 96 s from a cold target for this triple. (cdylib is dropped there.)
-cargo build --release --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf
 
 step "Python wheel (maturin, abi3) and pytest"
 python3 -m venv .venv
