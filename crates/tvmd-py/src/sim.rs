@@ -120,7 +120,11 @@ impl RunArgs<'_, '_> {
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
         let log = self.mcap;
-        Ok(RunSpec { scenario, log })
+        Ok(RunSpec {
+            scenario,
+            log,
+            pil: None,
+        })
     }
 }
 
