@@ -23,9 +23,8 @@ use serde::Serialize;
 
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
-use tvmd_sim::control::recording::record_cycles;
 use tvmd_sim::plot::{self, PlotSeries};
-use tvmd_sim::runner::{run_many, run_scenario_on, sweep_specs, RunSpec};
+use tvmd_sim::runner::{record_cycles, run_many, run_scenario_on, sweep_specs, RunSpec};
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;

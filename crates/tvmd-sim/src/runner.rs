@@ -10,7 +10,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use crate::control::pil::PilTarget;
-use crate::control::AnyTvmdController;
+use crate::control::recording::{CycleRecording, Recorder};
+use crate::control::TvmdController;
+use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
 use crate::log::{McapLog, METADATA_SCENARIO};
@@ -272,6 +274,34 @@ pub fn relaxation_sweep(
         jobs,
         progress,
     ))
+}
+
+/// Flies `scenario` with its f32 controller wrapped in a [`Recorder`] (whatever its `controller_precision`) and records
+/// its first `cycles` control cycles. Errors: the scenario's, the flight's, or a flight with
+/// fewer core cycles than asked.
+pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecording, SimError> {
+    let scenario = Scenario {
+        controller_precision: Precision::F32,
+        ..scenario.clone()
+    };
+    let config = wire_config(&scenario)?;
+    let (core, n) = core_of_scenario::<f32>(&scenario)?;
+    let mut controller: TvmdController<f32, Recorder<CoreController<f32>>> =
+        TvmdController::new(Recorder::new(core, n), n)
+            .with_failure_response(scenario.failure_response);
+    let mut sim = Simulation::with_options(&scenario, SimOptions::default())?;
+    sim.run(&mut controller, None)?;
+    let recorder = controller.engine();
+    if recorder.cycles() < cycles {
+        return Err(SimError::InvalidScenario {
+            field: "duration".into(),
+            reason: format!(
+                "the flight ran {} core cycles, fewer than the {cycles} to record",
+                recorder.cycles()
+            ),
+        });
+    }
+    Ok(recorder.recording(config, cycles))
 }
 
 #[cfg(test)]

@@ -4,11 +4,10 @@
 //! controller built from its configuration words (as the firmware does) reproduces every
 //! output bit for bit on the host.
 
-use tvmd_sim::control::recording::{
-    cycle_words, record_cycles, CycleRecording, EVENT_REFUSED, EVENT_SET,
-};
+use tvmd_sim::control::recording::{cycle_words, CycleRecording, EVENT_REFUSED, EVENT_SET};
 use tvmd_sim::control::wire::{self, Reader, Writer};
 use tvmd_sim::control::{core_of_scenario, wire_config};
+use tvmd_sim::runner::record_cycles;
 use tvmd_sim::scenario::{Precision, Scenario};
 
 const COMMITTED: &[u8] = include_bytes!("data/paper_tilt_f32.cycles");

@@ -320,8 +320,7 @@ impl AnyTvmdController {
     }
 }
 
-/// [`AnyTvmdController::target_label`] of an in-process controller.
-pub const HOST_TARGET: &str = "host";
+pub use crate::flight::HOST_TARGET;
 
 impl FlightController for AnyTvmdController {
     fn step(

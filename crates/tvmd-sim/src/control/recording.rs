@@ -20,10 +20,8 @@ use tvmd_core::{FailureMask, Reference, RigidState};
 
 use super::engine::{CoreEngine, CycleAnswer, FailureAnswer};
 use super::wire::{self, CoreConfig, Reader, Writer};
-use super::{core_of_scenario, CoreController, TvmdController, MAX_AGENTS};
+use super::MAX_AGENTS;
 use crate::error::BoxedError;
-use crate::scenario::{Precision, Scenario};
-use crate::sim::{SimOptions, Simulation};
 use crate::SimError;
 
 pub use super::wire::{
@@ -55,6 +53,16 @@ impl<E: CoreEngine<f32>> Recorder<E> {
     /// Cycles recorded so far.
     pub fn cycles(&self) -> usize {
         self.cycles
+    }
+
+    /// The first `cycles` recorded cycles (all if fewer) with the controller's `config`.
+    pub fn recording(&self, config: CoreConfig, cycles: usize) -> CycleRecording {
+        let cycles = cycles.min(self.cycles);
+        CycleRecording {
+            config,
+            cycles,
+            words: self.words[..cycles * cycle_words(self.n)].to_vec(),
+        }
     }
 }
 
@@ -168,36 +176,4 @@ impl CycleRecording {
         let len = cycle_words(self.config.n);
         self.words.get(k * len..(k + 1) * len)
     }
-}
-
-/// Flies `scenario` with its f32 controller (whatever its `controller_precision`) and records
-/// its first `cycles` control cycles. Errors: the scenario's, the flight's, or a flight with
-/// fewer core cycles than asked.
-pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecording, SimError> {
-    let scenario = Scenario {
-        controller_precision: Precision::F32,
-        ..scenario.clone()
-    };
-    let config = super::config::wire_config(&scenario)?;
-    let (core, n) = core_of_scenario::<f32>(&scenario)?;
-    let mut controller: TvmdController<f32, Recorder<CoreController<f32>>> =
-        TvmdController::new(Recorder::new(core, n), n)
-            .with_failure_response(scenario.failure_response);
-    let mut sim = Simulation::with_options(&scenario, SimOptions::default())?;
-    sim.run(&mut controller, None)?;
-    let recorder = controller.engine();
-    if recorder.cycles() < cycles {
-        return Err(SimError::InvalidScenario {
-            field: "duration".into(),
-            reason: format!(
-                "the flight ran {} core cycles, fewer than the {cycles} to record",
-                recorder.cycles()
-            ),
-        });
-    }
-    Ok(CycleRecording {
-        config,
-        cycles,
-        words: recorder.words[..cycles * cycle_words(n)].to_vec(),
-    })
 }

@@ -244,7 +244,7 @@ impl RunSummary {
         Self {
             scenario: scenario.name.clone(),
             controller_precision: scenario.controller_precision,
-            controller_target: crate::control::HOST_TARGET.to_string(),
+            controller_target: crate::flight::HOST_TARGET.to_string(),
             time,
             final_position: arr(&s.position),
             final_velocity: arr(&s.velocity),

@@ -29,23 +29,42 @@ const UART0: usize = 0x4000_4000;
 const DATA: usize = UART0;
 const STATE: usize = UART0 + 0x04;
 const CTRL: usize = UART0 + 0x08;
+const INTSTATUS: usize = UART0 + 0x0c;
 const BAUDDIV: usize = UART0 + 0x10;
 const TX_FULL: u32 = 1;
 const RX_FULL: u32 = 2;
+/// CTRL: transmitter, receiver and receive interrupt enabled.
+const TX_RX_RX_INTERRUPT: u32 = 0b1011;
+/// UART0's receive interrupt is IRQ 0 on both boards; NVIC set-enable and clear-pending.
+const NVIC_ISER0: usize = 0xe000_e100;
+const NVIC_ICPR0: usize = 0xe000_e280;
 
 fn uart_init() {
-    // SAFETY: the UART's registers on both boards; this firmware is their only user.
+    // Interrupts stay masked (PRIMASK): the receive interrupt only wakes `wfi`, no handler runs.
+    cortex_m::interrupt::disable();
+    // SAFETY: the UART's and the NVIC's registers on both boards; this firmware is their only
+    // user.
     unsafe {
         write_volatile(BAUDDIV as *mut u32, 16);
-        write_volatile(CTRL as *mut u32, 0b11);
+        write_volatile(CTRL as *mut u32, TX_RX_RX_INTERRUPT);
+        write_volatile(NVIC_ISER0 as *mut u32, 1);
     }
 }
 
+/// Waits for a byte asleep (`wfi` until the receive interrupt is pending) rather than polling
+/// the status register: a polling vCPU contends with QEMU's I/O thread for its global lock on
+/// every register read and slows the link down several times.
 fn read_byte() -> u8 {
     // SAFETY: as in `uart_init`.
     unsafe {
-        while read_volatile(STATE as *const u32) & RX_FULL == 0 {}
-        read_volatile(DATA as *const u32) as u8
+        while read_volatile(STATE as *const u32) & RX_FULL == 0 {
+            // A byte arriving after the check leaves the interrupt pending: `wfi` returns.
+            cortex_m::asm::wfi();
+        }
+        let b = read_volatile(DATA as *const u32) as u8;
+        write_volatile(INTSTATUS as *mut u32, RX_FULL);
+        write_volatile(NVIC_ICPR0 as *mut u32, 1);
+        b
     }
 }
 

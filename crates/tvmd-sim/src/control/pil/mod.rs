@@ -153,7 +153,12 @@ pub enum PilError {
 /// `$CARGO_TARGET_DIR` and the standard build directories of `embedded/target-tests` in this
 /// repository.
 pub fn firmware_candidates() -> Vec<PathBuf> {
-    if let Some(p) = std::env::var_os(FIRMWARE_ENV) {
+    candidates_with(std::env::var_os(FIRMWARE_ENV))
+}
+
+/// [`firmware_candidates`] with [`FIRMWARE_ENV`] set to `env`.
+fn candidates_with(env: Option<std::ffi::OsString>) -> Vec<PathBuf> {
+    if let Some(p) = env {
         return vec![PathBuf::from(p)];
     }
     let rel = Path::new("thumbv7em-none-eabihf/release/tvmd-pil");
@@ -169,7 +174,10 @@ pub fn firmware_candidates() -> Vec<PathBuf> {
 
 /// The PIL firmware ELF (see [`firmware_candidates`]).
 pub fn firmware_path() -> Result<PathBuf, PilError> {
-    let candidates = firmware_candidates();
+    first_file(&firmware_candidates())
+}
+
+fn first_file(candidates: &[PathBuf]) -> Result<PathBuf, PilError> {
     candidates
         .iter()
         .find(|p| p.is_file())
@@ -361,10 +369,16 @@ mod tests {
 
     #[test]
     fn missing_firmware_names_the_build_command() {
-        let e = PilError::FirmwareMissing {
-            searched: "x".into(),
-        };
+        let only = candidates_with(Some("/nonexistent/tvmd-pil".into()));
+        assert_eq!(only, [PathBuf::from("/nonexistent/tvmd-pil")]);
+        let e = first_file(&only).unwrap_err();
         let m = e.to_string();
+        assert!(m.contains("/nonexistent/tvmd-pil"), "{m}");
+        let standard = candidates_with(None);
+        assert!(standard
+            .iter()
+            .any(|p| p
+                .ends_with("embedded/target-tests/target/thumbv7em-none-eabihf/release/tvmd-pil")));
         assert!(m.contains(BUILD_COMMAND) && m.contains(FIRMWARE_ENV), "{m}");
         assert!(PilError::QemuMissing
             .to_string()
