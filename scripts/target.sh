@@ -56,7 +56,7 @@ done
 # in-process f32 flight (crates/tvmd-sim/tests/pil.rs, #[ignore]d in plain cargo test).
 echo "==> processor in the loop (tvmd-sim --pil cortex-m4, cortex-m7)"
 pil_elf=$(realpath "$target_dir/thumbv7em-none-eabihf/release/tvmd-pil")
-TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored || {
+TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored --nocapture || {
   echo "error: the processor-in-the-loop flights failed" >&2
   status=1
 }
