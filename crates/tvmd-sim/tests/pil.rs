@@ -84,3 +84,55 @@ fn pil_needs_the_f32_controller_and_a_known_target() {
     assert_eq!(spec.scenario.controller_precision, Precision::F32);
     assert!("cortex-m3".parse::<PilTarget>().is_err());
 }
+
+/// A failure mask crosses the link: A4-Inc loses agent 0 at t = 5 s (controller informed); the
+/// target's hover classification and flight match the host's.
+#[test]
+#[ignore = "needs qemu-system-arm and the PIL firmware; run by scripts/target.sh"]
+fn pil_flight_with_an_agent_failure_matches_the_host() {
+    let mut s = Scenario {
+        controller_precision: Precision::F32,
+        ..Scenario::builtin("agent-failure").unwrap()
+    };
+    s.duration = 6.0;
+    let host = run_scenario(&s, None, None).unwrap();
+    let pil = run_scenario_on(&s, Some(PilTarget::CortexM4), None, None).unwrap();
+    assert_eq!(host.summary.hover_classifications.len(), 1);
+    assert_eq!(
+        pil.summary.hover_classifications,
+        host.summary.hover_classifications
+    );
+    let d = FlightDifference::between(&host.samples, &pil.samples).unwrap();
+    eprintln!("cortex-m4 PIL vs host f32, agent-failure to 6 s: {d:#?}");
+    assert!(
+        d.position < 1e-5 && d.gimbal < 5e-6 && d.thrust < 5e-4,
+        "{d:?}"
+    );
+}
+
+/// The firmware answers a corrupted frame and a cycle before its configuration with an error
+/// frame (which the host reports), and the next good frame still parses.
+#[test]
+#[ignore = "needs qemu-system-arm and the PIL firmware; run by scripts/target.sh"]
+fn pil_firmware_reports_a_corrupted_frame_and_an_unconfigured_cycle() {
+    use std::time::{Duration, Instant};
+    use tvmd_sim::control::pil::{firmware_path, frame, QemuLink};
+    use tvmd_sim::control::wire;
+
+    let mut link = QemuLink::spawn("mps2-an386", &firmware_path().unwrap()).unwrap();
+    let soon = || Instant::now() + Duration::from_secs(30);
+    let ready = link.receive(soon()).unwrap();
+    assert_eq!((ready.kind, ready.words()), (wire::KIND_READY, vec![1]));
+    let step = frame::bytes_of(&[0; wire::INPUT_WORDS]);
+    let mut bad = frame::encode(wire::KIND_STEP, 7, &step).unwrap();
+    bad[20] ^= 1;
+    link.send(&bad).unwrap();
+    let reply = link.receive(soon()).unwrap();
+    assert_eq!((reply.kind, reply.seq), (wire::KIND_ERROR, 7));
+    assert_eq!(reply.text(0), "checksum mismatch");
+    link.send(&frame::encode(wire::KIND_STEP, 8, &step).unwrap())
+        .unwrap();
+    let reply = link.receive(soon()).unwrap();
+    assert_eq!((reply.kind, reply.seq), (wire::KIND_ERROR, 8));
+    assert_eq!(reply.text(0), "controller not configured");
+}
