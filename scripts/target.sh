@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Runs the f32 core on emulated Cortex-M4F (QEMU mps2-an386) and Cortex-M7 (mps2-an500): the
 # firmware in embedded/target-tests checks every reference vector against the host's f32 result
-# and the file's f64 result, and exits through semihosting; QEMU's exit status decides.
+# and the file's f64 result, and replays the recorded 1,000 cycles of the f32 paper-tilt
+# flight (crates/tvmd-sim/tests/data), and exits through semihosting; QEMU's exit status
+# decides. Then the processor-in-the-loop flights (tvmd-sim --pil) on both boards.
 # Installs qemu-system-arm with apt-get when it is missing (as root, or through sudo).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,5 +50,15 @@ for machine in mps2-an386 mps2-an500; do
     status=1
   fi
 done
+
+# Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
+# tvmd-pil firmware, built above with the target tests) on both boards, compared with the
+# in-process f32 flight (crates/tvmd-sim/tests/pil.rs, #[ignore]d in plain cargo test).
+echo "==> processor in the loop (tvmd-sim --pil cortex-m4, cortex-m7)"
+pil_elf=$(realpath "$target_dir/thumbv7em-none-eabihf/release/tvmd-pil")
+TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored --nocapture || {
+  echo "error: the processor-in-the-loop flights failed" >&2
+  status=1
+}
 [ "$status" -eq 0 ] && echo "target tests passed on mps2-an386 (Cortex-M4F) and mps2-an500 (Cortex-M7)"
 exit "$status"

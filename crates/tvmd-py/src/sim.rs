@@ -11,6 +11,7 @@ use pyo3::types::{PyDict, PyString};
 
 use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
+use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
@@ -30,6 +31,7 @@ const RUN_KEYS: &[&str] = &[
     "relaxation",
     "allocator",
     "precision",
+    "pil",
 ];
 
 /// What was done with the file an I/O error names.
@@ -97,6 +99,7 @@ struct RunArgs<'a, 'py> {
     relaxation: Option<f64>,
     allocator: Option<String>,
     precision: Option<String>,
+    pil: Option<String>,
 }
 
 impl RunArgs<'_, '_> {
@@ -113,14 +116,18 @@ impl RunArgs<'_, '_> {
             (None, None) => Scenario::builtin(DEFAULT_SCENARIO).map_err(value_error)?,
         };
         let precision = self.precision.as_deref().map(str::parse::<Precision>);
+        let precision = precision.transpose().map_err(value_error)?;
+        let pil = self.pil.as_deref().map(str::parse::<PilTarget>);
+        let pil = pil
+            .transpose()
+            .map_err(|e| PyValueError::new_err(format!("`pil`: {e}")))?;
         let overrides = Overrides {
             relaxation: self.relaxation,
             allocator: self.allocator,
-            precision: precision.transpose().map_err(value_error)?,
+            precision,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
-        let log = self.mcap;
-        Ok(RunSpec { scenario, log })
+        RunSpec::on_target(scenario, self.mcap, pil, precision).map_err(value_error)
     }
 }
 
@@ -175,6 +182,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         relaxation: opt(dict, &name, "relaxation")?,
         allocator: opt(dict, &name, "allocator")?,
         precision: opt(dict, &name, "precision")?,
+        pil: opt(dict, &name, "pil")?,
     }
     .spec(&format!("{name}['scenario']"))
 }
@@ -228,7 +236,8 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None))]
+#[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
     scenario: Option<&Bound<'_, PyAny>>,
@@ -237,6 +246,7 @@ fn run(
     relaxation: Option<f64>,
     allocator: Option<String>,
     precision: Option<String>,
+    pil: Option<String>,
 ) -> PyResult<PySimResult> {
     let spec = RunArgs {
         scenario,
@@ -245,6 +255,7 @@ fn run(
         relaxation,
         allocator,
         precision,
+        pil,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?
@@ -278,7 +289,7 @@ fn run_many(
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
 #[pyfunction]
-#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None))]
+#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None, pil = None))]
 #[allow(clippy::too_many_arguments)]
 fn relaxation_sweep(
     py: Python<'_>,
@@ -289,6 +300,7 @@ fn relaxation_sweep(
     precision: Option<String>,
     mcap_dir: Option<PathBuf>,
     jobs: Option<i64>,
+    pil: Option<String>,
 ) -> PyResult<Vec<PySimResult>> {
     let values = match relaxations.filter(|r| !r.is_none()) {
         Some(r) => match scalars(r, "relaxations")? {
@@ -302,10 +314,15 @@ fn relaxation_sweep(
         toml,
         allocator,
         precision,
+        pil,
         ..RunArgs::default()
     };
-    let base = args.spec("scenario")?.scenario;
-    let specs = sweep_specs(&base, &values, mcap_dir.as_deref()).map_err(value_error)?;
+    let base = args.spec("scenario")?;
+    let mut specs =
+        sweep_specs(&base.scenario, &values, mcap_dir.as_deref()).map_err(value_error)?;
+    for spec in &mut specs {
+        spec.pil = base.pil;
+    }
     run_specs(py, specs, jobs, |_, s| {
         format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
     })
@@ -416,6 +433,9 @@ record! {
         allocator => o.scenario.allocator.as_str(),
         /// The float type the controller flew in, "f64" or "f32".
         precision => o.scenario.controller_precision.as_str(),
+        /// Where the controller ran: "host", or the emulated target of a processor-in-the-loop
+        /// run (e.g. "cortex-m4 (qemu mps2-an386)").
+        controller_target => o.summary.controller_target.as_str(),
         /// Path of the MCAP log written, or None.
         mcap_path => o.mcap_string(),
         /// Number of agents `n`.

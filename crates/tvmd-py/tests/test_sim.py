@@ -30,7 +30,7 @@ HORIZONTAL_ERROR_AT_12S = 0.11
 SHORT = "duration = 1.0\n"
 
 RUN_SUMMARY_FIELDS = {
-    "scenario", "controller_precision", "time", "final_position", "final_velocity", "final_omega",
+    "scenario", "controller_precision", "controller_target", "time", "final_position", "final_velocity", "final_omega",
     "final_roll_pitch_yaw", "max_position_error", "max_position_error_after_4s",
     "final_position_error", "horizontal_error_at_4s", "horizontal_error_at_12s", "max_tilt",
     "max_roll", "max_planned_roll", "max_e_f", "max_e_f_time", "max_e_f_over_weight",
@@ -460,3 +460,44 @@ def test_sim_docstrings_present():
             assert getattr(value, "__doc__", None), attr
     for field in sim.SimResult.FIELDS:
         assert isinstance(vars(sim.SimResult)[field], type(tvmd.Team.n)), field
+
+
+# Processor in the loop (tvmd-sim --pil): the f32 controller in QEMU. Skipped only when
+# qemu-system-arm or the PIL firmware is missing (the test command builds the firmware with
+# scripts/target.sh before pytest runs).
+PIL_MISSING = ("PIL firmware not found", "`qemu-system-arm` not found")
+
+
+@pytest.mark.parametrize(
+    ("target", "label"),
+    [("cortex-m4", "cortex-m4 (qemu mps2-an386)"), ("cortex-m7", "cortex-m7 (qemu mps2-an500)")],
+)
+def test_pil_flight_matches_the_f32_host_flight(target: str, label: str) -> None:
+    try:
+        r = sim.run("paper-tilt", pil=target)
+    except RuntimeError as e:
+        if any(m in str(e) for m in PIL_MISSING):
+            pytest.skip(f"PIL unavailable: {e}")
+        raise
+    host = sim.run("paper-tilt", precision="f32")
+    assert r.controller_target == label
+    assert r.summary["controller_target"] == label
+    assert host.controller_target == "host"
+    assert r.precision == "f32"
+    # Bounds of crates/tvmd-sim/tests/pil.rs (about 10x the measured differences).
+    assert np.abs(r.position - host.position).max() < 1e-5
+    assert np.abs(r.commands[:, :, 2] - host.commands[:, :, 2]).max() < 5e-4
+    assert np.abs(r.commands[:, :, :2] - host.commands[:, :, :2]).max() < 5e-6
+    # The planner saturation reproduced on the target.
+    planned = r.summary["max_planned_roll"]
+    assert abs(planned - r.hover_roll_limit) < 0.01
+    assert abs(planned - host.summary["max_planned_roll"]) < 1e-5
+
+
+def test_pil_option_errors() -> None:
+    with pytest.raises(ValueError, match="unknown PIL target `cortex-m0`"):
+        sim.run(toml=SHORT, pil="cortex-m0")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="controller_precision.*f32"):
+        sim.run(toml=SHORT, pil="cortex-m4", precision="f64")
+    with pytest.raises(ValueError, match="runs\\[0\\]|unknown PIL target"):
+        sim.run_many([{"toml": SHORT, "pil": "m4"}])

@@ -75,6 +75,9 @@ pub enum SimError {
     /// The log was already finished.
     #[error("the MCAP log is already finished")]
     LogFinished,
+    /// The processor-in-the-loop link failed (firmware or QEMU missing, timeout, desync).
+    #[error("processor in the loop: {0}")]
+    Pil(#[from] crate::control::pil::PilError),
     /// A run of a batch panicked (a bug in the simulator) or did not finish.
     #[error("internal error in tvmd-sim (please report): {0}")]
     Internal(String),

@@ -8,6 +8,10 @@ use crate::error::BoxedError;
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
 
+/// Where an in-process controller runs (a summary's `controller_target`; a
+/// processor-in-the-loop flight names its emulated target instead).
+pub const HOST_TARGET: &str = "host";
+
 /// What a controller returns at each tick.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FlightOutput {

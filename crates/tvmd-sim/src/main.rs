@@ -4,9 +4,11 @@
 //! ```text
 //! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
 //!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
+//!              [--pil cortex-m4|cortex-m7]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
 //!                [--precision f64|f32]
 //! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
+//! tvmd-sim record-cycles [SCENARIO|FILE.toml] --out FILE [--cycles 1000]
 //! tvmd-sim list
 //! tvmd-sim show NAME
 //! ```
@@ -20,8 +22,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use tvmd_sim::control::hover_roll_limit;
+use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::plot::{self, PlotSeries};
-use tvmd_sim::runner::{run_many, run_scenario, sweep_specs};
+use tvmd_sim::runner::{record_cycles, run_many, run_scenario_on, sweep_specs, RunSpec};
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;
@@ -66,6 +69,26 @@ enum Command {
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
         precision: Option<String>,
+        /// Processor in the loop: run the f32 controller on an emulated target (QEMU
+        /// mps2-an386 for cortex-m4, mps2-an500 for cortex-m7) while the physics stays here.
+        /// Needs qemu-system-arm and the PIL firmware (`bash scripts/pil.sh build`, or
+        /// TVMD_PIL_FIRMWARE=ELF).
+        #[arg(long, value_parser = ["cortex-m4", "cortex-m7"])]
+        pil: Option<String>,
+    },
+    /// Record the first control cycles of a scenario's f32 flight (the core's exact inputs and
+    /// the host's outputs) for the target tests; the committed recording is
+    /// `crates/tvmd-sim/tests/data/paper_tilt_f32.cycles`.
+    RecordCycles {
+        /// A built-in scenario name or a TOML file.
+        #[arg(default_value = "paper-tilt")]
+        scenario: String,
+        /// File to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Consecutive control cycles to record, from the first.
+        #[arg(long, default_value_t = 1000)]
+        cycles: usize,
     },
     /// The relaxation study: the scenario flown once per relaxation s (in parallel threads).
     Sweep {
@@ -157,6 +180,7 @@ fn main() -> ExitCode {
             relaxation,
             allocator,
             precision,
+            pil,
         } => cmd_run(RunArgs {
             scenario,
             out,
@@ -166,7 +190,13 @@ fn main() -> ExitCode {
             relaxation,
             allocator,
             precision,
+            pil,
         }),
+        Command::RecordCycles {
+            scenario,
+            out,
+            cycles,
+        } => cmd_record_cycles(&scenario, &out, cycles),
         Command::Sweep {
             relaxations,
             scenario,
@@ -237,6 +267,8 @@ struct RunReport<'a> {
     allocator: &'a str,
     /// The controller's float type, `"f64"` or `"f32"`.
     controller_precision: Precision,
+    /// Where the controller ran: `"host"` or the emulated target.
+    controller_target: &'a str,
     /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
     hover_roll_limit: Option<f64>,
     summary: &'a RunSummary,
@@ -253,6 +285,7 @@ struct RunArgs {
     relaxation: Option<f64>,
     allocator: Option<String>,
     precision: Option<String>,
+    pil: Option<String>,
 }
 
 /// The `--precision` argument (clap has checked the spelling; the parse names the field).
@@ -260,12 +293,38 @@ fn precision_arg(p: Option<&str>) -> Result<Option<Precision>, CliError> {
     Ok(p.map(str::parse).transpose()?)
 }
 
+fn cmd_record_cycles(scenario: &str, out: &Path, cycles: usize) -> Result<(), CliError> {
+    let scenario = Scenario::load(scenario)?;
+    let recording = record_cycles(&scenario, cycles)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let bytes = recording.to_bytes();
+    std::fs::write(out, &bytes)?;
+    println!(
+        "recorded {cycles} f32 control cycles of {} ({} agents, {} bytes): {}",
+        scenario.name,
+        recording.config.n,
+        bytes.len(),
+        out.display()
+    );
+    Ok(())
+}
+
 fn cmd_run(a: RunArgs) -> Result<(), CliError> {
+    let precision = precision_arg(a.precision.as_deref())?;
+    let pil = a
+        .pil
+        .as_deref()
+        .map(str::parse::<PilTarget>)
+        .transpose()
+        .map_err(SimError::from)?;
     let scenario = Scenario::load(&a.scenario)?.with_overrides(&Overrides {
         relaxation: a.relaxation,
         allocator: a.allocator,
-        precision: precision_arg(a.precision.as_deref())?,
+        precision,
     })?;
+    let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
     let log = if a.no_log {
         None
     } else {
@@ -276,7 +335,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     };
     let bar = progress_bar(ticks_of(&scenario), &scenario.name);
     let mut tick = |_t: f64| bar.inc(1);
-    let result = run_scenario(&scenario, log.as_deref(), Some(&mut tick));
+    let result = run_scenario_on(&scenario, pil, log.as_deref(), Some(&mut tick));
     bar.finish_and_clear();
     let result = result?;
     let report = RunReport {
@@ -284,6 +343,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
         controller_precision: scenario.controller_precision,
+        controller_target: &result.summary.controller_target,
         hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
         summary: &result.summary,
         paper: PaperMetrics::new(&scenario, &result.samples),
@@ -334,6 +394,7 @@ fn print_run(r: &RunReport<'_>) {
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
         ("controller precision", r.controller_precision.to_string()),
+        ("controller target", r.controller_target.to_string()),
         ("simulated time", format!("{:.3} s", s.time)),
         (
             "wall time / RTF",

@@ -9,13 +9,16 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use crate::control::AnyTvmdController;
+use crate::control::pil::PilTarget;
+use crate::control::recording::{CycleRecording, Recorder};
+use crate::control::TvmdController;
+use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
 use crate::log::{McapLog, METADATA_SCENARIO};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
-use crate::scenario::Scenario;
+use crate::scenario::{Precision, Scenario};
 use crate::sim::{RunResult, SimOptions, Simulation};
 use crate::SimError;
 
@@ -69,7 +72,19 @@ pub fn run_scenario(
     log: Option<&Path>,
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<RunResult, SimError> {
-    let mut controller = AnyTvmdController::from_scenario(scenario)?;
+    run_scenario_on(scenario, None, log, progress)
+}
+
+/// [`run_scenario`] with the controller on `target`: in process for `None`, else on the
+/// emulated target ([`AnyTvmdController::from_scenario_on`]; the scenario's precision must be
+/// f32). The summary's `controller_target` says which.
+pub fn run_scenario_on(
+    scenario: &Scenario,
+    target: Option<PilTarget>,
+    log: Option<&Path>,
+    progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<RunResult, SimError> {
+    let mut controller = AnyTvmdController::from_scenario_on(scenario, target)?;
     let mut sim = Simulation::with_options(scenario, SimOptions::default())?;
     let mut mcap = match log {
         Some(path) => {
@@ -89,7 +104,9 @@ pub fn run_scenario(
     if let Some(l) = mcap.as_mut() {
         l.finish()?;
     }
-    result
+    let mut result = result?;
+    result.summary.controller_target = controller.target_label();
+    Ok(result)
 }
 
 /// One run of a batch: a validated scenario and the MCAP log to write, if any.
@@ -99,6 +116,36 @@ pub struct RunSpec {
     pub scenario: Scenario,
     /// MCAP log to write (parent directories are created).
     pub log: Option<PathBuf>,
+    /// The emulated target the controller runs on (processor in the loop), or `None` for the
+    /// host.
+    pub pil: Option<PilTarget>,
+}
+
+impl RunSpec {
+    /// A run of `scenario` (overrides applied) with the controller on `pil`. On a target the
+    /// controller precision becomes f32, the precision the PIL firmware runs; `precision` is
+    /// the one the caller asked for explicitly, and asking for f64 on a target is an error
+    /// naming `controller_precision`.
+    pub fn on_target(
+        mut scenario: Scenario,
+        log: Option<PathBuf>,
+        pil: Option<PilTarget>,
+        precision: Option<Precision>,
+    ) -> Result<Self, SimError> {
+        if let Some(target) = pil {
+            if precision == Some(Precision::F64) {
+                return Err(SimError::InvalidScenario {
+                    field: "controller_precision".into(),
+                    reason: format!(
+                        "the {target} PIL firmware runs the f32 controller; drop the f64 \
+                         precision or the PIL target"
+                    ),
+                });
+            }
+            scenario.controller_precision = Precision::F32;
+        }
+        Ok(Self { scenario, log, pil })
+    }
 }
 
 /// A finished run of a batch: what was asked and what came out.
@@ -135,8 +182,13 @@ fn run_guarded(
     progress: Option<Progress<'_>>,
 ) -> Result<RunResult, SimError> {
     catch_unwind(AssertUnwindSafe(|| match progress {
-        Some(p) => run_scenario(&spec.scenario, spec.log.as_deref(), Some(&mut |t| p(k, t))),
-        None => run_scenario(&spec.scenario, spec.log.as_deref(), None),
+        Some(p) => run_scenario_on(
+            &spec.scenario,
+            spec.pil,
+            spec.log.as_deref(),
+            Some(&mut |t| p(k, t)),
+        ),
+        None => run_scenario_on(&spec.scenario, spec.pil, spec.log.as_deref(), None),
     }))
     .unwrap_or_else(|p| Err(SimError::Internal(panic_message(p.as_ref()))))
 }
@@ -199,7 +251,11 @@ pub fn sweep_specs(
             scenario.name = format!("{}-s{s}", base.name);
             scenario.validate()?;
             let log = log_dir.map(|d| d.join(format!("{}.mcap", scenario.name)));
-            Ok(RunSpec { scenario, log })
+            Ok(RunSpec {
+                scenario,
+                log,
+                pil: None,
+            })
         })
         .collect()
 }
@@ -218,6 +274,34 @@ pub fn relaxation_sweep(
         jobs,
         progress,
     ))
+}
+
+/// Flies `scenario` with its f32 controller wrapped in a [`Recorder`] (whatever its `controller_precision`) and records
+/// its first `cycles` control cycles. Errors: the scenario's, the flight's, or a flight with
+/// fewer core cycles than asked.
+pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecording, SimError> {
+    let scenario = Scenario {
+        controller_precision: Precision::F32,
+        ..scenario.clone()
+    };
+    let config = wire_config(&scenario)?;
+    let (core, n) = core_of_scenario::<f32>(&scenario)?;
+    let mut controller: TvmdController<f32, Recorder<CoreController<f32>>> =
+        TvmdController::new(Recorder::new(core, n), n)
+            .with_failure_response(scenario.failure_response);
+    let mut sim = Simulation::with_options(&scenario, SimOptions::default())?;
+    sim.run(&mut controller, None)?;
+    let recorder = controller.engine();
+    if recorder.cycles() < cycles {
+        return Err(SimError::InvalidScenario {
+            field: "duration".into(),
+            reason: format!(
+                "the flight ran {} core cycles, fewer than the {cycles} to record",
+                recorder.cycles()
+            ),
+        });
+    }
+    Ok(recorder.recording(config, cycles))
 }
 
 #[cfg(test)]
@@ -248,6 +332,7 @@ mod tests {
             .map(|&(n, s)| RunSpec {
                 scenario: short(n, s),
                 log: None,
+                pil: None,
             })
             .collect();
         let ticks = AtomicUsize::new(0);

@@ -28,6 +28,9 @@ _RunItem = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 # The controller's float type: "f32" flies ``tvmd_core::Controller<f32, ..>`` (the flight
 # configuration), "f64" the default; the physics is f64 either way.
 _Precision = Literal["f32", "f64"]
+# Processor in the loop: the f32 controller runs on an emulated target (QEMU mps2-an386 for
+# "cortex-m4", mps2-an500 for "cortex-m7"), the physics here.
+_PilTarget = Literal["cortex-m4", "cortex-m7"]
 
 @final
 class SimResult:
@@ -40,7 +43,8 @@ class SimResult:
 
     Attributes:
         scenario_name, relaxation (``s``), allocator, precision (``"f64"`` or ``"f32"``, the
-        controller's float type), mcap_path (str or None), n_agents,
+        controller's float type), controller_target (``"host"`` or the PIL target), mcap_path
+        (str or None), n_agents,
         mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
         planned roll at which the planner saturates in hover).
         t: (K,) time (s).
@@ -74,6 +78,10 @@ class SimResult:
     @property
     def precision(self) -> _Precision:
         """The float type the controller flew in, "f64" or "f32"."""
+    @property
+    def controller_target(self) -> str:
+        """Where the controller ran: "host", or the emulated target of a processor-in-the-loop
+        run (e.g. "cortex-m4 (qemu mps2-an386)")."""
     @property
     def mcap_path(self) -> Optional[str]:
         """Path of the MCAP log written, or None."""
@@ -185,6 +193,7 @@ def run(
     relaxation: Optional[float] = None,
     allocator: Optional[AllocatorName] = None,
     precision: Optional[_Precision] = None,
+    pil: Optional[_PilTarget] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -205,14 +214,22 @@ def run(
             ``controller_precision``): "f32" flies ``tvmd_core::Controller<f32, ..>``, the type a
             flight controller runs; "f64" (the default). The physics stays f64; the summary's
             ``controller_precision`` says which flew.
+        pil: processor in the loop: "cortex-m4" or "cortex-m7" runs the f32 controller in QEMU
+            (``qemu-system-arm``, machine mps2-an386 or mps2-an500; the PIL firmware built by
+            ``bash scripts/pil.sh build``, or the ELF ``TVMD_PIL_FIRMWARE`` names) while the
+            physics stays here; the precision becomes "f32" (asking for "f64" too is a
+            ``ValueError``). The summary's and the result's ``controller_target`` say
+            which target flew ("host" otherwise).
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
             message names the field, e.g. ``physics.dt``), a bad override, both ``scenario`` and
-            ``toml``.
+            ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``.
         TypeError: an argument of the wrong type.
         OSError: the scenario file cannot be read or the log cannot be written.
-        RuntimeError: the run failed while flying (the state diverged, the controller failed).
+        RuntimeError: the run failed while flying (the state diverged, the controller failed,
+            the PIL link broke); with ``pil``, also ``qemu-system-arm`` or the PIL firmware not
+            found (the message says how to install or build it).
     """
 
 def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[SimResult]:
@@ -223,7 +240,7 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
         runs: a sequence whose items are each a scenario (a built-in name or a TOML file, as
             ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
             ``{"scenario": "a4-con", "relaxation": 1.0}``, ``{"toml": text, "mcap": "x.mcap"}`` or
-            ``{"scenario": "paper-tilt", "precision": "f32"}``.
+            ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` too, as ``run``).
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
 
     Every item is loaded and validated before any run starts. If runs fail, the first failure
@@ -243,6 +260,7 @@ def relaxation_sweep(
     precision: Optional[_Precision] = None,
     mcap_dir: Optional[_PathArg] = None,
     jobs: Optional[int] = None,
+    pil: Optional[_PilTarget] = None,
 ) -> list[SimResult]:
     """The paper's relaxation study: one scenario flown once per relaxation ``s`` (in parallel
     threads, GIL released), results in the order of ``relaxations``. The planner's roll limit in
@@ -258,6 +276,7 @@ def relaxation_sweep(
         precision: override the controller's float type, as ``run``.
         mcap_dir: write one MCAP log per run there, ``<name>-s<s>.mcap``.
         jobs: worker threads (default: the available cores).
+        pil: fly every run with the controller on this emulated target, as ``run``.
 
     Raises:
         ValueError: as ``run``; an ``s`` outside (0, 1] or not finite, ``relaxations`` not 1-D.

@@ -159,3 +159,47 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
     let s = Relaxation::new(s).map_err(config_error)?;
     Ok(afs.semi_axes(1.0, s).c_y.atan())
 }
+
+/// The f32 controller's configuration of a scenario as the words an f32 target builds it from
+/// ([`super::wire::CoreConfig`]): every value rounded exactly as [`team_config`],
+/// [`controller_settings`] and [`allocator`] round it. Errors name the scenario field, as
+/// [`super::TvmdController::from_scenario`]'s do.
+pub fn wire_config(scenario: &Scenario) -> Result<super::wire::CoreConfig, SimError> {
+    use super::wire::{CoreConfig, AGENTS, ALLOCATOR_NAME_BYTES};
+    team_config::<f32>(scenario)?;
+    controller_settings::<f32>(scenario)?;
+    allocator::<f32>(&scenario.allocator)?;
+    let body = scenario.team_body()?;
+    let mut agents = [([0.0f32; 3], 0, 0.0f32); AGENTS];
+    for (slot, a) in agents.iter_mut().zip(&body.agents) {
+        let p = vector_to_core::<f32>(&a.position_vector());
+        *slot = ([p.x, p.y, p.z], a.quarter_turns, to_core(a.mass));
+    }
+    let name = scenario.allocator.as_bytes();
+    let mut allocator = [0u8; ALLOCATOR_NAME_BYTES];
+    allocator
+        .get_mut(..name.len())
+        .ok_or_else(|| invalid("allocator", "name longer than 32 bytes"))?
+        .copy_from_slice(name);
+    let inertia = matrix_to_core::<f32>(&from_rows(&body.navigator_inertia));
+    let g = &scenario.gains;
+    Ok(CoreConfig {
+        n: body.len(),
+        agents,
+        limits: [
+            to_core(scenario.limits.sigma_x),
+            to_core(scenario.limits.sigma_y),
+            to_core(scenario.max_thrust()?),
+        ],
+        navigator: (
+            to_core(body.navigator_mass),
+            core::array::from_fn(|k| inertia[(k / 3, k % 3)]),
+        ),
+        gains: (g.k_x.map(to_core), g.k_r.map(to_core), g.k_xi.map(to_core)),
+        relaxation: to_core(scenario.relaxation),
+        gravity: to_core(scenario.physics.gravity),
+        period: to_core(scenario.controller_period),
+        rate_limits: scenario.controller_rate_limits.map(|r| r.map(to_core)),
+        allocator,
+    })
+}

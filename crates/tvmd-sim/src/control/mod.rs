@@ -36,11 +36,16 @@ use crate::SimError;
 mod config;
 mod convert;
 mod diagnostics;
+pub mod engine;
 mod landing;
+pub mod pil;
+pub mod recording;
+pub mod wire;
 
+pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
 pub use landing::Landing;
 
-pub use config::{allocator, controller_settings, hover_roll_limit, team_config};
+pub use config::{allocator, controller_settings, hover_roll_limit, team_config, wire_config};
 pub use convert::{core_reference, core_state, sim_command, CoreFloat};
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
@@ -52,10 +57,24 @@ pub type CoreController<T> = tvmd_core::Controller<T, MAX_AGENTS, AnyAllocator<T
 /// The core's output of one cycle.
 pub type CoreOutput<T> = tvmd_core::ControlOutput<T, MAX_AGENTS>;
 
-/// [`tvmd_core::Controller`] in `T` as a [`FlightController`].
+/// The core controller of a scenario in `T` and its agent count, as
+/// [`TvmdController::from_scenario`] builds it.
+pub fn core_of_scenario<T: CoreFloat>(
+    scenario: &Scenario,
+) -> Result<(CoreController<T>, usize), SimError> {
+    let team = config::team_config::<T>(scenario)?;
+    let settings = config::controller_settings::<T>(scenario)?;
+    let alloc = config::allocator::<T>(&scenario.allocator)?;
+    let n = team.len();
+    let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
+    Ok((inner, n))
+}
+
+/// [`tvmd_core::Controller`] in `T` as a [`FlightController`], the core's cycle run by the
+/// engine `E` (in process by default; on an emulated target with module `pil`).
 #[derive(Debug)]
-pub struct TvmdController<T: CoreFloat> {
-    inner: CoreController<T>,
+pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
+    inner: E,
     n: usize,
     mask: Vec<bool>,
     failure_note: Option<String>,
@@ -72,14 +91,17 @@ impl<T: CoreFloat> TvmdController<T> {
     /// [`AnyTvmdController::from_scenario`] for the one it names). Errors name the scenario
     /// field the core rejected.
     pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
-        let team = config::team_config::<T>(scenario)?;
-        let settings = config::controller_settings::<T>(scenario)?;
-        let alloc = config::allocator::<T>(&scenario.allocator)?;
-        let n = team.len();
-        let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
+        let (inner, n) = core_of_scenario(scenario)?;
         Ok(Self::new(inner, n).with_failure_response(scenario.failure_response))
     }
 
+    /// The wrapped core controller.
+    pub fn core(&self) -> &CoreController<T> {
+        &self.inner
+    }
+}
+
+impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
     /// The same controller with another response to a hover-capability loss.
     pub fn with_failure_response(mut self, response: FailureResponse) -> Self {
         self.response = response;
@@ -91,8 +113,8 @@ impl<T: CoreFloat> TvmdController<T> {
         self.landing.as_ref()
     }
 
-    /// Wraps a core controller for a team of `n` agents.
-    pub fn new(inner: CoreController<T>, n: usize) -> Self {
+    /// Wraps a core controller (or another engine) for a team of `n` agents.
+    pub fn new(inner: E, n: usize) -> Self {
         Self {
             inner,
             n,
@@ -105,8 +127,8 @@ impl<T: CoreFloat> TvmdController<T> {
         }
     }
 
-    /// The wrapped core controller.
-    pub fn core(&self) -> &CoreController<T> {
+    /// The engine running the core's cycle.
+    pub fn engine(&self) -> &E {
         &self.inner
     }
 
@@ -115,19 +137,24 @@ impl<T: CoreFloat> TvmdController<T> {
         self.last.as_ref()
     }
 
-    fn update_failures(&mut self, t: f64, state: &PlantState, failed: &[bool]) {
+    fn update_failures(
+        &mut self,
+        t: f64,
+        state: &PlantState,
+        failed: &[bool],
+    ) -> Result<(), BoxedError> {
         let wanted: Vec<bool> = (0..self.n)
             .map(|i| failed.get(i).copied().unwrap_or(false))
             .collect();
         if wanted == self.mask {
-            return;
+            return Ok(());
         }
         let mut mask = FailureMask::<MAX_AGENTS>::none();
         for (i, f) in wanted.iter().enumerate() {
             // i < n <= MAX_AGENTS, so this cannot fail.
             let _ = mask.set(i, *f);
         }
-        match self.inner.set_failures(mask) {
+        match self.inner.set_failures(mask)? {
             Ok(hover) => {
                 self.failure_note = None;
                 let land = !hover.capable
@@ -159,10 +186,11 @@ impl<T: CoreFloat> TvmdController<T> {
         if self.mask != wanted && self.failure_note.is_none() {
             self.failure_note = Some(format!("failure mask {wanted:?} not applied"));
         }
+        Ok(())
     }
 }
 
-impl<T: CoreFloat> FlightController for TvmdController<T> {
+impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
     fn step(
         &mut self,
         t: f64,
@@ -170,7 +198,7 @@ impl<T: CoreFloat> FlightController for TvmdController<T> {
         reference: &ReferenceSample,
         failed: &[bool],
     ) -> Result<FlightOutput, BoxedError> {
-        self.update_failures(t, state, failed);
+        self.update_failures(t, state, failed)?;
         let n = self.n;
         if let Some(landing) = &mut self.landing {
             landing.disarmed |= landing.touched_down(t, &state.position);
@@ -193,7 +221,7 @@ impl<T: CoreFloat> FlightController for TvmdController<T> {
         match self.inner.step(
             &convert::core_state(state),
             &convert::core_reference(reference),
-        ) {
+        )? {
             Ok(out) => {
                 let mut diagnostics =
                     diagnostics::cycle_diagnostics(&out, n, self.failure_note.clone());
@@ -208,7 +236,7 @@ impl<T: CoreFloat> FlightController for TvmdController<T> {
             Err(e) => Ok(FlightOutput {
                 commands: e.commands[..n].iter().map(sim_command).collect(),
                 diagnostics: Diagnostics {
-                    cycle_error: Some(e.to_string()),
+                    cycle_error: Some(e.message),
                     failure_note: self.failure_note.clone(),
                     hover,
                     ..Default::default()
@@ -228,6 +256,8 @@ pub enum AnyTvmdController {
     F64(TvmdController<f64>),
     /// `TvmdController<f32>`, the type a flight controller runs.
     F32(TvmdController<f32>),
+    /// The f32 controller executed on an emulated Cortex-M (processor in the loop).
+    Pil(TvmdController<f32, pil::PilCore>),
 }
 
 impl AnyTvmdController {
@@ -240,22 +270,57 @@ impl AnyTvmdController {
         })
     }
 
+    /// The controller of a scenario on `target`: in process ([`Self::from_scenario`]) for
+    /// `None`, else the f32 controller on the emulated target ([`pil::PilCore`], which needs
+    /// an f32 `controller_precision`: the firmware runs the flight configuration only).
+    pub fn from_scenario_on(
+        scenario: &Scenario,
+        target: Option<pil::PilTarget>,
+    ) -> Result<Self, SimError> {
+        let Some(target) = target else {
+            return Self::from_scenario(scenario);
+        };
+        if scenario.controller_precision != Precision::F32 {
+            return Err(config::invalid(
+                "controller_precision",
+                format!("the {target} PIL firmware runs the f32 controller only"),
+            ));
+        }
+        let wire = config::wire_config(scenario)?;
+        let core = pil::PilCore::start(target, &wire)?;
+        Ok(Self::Pil(
+            TvmdController::new(core, wire.n).with_failure_response(scenario.failure_response),
+        ))
+    }
+
     /// The precision the controller runs in.
     pub fn precision(&self) -> Precision {
         match self {
             Self::F64(_) => Precision::F64,
-            Self::F32(_) => Precision::F32,
+            Self::F32(_) | Self::Pil(_) => Precision::F32,
+        }
+    }
+
+    /// Where the controller runs: `"host"`, or the target's label (e.g.
+    /// `"cortex-m4 (qemu mps2-an386)"`).
+    pub fn target_label(&self) -> String {
+        match self {
+            Self::F64(_) | Self::F32(_) => HOST_TARGET.to_string(),
+            Self::Pil(c) => c.engine().target().label(),
         }
     }
 
     /// The agents the core currently treats as failed (the mask it accepted).
     pub fn failures(&self) -> FailureMask<MAX_AGENTS> {
         match self {
-            Self::F64(c) => *c.core().failures(),
-            Self::F32(c) => *c.core().failures(),
+            Self::F64(c) => CoreEngine::failures(c.engine()),
+            Self::F32(c) => CoreEngine::failures(c.engine()),
+            Self::Pil(c) => c.engine().failures(),
         }
     }
 }
+
+pub use crate::flight::HOST_TARGET;
 
 impl FlightController for AnyTvmdController {
     fn step(
@@ -268,6 +333,7 @@ impl FlightController for AnyTvmdController {
         match self {
             Self::F64(c) => c.step(t, state, reference, failed),
             Self::F32(c) => c.step(t, state, reference, failed),
+            Self::Pil(c) => c.step(t, state, reference, failed),
         }
     }
 }

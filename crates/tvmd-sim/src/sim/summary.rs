@@ -156,6 +156,9 @@ pub struct RunSummary {
     pub scenario: String,
     /// The float type the controller flew in (`"f64"` or `"f32"`).
     pub controller_precision: Precision,
+    /// Where the controller ran: `"host"`, or the emulated target of a processor-in-the-loop
+    /// flight (e.g. `"cortex-m4 (qemu mps2-an386)"`).
+    pub controller_target: String,
     /// Simulated time reached (s).
     pub time: f64,
     /// Final position (m).
@@ -241,6 +244,7 @@ impl RunSummary {
         Self {
             scenario: scenario.name.clone(),
             controller_precision: scenario.controller_precision,
+            controller_target: crate::flight::HOST_TARGET.to_string(),
             time,
             final_position: arr(&s.position),
             final_velocity: arr(&s.velocity),

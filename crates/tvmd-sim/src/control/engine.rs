@@ -1,0 +1,72 @@
+//! Where the core's cycle runs: [`CoreEngine`], implemented by the in-process
+//! [`CoreController`] and by the processor-in-the-loop link (module `pil`), and wrapped by the
+//! cycle recorder (module `recording`). [`super::TvmdController`] drives any of them alike.
+
+use tvmd_core::{AgentCommand, FailureMask, HoverCapability, Reference, RigidState};
+
+use super::convert::CoreFloat;
+use super::{CoreController, CoreOutput, MAX_AGENTS};
+use crate::error::BoxedError;
+
+/// A cycle the core skipped: its message (the [`tvmd_core::CycleError`]'s) and the commands
+/// it holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkippedCycle<T: CoreFloat> {
+    /// `CycleError`'s message.
+    pub message: String,
+    /// The commands held.
+    pub commands: [AgentCommand<T>; MAX_AGENTS],
+}
+
+/// The core's answer to a failure mask: the accepted mask's hover classification, or the
+/// message of the [`tvmd_core::ConfigError`] that refused it.
+pub type FailureAnswer<T> = Result<HoverCapability<T>, String>;
+
+/// The core's answer to one cycle.
+pub type CycleAnswer<T> = Result<CoreOutput<T>, SkippedCycle<T>>;
+
+/// A core controller in `T`, wherever it runs. The outer `Result` is the engine's own failure
+/// (a broken link to a target), which ends the run; the inner one is the core's answer.
+pub trait CoreEngine<T: CoreFloat> {
+    /// [`tvmd_core::Controller::set_failures`].
+    fn set_failures(
+        &mut self,
+        mask: FailureMask<MAX_AGENTS>,
+    ) -> Result<FailureAnswer<T>, BoxedError>;
+
+    /// [`tvmd_core::Controller::failures`]: the mask the core accepted.
+    fn failures(&self) -> FailureMask<MAX_AGENTS>;
+
+    /// [`tvmd_core::Controller::step`].
+    fn step(
+        &mut self,
+        state: &RigidState<T>,
+        reference: &Reference<T>,
+    ) -> Result<CycleAnswer<T>, BoxedError>;
+}
+
+impl<T: CoreFloat> CoreEngine<T> for CoreController<T> {
+    fn set_failures(
+        &mut self,
+        mask: FailureMask<MAX_AGENTS>,
+    ) -> Result<FailureAnswer<T>, BoxedError> {
+        Ok(tvmd_core::Controller::set_failures(self, mask).map_err(|e| e.to_string()))
+    }
+
+    fn failures(&self) -> FailureMask<MAX_AGENTS> {
+        *tvmd_core::Controller::failures(self)
+    }
+
+    fn step(
+        &mut self,
+        state: &RigidState<T>,
+        reference: &Reference<T>,
+    ) -> Result<CycleAnswer<T>, BoxedError> {
+        Ok(
+            tvmd_core::Controller::step(self, state, reference).map_err(|e| SkippedCycle {
+                message: e.to_string(),
+                commands: e.commands,
+            }),
+        )
+    }
+}
