@@ -312,3 +312,47 @@ fn f32_agrees_with_f64_on_attainable_requests() {
     // f64 meets 95% of such requests to 1e-9; f32 to its own resolution about as often.
     assert!(exact >= 170, "{exact}/200");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// f32, any request with rate-narrowed sets: the command inversion clamps round-off only.
+    #[test]
+    fn f32_forces_invert_without_clamping(
+        which in 0usize..4,
+        u in proptest::array::uniform6(-1.0f32..1.0),
+        scale in prop_oneof![Just(1.0f32), Just(40.0), Just(1e6)],
+        centre in proptest::array::uniform3(-1.0f32..1.0),
+        window in proptest::option::of(0.001f32..0.3),
+        repeat in 1usize..5,
+    ) {
+        let team: TeamConfig<f32, CAP> = match which % 4 {
+            0 => presets::a4_inc().unwrap(),
+            1 => presets::a4_con().unwrap(),
+            2 => presets::ring(6, 0.5, true, presets::paper_limits()).unwrap(),
+            _ => presets::ring(8, 0.6, false, presets::paper_limits()).unwrap(),
+        };
+        let e = team.effectiveness(&FailureMask::none());
+        let mut sets = [AdmissibleSet::from_limits(team.limits()); CAP];
+        if let Some(w) = window {
+            let previous = GimbalCommand { thrust: 2.0, eta_x: centre[0] * 0.5, eta_y: centre[1] * 0.8 };
+            let rates = tvmd_core::admissible::RateLimits::new(w, w).unwrap();
+            for s in sets.iter_mut() {
+                *s = s.with_rate_limit(&previous, &rates, 1.0);
+            }
+        }
+        let wrench = Vector6::from(u) * scale;
+        let request = AllocationRequest { effectiveness: &e, sets: &sets, wrench };
+        let mut allocator = ExactBoundaryRedistribution::new();
+        for _ in 0..repeat {
+            let a = allocator.allocate(&request);
+            for (i, (f, set)) in a.forces.iter().zip(&sets).enumerate().take(team.len()) {
+                let (_, clamp) = tvmd_core::command::invert(f, set, team.limits());
+                prop_assert!(
+                    clamp <= tvmd_core::command::command_tolerance::<f32>(),
+                    "agent {} force {:?} clamp {} set {:?}", i, f, clamp, set
+                );
+            }
+        }
+    }
+}

@@ -15,6 +15,7 @@
 use nalgebra::Vector3;
 
 use crate::admissible::AdmissibleSet;
+use crate::limits::Interval;
 use crate::linalg::{max_abs, norm};
 use crate::real::{eps, lit, Real};
 
@@ -120,6 +121,23 @@ impl<T: Real> Constraint<T> {
     }
 }
 
+/// `set` with `|eta_x| <= pi/2 - 1e-3`: at `|eta_x| = pi/2` the force lies on the `y` axis,
+/// where `eta_y` is undefined, and near it the gimbal inverse `eta_x = asin(-f_y / T)` loses
+/// `eps / cos(eta_x)` rad, which moves the force `T eps / cos(eta_x)` off the one allocated.
+/// One milliradian short of the axis, every force the walk returns inverts to a command that
+/// reproduces it within `1e3 eps T`, in `f32` and `f64`. (`set` itself if the narrowed ranges
+/// do not make a set.)
+pub(super) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
+    let cap = T::frac_pi_2() - lit(1e-3);
+    let ex = set.eta_x();
+    let hi = ex.hi.min(cap);
+    let narrowed = Interval {
+        lo: ex.lo.max(-cap).min(hi),
+        hi,
+    };
+    AdmissibleSet::new(narrowed, set.eta_y(), set.thrust()).unwrap_or(*set)
+}
+
 /// The six constraints of `set` (a bound that can never bind, `T >= 0`, is `-T_max <= 0`:
 /// never violated, never crossed, never on the boundary).
 pub(super) fn constraints<T: Real>(set: &AdmissibleSet<T>) -> [Constraint<T>; CONSTRAINTS] {
@@ -180,7 +198,6 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
     use super::*;
     use crate::gimbal::GimbalCommand;
-    use crate::limits::Interval;
 
     fn set() -> AdmissibleSet<f64> {
         AdmissibleSet::new(

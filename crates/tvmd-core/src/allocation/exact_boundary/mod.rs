@@ -8,7 +8,7 @@ mod constraint;
 use nalgebra::{Matrix6, Vector3, Vector6};
 
 use self::active::ActiveSet;
-use self::constraint::{constraints, Constraint, CONSTRAINTS};
+use self::constraint::{constraints, regular, Constraint, CONSTRAINTS};
 use super::{
     outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
 };
@@ -31,7 +31,9 @@ use crate::real::{eps, lit, Real};
 /// 3. that agent is held on that boundary from now on (a cone or sphere is re-entered after a
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
-/// It ends when `r` is spent, nothing can move, or after `3 n + 3` rounds. Every force is
+/// It ends when `r` is spent, nothing can move, or after `3 n + 3` rounds. A start that
+/// already meets the request is returned as it is. The walk keeps `|eta_x|` one milliradian
+/// inside `pi/2`, where the gimbal inverse is singular (see `constraint::regular`). Every force is
 /// inside its set (the last rounds' forces are saturated if round-off left one outside).
 /// `rounds` counts the start's rounds and the walk's; `saturated` marks agents that end on a boundary.
 /// The previous forces are forgotten by [`Allocator::configure`] (new team or failures) and
@@ -225,6 +227,23 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     }
 }
 
+/// `f` of every set, computed once per run of equal sets (the agents usually share one set, and
+/// the constraints cost trigonometry).
+fn per_set<T: Real, U: Copy, const N: usize>(
+    sets: &[AdmissibleSet<T>; N],
+    f: impl Fn(&AdmissibleSet<T>) -> U,
+) -> [U; N] {
+    let mut last: Option<(&AdmissibleSet<T>, U)> = None;
+    sets.each_ref().map(|s| match last {
+        Some((l, u)) if l == s => u,
+        _ => {
+            let u = f(s);
+            last = Some((s, u));
+            u
+        }
+    })
+}
+
 /// Whether `f` is on a constraint of its set, within `sqrt(eps)` of the largest thrust.
 fn on_boundary<T: Real>(
     bounds: &[Constraint<T>; CONSTRAINTS],
@@ -248,16 +267,26 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
         let e = request.effectiveness;
         let working = working_mask(e);
+        let sets = &per_set(request.sets, regular);
+        let scale = max_abs(&request.wrench).max(T::one());
+        let tol = eps::<T>() * lit(64.0) * scale;
         let start = RedistributedPseudoInverse.allocate(request);
         let mut forces = start.forces;
+        let mut moved = false;
+        for (f, set) in forces.iter_mut().zip(sets) {
+            if outside(set, f) {
+                *f = set.saturate(f);
+                moved = true;
+            }
+        }
+        // Met by the start (hover, and most requests inside the attainable set): nothing to walk.
+        if !moved && max_abs(&(request.wrench - start.wrench)) <= tol {
+            self.previous = Some(start.forces);
+            return start;
+        }
         if let Some(previous) = &self.previous {
             let mut kept = [Vector3::zeros(); N];
-            for (((k, p), set), w) in kept
-                .iter_mut()
-                .zip(previous)
-                .zip(request.sets)
-                .zip(&working)
-            {
+            for (((k, p), set), w) in kept.iter_mut().zip(previous).zip(sets).zip(&working) {
                 if *w {
                     *k = if outside(set, p) { set.saturate(p) } else { *p };
                 }
@@ -266,17 +295,15 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
                 forces = kept;
             }
         }
-        let bounds = request.sets.map(|s| constraints(&s));
+        let bounds = per_set(sets, |s| constraints(s));
         let mut walk = Walk {
             effectiveness: e,
-            sets: request.sets,
+            sets,
             bounds,
             working,
             forces,
             active: [ActiveSet::default(); N],
         };
-        let scale = max_abs(&request.wrench).max(T::one());
-        let tol = eps::<T>() * lit(64.0) * scale;
         let limit = 3 * e.working_count() + 3;
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
@@ -312,7 +339,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let mut saturated = [false; N];
         for ((((f, set), b), w), s) in forces
             .iter_mut()
-            .zip(request.sets)
+            .zip(sets)
             .zip(&walk.bounds)
             .zip(&working)
             .zip(saturated.iter_mut())
