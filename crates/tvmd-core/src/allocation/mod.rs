@@ -53,7 +53,7 @@ pub struct Allocation<T: Real, const N: usize> {
     /// `||u_d - M f||` over the whole wrench.
     pub wrench_error: T,
     /// Solve rounds used (pseudo-inverse: 1; redistribution: up to `n`; exact-boundary
-    /// redistribution: its start's and its walk's, up to `4 n + 3`).
+    /// redistribution: its start's and its walk's, up to `3 n + 4`).
     pub rounds: u32,
     /// Agents whose force was saturated onto the boundary of their admissible set.
     pub saturated: [bool; N],

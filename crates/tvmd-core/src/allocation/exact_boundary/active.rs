@@ -17,6 +17,7 @@ pub(super) struct ActiveSet<T: Real> {
     /// Orthonormal basis of the normals, up to two; three independent normals fix the force.
     basis: [Option<Vector3<T>>; 2],
     fixed: bool,
+    curved: bool,
 }
 
 impl<T: Real> Default for ActiveSet<T> {
@@ -26,6 +27,7 @@ impl<T: Real> Default for ActiveSet<T> {
             released: 0,
             basis: [None, None],
             fixed: false,
+            curved: false,
         }
     }
 }
@@ -69,10 +71,12 @@ impl<T: Real> ActiveSet<T> {
     ) {
         self.basis = [None, None];
         self.fixed = false;
+        self.curved = false;
         for (k, c) in constraints.iter().enumerate() {
             if !self.holds(k) {
                 continue;
             }
+            self.curved |= c.curved();
             let mut v = c.gradient(force);
             let length = norm(&v);
             if length <= T::zero() {
@@ -107,17 +111,23 @@ impl<T: Real> ActiveSet<T> {
         p
     }
 
-    /// `B P B^T` for the agent's effectiveness block `B` (`P` symmetric and idempotent).
-    pub(super) fn gram(&self, block: &Matrix6x3<T>) -> nalgebra::Matrix6<T> {
+    /// Turns the agent's term `B B^T` of a Gram matrix into `B P B^T` (`B` its effectiveness
+    /// block; `P` symmetric and idempotent, so `B P (B P)^T = B P B^T`): one rank-one downdate per
+    /// held normal, or the whole term for a fixed agent.
+    pub(super) fn downdate(&self, block: &Matrix6x3<T>, gram: &mut nalgebra::Matrix6<T>) {
         if self.fixed {
-            return nalgebra::Matrix6::zeros();
+            *gram -= block * block.transpose();
+            return;
         }
-        let mut g = block * block.transpose();
         for u in self.basis.iter().flatten() {
             let bu: Vector6<T> = block * u;
-            g -= bu * bu.transpose();
+            *gram -= bu * bu.transpose();
         }
-        g
+    }
+
+    /// Whether a held constraint is a cone or a sphere.
+    pub(super) fn curved(&self) -> bool {
+        self.curved
     }
 }
 
@@ -166,7 +176,7 @@ mod tests {
     }
 
     #[test]
-    fn gram_is_the_projected_block_product() {
+    fn downdate_gives_the_projected_block_product() {
         let block = Matrix6x3::<f64>::from_fn(|i, j| (i as f64 * 0.7 + j as f64 * 1.3).sin());
         let set = AdmissibleSet::new(
             Interval { lo: -0.5, hi: 0.5 },
@@ -182,6 +192,8 @@ mod tests {
         let n = f / f.norm();
         let p = nalgebra::Matrix3::identity() - n * n.transpose();
         let want = block * p * block.transpose();
-        assert!((active.gram(&block) - want).norm() < 1e-12);
+        let mut got = block * block.transpose();
+        active.downdate(&block, &mut got);
+        assert!((got - want).norm() < 1e-12);
     }
 }

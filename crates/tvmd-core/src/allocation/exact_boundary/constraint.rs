@@ -66,17 +66,20 @@ impl<T: Real> Constraint<T> {
             return None;
         }
         let (f, d, k) = (f / m, d / m, self.k / m);
+        // Scaled to components of at most one: plain norms cannot overflow (an underflow is
+        // a force at the origin, which it is to this precision).
+        let len = |v: &Vector3<T>| v.dot(v).sqrt();
         let tol: T = eps::<T>() * lit(64.0);
-        let g0 = self.c.dot(&f) + self.s * norm(&f) + k;
+        let g0 = self.c.dot(&f) + self.s * len(&f) + k;
         let slope = |x: &Vector3<T>| {
-            let n = norm(x);
+            let n = len(x);
             if n > T::zero() {
                 self.c.dot(&d) + self.s * x.dot(&d) / n
             } else {
-                self.c.dot(&d) + self.s * norm(&d)
+                self.c.dot(&d) + self.s * len(&d)
             }
         };
-        let d_scale = norm(&d);
+        let d_scale = len(&d);
         if g0 > -tol && slope(&f) > tol * d_scale {
             return Some(T::zero());
         }

@@ -31,7 +31,7 @@ use crate::real::{eps, lit, Real};
 /// 3. that agent is held on that boundary from now on (a cone or sphere is re-entered after a
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
-/// It ends when `r` is spent, nothing can move, or after `3 n + 3` rounds. A start that
+/// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds. A start that
 /// already meets the request is returned as it is. The walk keeps `|eta_x|` one milliradian
 /// inside `pi/2`, where the gimbal inverse is singular (see `constraint::regular`). Every force is
 /// inside its set (the last rounds' forces are saturated if round-off left one outside).
@@ -85,6 +85,8 @@ struct Walk<'a, T: Real, const N: usize> {
     effectiveness: &'a Effectiveness<T, N>,
     sets: &'a [AdmissibleSet<T>; N],
     bounds: [[Constraint<T>; CONSTRAINTS]; N],
+    /// `sum_i M_i M_i^T` over the working agents, before any is held.
+    gram: Matrix6<T>,
     working: [bool; N],
     forces: [Vector3<T>; N],
     active: [ActiveSet<T>; N],
@@ -97,7 +99,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
 
     /// `delta` of step 1, or `None` when nothing can move or the solve is not finite.
     fn direction(&mut self, r: &Vector6<T>, release: bool) -> Option<[Vector3<T>; N]> {
-        let mut gram = Matrix6::zeros();
+        let mut gram = self.gram;
         let mut movable = false;
         for (((block, a), f), (w, b)) in self
             .effectiveness
@@ -109,10 +111,8 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         {
             if let (Some(block), true) = (block, *w) {
                 a.update(b, f);
-                if !a.fixed() {
-                    gram += a.gram(block);
-                    movable = true;
-                }
+                a.downdate(block, &mut gram);
+                movable |= !a.fixed();
             }
         }
         if !movable {
@@ -178,19 +178,23 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         }
     }
 
-    /// Step 2: the largest `tau <= 1` and the constraint that stops it, `(agent, constraint)`.
-    fn step(&self, delta: &[Vector3<T>; N]) -> (T, Option<(usize, usize)>) {
+    /// Step 2: the largest `tau <= 1`, and for each agent the constraint it stops on: the one
+    /// agent that stops the step, or, when the step is zero, every agent already on a boundary
+    /// the increment leaves (held together, one round instead of one each).
+    fn step(&self, delta: &[Vector3<T>; N]) -> (T, [Option<usize>; N]) {
         let mut tau = T::one();
-        let mut stop = None;
-        for (i, (((f, d), b), a)) in self
+        let mut first = None;
+        let mut at_once = [None; N];
+        for (i, ((((f, d), b), a), (w, now))) in self
             .forces
             .iter()
             .zip(delta)
             .zip(&self.bounds)
             .zip(&self.active)
+            .zip(self.working.iter().zip(at_once.iter_mut()))
             .enumerate()
         {
-            if !self.working.get(i).copied().unwrap_or(false) || a.fixed() {
+            if !*w || a.fixed() {
                 continue;
             }
             for (k, c) in b.iter().enumerate() {
@@ -198,28 +202,42 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                     continue;
                 }
                 if let Some(t) = c.first_exit(f, d) {
+                    if t == T::zero() && now.is_none() {
+                        *now = Some(k);
+                    }
                     if t < tau {
                         tau = t;
-                        stop = Some((i, k));
+                        first = Some((i, k));
                     }
                 }
             }
         }
-        (tau, stop)
+        if tau > T::zero() {
+            at_once = [None; N];
+            if let Some((i, k)) = first {
+                if let Some(slot) = at_once.get_mut(i) {
+                    *slot = Some(k);
+                }
+            }
+        }
+        (tau, at_once)
     }
 
     /// Moves by `tau delta`; agents that left their set by moving along a curved boundary's
     /// tangent (or by round-off) are put back on it.
     fn advance(&mut self, tau: T, delta: &[Vector3<T>; N]) {
-        for ((f, d), (set, w)) in self
+        for (((f, d), (set, w)), a) in self
             .forces
             .iter_mut()
             .zip(delta)
             .zip(self.sets.iter().zip(&self.working))
+            .zip(&self.active)
         {
             if *w {
                 *f += d * tau;
-                if outside(set, f) {
+                // Only a tangent step on a cone or sphere leaves the set by more than round-off
+                // (the final forces are checked anyway).
+                if a.curved() && outside(set, f) {
                     *f = set.saturate(f);
                 }
             }
@@ -300,11 +318,12 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             effectiveness: e,
             sets,
             bounds,
+            gram: e.gram(),
             working,
             forces,
             active: [ActiveSet::default(); N],
         };
-        let limit = 3 * e.working_count() + 3;
+        let limit = 2 * e.working_count() + 4;
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
         // than its step gained, and the result is never worse than the start.
@@ -325,8 +344,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             rounds += 1;
             let (tau, stop) = walk.step(&delta);
             walk.advance(tau, &delta);
-            if let Some((i, k)) = stop {
-                if let Some(a) = walk.active.get_mut(i) {
+            for (a, k) in walk.active.iter_mut().zip(stop) {
+                if let Some(k) = k {
                     a.hold(k);
                 }
             }
