@@ -14,8 +14,8 @@ use tvmd::core::nalgebra::{Vector3, Vector6};
 use tvmd::core::team::presets;
 use tvmd::core::{
     project_force, AdmissibleSet, AllocationRequest, Allocator, AttitudePlanner, Controller,
-    ControllerSettings, FailureMask, PseudoInverse, Real, RedistributedPseudoInverse, Reference,
-    RigidState, TeamConfig,
+    ControllerSettings, ExactBoundaryRedistribution, FailureMask, PseudoInverse, Real,
+    RedistributedPseudoInverse, Reference, RigidState, TeamConfig,
 };
 
 fn lit<T: Real>(x: f64) -> T {
@@ -103,6 +103,12 @@ fn bench_size<T: Real, const N: usize>(c: &mut Criterion, float: &str) {
         BenchmarkId::new("redistributed_pseudo_inverse", N),
         &saturating,
         |b, r| b.iter(|| RedistributedPseudoInverse.allocate(black_box(r))),
+    );
+    // From no previous forces: the redistributed pseudo-inverse's start, then the walk.
+    g.bench_with_input(
+        BenchmarkId::new("exact_boundary_redistribution", N),
+        &saturating,
+        |b, r| b.iter(|| ExactBoundaryRedistribution::<T, N>::new().allocate(black_box(r))),
     );
     #[cfg(feature = "clarabel")]
     {

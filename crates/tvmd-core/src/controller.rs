@@ -210,9 +210,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.planner = planner;
     }
 
-    /// Forgets the previous command (rate limits restart from a centred gimbal).
+    /// Forgets the previous command (rate limits restart from a centred gimbal) and whatever the
+    /// allocator kept from earlier periods ([`Allocator::reset`]).
     pub fn reset(&mut self) {
         self.previous = [AgentCommand::idle(); N];
+        self.allocator.reset();
     }
 
     /// The team.

@@ -70,8 +70,8 @@ pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 #[cfg(feature = "clarabel")]
 pub use allocation::ClarabelAllocator;
 pub use allocation::{
-    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator, PseudoInverse,
-    RedistributedPseudoInverse, WeightedPseudoInverse,
+    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
+    ExactBoundaryRedistribution, PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};

@@ -215,8 +215,9 @@ fn allocator<T: Real>(rng: &mut StdRng, clarabel: bool) -> AnyAllocator<T, N> {
     let name = if clarabel {
         "clarabel"
     } else {
-        match rng.random_range(0..3) {
+        match rng.random_range(0..4) {
             0 => "pseudo-inverse",
+            3 => "exact-boundary-redistribution",
             1 => {
                 options.agent_weights =
                     Some(std::array::from_fn(|_| conv(log_uniform(rng, 0.1, 10.0))));

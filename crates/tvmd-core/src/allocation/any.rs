@@ -2,8 +2,8 @@
 //! allocator names.
 
 use super::{
-    Allocation, AllocationRequest, Allocator, PseudoInverse, RedistributedPseudoInverse,
-    WeightedPseudoInverse,
+    Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution, PseudoInverse,
+    RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField};
@@ -15,6 +15,8 @@ pub const PSEUDO_INVERSE: &str = "pseudo-inverse";
 pub const WEIGHTED_PSEUDO_INVERSE: &str = "weighted-pseudo-inverse";
 /// Name of [`RedistributedPseudoInverse`], the default (the paper's).
 pub const REDISTRIBUTED_PSEUDO_INVERSE: &str = "redistributed-pseudo-inverse";
+/// Name of [`ExactBoundaryRedistribution`].
+pub const EXACT_BOUNDARY_REDISTRIBUTION: &str = "exact-boundary-redistribution";
 /// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without
 /// the feature can say what is missing).
 pub const CLARABEL: &str = "clarabel";
@@ -24,6 +26,7 @@ const NAMES: &[&str] = &[
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
+    EXACT_BOUNDARY_REDISTRIBUTION,
     CLARABEL,
 ];
 #[cfg(not(feature = "clarabel"))]
@@ -31,6 +34,7 @@ const NAMES: &[&str] = &[
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
+    EXACT_BOUNDARY_REDISTRIBUTION,
 ];
 
 /// Options of [`AnyAllocator::from_name`]; each applies to one allocator only.
@@ -75,6 +79,8 @@ pub enum AnyAllocator<T: Real, const N: usize> {
     WeightedPseudoInverse(WeightedPseudoInverse<T, N>),
     /// [`RedistributedPseudoInverse`].
     RedistributedPseudoInverse(RedistributedPseudoInverse),
+    /// [`ExactBoundaryRedistribution`].
+    ExactBoundaryRedistribution(ExactBoundaryRedistribution<T, N>),
     /// [`super::ClarabelAllocator`] (feature `clarabel`).
     #[cfg(feature = "clarabel")]
     Clarabel(super::ClarabelAllocator<T, N>),
@@ -111,16 +117,18 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
             )
         };
         match name {
-            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE => {
+            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE | EXACT_BOUNDARY_REDISTRIBUTION => {
                 refuse(
                     options.agent_weights.is_some(),
                     ConfigField::AllocatorWeights,
                 )?;
                 no_clarabel_options()?;
-                Ok(if name == PSEUDO_INVERSE {
-                    Self::PseudoInverse(PseudoInverse)
-                } else {
-                    Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
+                Ok(match name {
+                    PSEUDO_INVERSE => Self::PseudoInverse(PseudoInverse),
+                    REDISTRIBUTED_PSEUDO_INVERSE => {
+                        Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
+                    }
+                    _ => Self::ExactBoundaryRedistribution(ExactBoundaryRedistribution::new()),
                 })
             }
             WEIGHTED_PSEUDO_INVERSE => {
@@ -176,8 +184,20 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::PseudoInverse(a) => a.configure(effectiveness),
             Self::WeightedPseudoInverse(a) => a.configure(effectiveness),
             Self::RedistributedPseudoInverse(a) => a.configure(effectiveness),
+            Self::ExactBoundaryRedistribution(a) => a.configure(effectiveness),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.configure(effectiveness),
+        }
+    }
+
+    fn reset(&mut self) {
+        match self {
+            Self::PseudoInverse(a) => Allocator::<T, N>::reset(a),
+            Self::WeightedPseudoInverse(a) => a.reset(),
+            Self::RedistributedPseudoInverse(a) => Allocator::<T, N>::reset(a),
+            Self::ExactBoundaryRedistribution(a) => a.reset(),
+            #[cfg(feature = "clarabel")]
+            Self::Clarabel(a) => a.reset(),
         }
     }
 
@@ -186,6 +206,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::PseudoInverse(a) => a.allocate(request),
             Self::WeightedPseudoInverse(a) => a.allocate(request),
             Self::RedistributedPseudoInverse(a) => a.allocate(request),
+            Self::ExactBoundaryRedistribution(a) => a.allocate(request),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.allocate(request),
         }
@@ -196,6 +217,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::PseudoInverse(a) => Allocator::<T, N>::name(a),
             Self::WeightedPseudoInverse(a) => a.name(),
             Self::RedistributedPseudoInverse(a) => Allocator::<T, N>::name(a),
+            Self::ExactBoundaryRedistribution(a) => a.name(),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.name(),
         }

@@ -8,15 +8,17 @@
 mod any;
 #[cfg(feature = "clarabel")]
 mod clarabel;
+mod exact_boundary;
 mod pseudo_inverse;
 mod redistributed;
 
 pub use any::{
-    AllocatorOptions, AnyAllocator, CLARABEL, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
-    WEIGHTED_PSEUDO_INVERSE,
+    AllocatorOptions, AnyAllocator, CLARABEL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 #[cfg(feature = "clarabel")]
 pub use clarabel::{ClarabelAllocator, ClarabelStatus, FallbackReason, SolveReport};
+pub use exact_boundary::ExactBoundaryRedistribution;
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
 pub use redistributed::RedistributedPseudoInverse;
 
@@ -50,7 +52,8 @@ pub struct Allocation<T: Real, const N: usize> {
     pub e_f: T,
     /// `||u_d - M f||` over the whole wrench.
     pub wrench_error: T,
-    /// Solve rounds used (pseudo-inverse: 1; redistribution: up to `n`).
+    /// Solve rounds used (pseudo-inverse: 1; redistribution: up to `n`; exact-boundary
+    /// redistribution: its start's and its walk's, up to `3 n + 4`).
     pub rounds: u32,
     /// Agents whose force was saturated onto the boundary of their admissible set.
     pub saturated: [bool; N],
@@ -96,6 +99,10 @@ pub trait Allocator<T: Real, const N: usize> {
     fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
         let _ = effectiveness;
     }
+
+    /// Forgets what the allocator kept from earlier periods (a new flight, as
+    /// [`crate::Controller::reset`]); the default does nothing.
+    fn reset(&mut self) {}
 
     /// Allocates `request.wrench` over the working agents.
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N>;

@@ -33,7 +33,11 @@ _StateLike = Union["State", Mapping[str, ArrayLike]]
 _ReferenceLike = Union["Reference", Mapping[str, ArrayLike]]
 
 AllocatorName = Literal[
-    "pseudo-inverse", "weighted-pseudo-inverse", "redistributed-pseudo-inverse", "clarabel"
+    "pseudo-inverse",
+    "weighted-pseudo-inverse",
+    "redistributed-pseudo-inverse",
+    "exact-boundary-redistribution",
+    "clarabel",
 ]
 """The allocators (``"clarabel"`` only with the cargo feature, see ``ALLOCATORS``)."""
 PlannerStatus = Literal["already-feasible", "planned", "zero-force", "unreachable"]
@@ -804,6 +808,10 @@ def allocate(
             ``weights`` (n,) positive per-agent weights are required.
         "redistributed-pseudo-inverse" (default): Jin 2005 redistribution: the agent leaving
             ``E_f`` furthest is saturated and fixed, the rest of the wrench is redistributed.
+        "exact-boundary-redistribution": walks from the redistributed pseudo-inverse's forces
+            toward ``u_d``, stopping each agent on the exact boundary of ``E_f`` (closed form)
+            and moving it along that boundary afterwards; never clamps (a one-shot call has no
+            previous period to start from; the controller's allocator keeps one).
         "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
             ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
             diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).

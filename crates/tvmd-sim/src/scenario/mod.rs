@@ -390,8 +390,8 @@ pub struct Scenario {
     /// Planner relaxation `s` in `(0, 1]`; 0.5.
     pub relaxation: f64,
     /// Allocator name, interpreted by the controller; `"redistributed-pseudo-inverse"`
-    /// (also `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and
-    /// `"clarabel"` with the `clarabel` feature).
+    /// (also `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights,
+    /// `"exact-boundary-redistribution"`, and `"clarabel"` with the `clarabel` feature).
     pub allocator: String,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the

@@ -1,0 +1,199 @@
+//! The constraints an agent is held on during one allocation, and the projection of its force
+//! increments onto their tangent planes.
+
+use nalgebra::{Matrix6x3, Vector3, Vector6};
+
+use super::constraint::{Constraint, CONSTRAINTS};
+use crate::linalg::norm;
+use crate::real::{lit, Real};
+
+/// Constraints an agent is held on (bit `k` for constraint `k`), with the orthonormal normals of
+/// their tangent planes at the agent's current force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct ActiveSet<T: Real> {
+    bits: u8,
+    /// Constraints already let go once in this allocation: never again, so no cycling.
+    released: u8,
+    /// Orthonormal basis of the normals, up to two; three independent normals fix the force.
+    basis: [Option<Vector3<T>>; 2],
+    fixed: bool,
+    curved: bool,
+}
+
+impl<T: Real> Default for ActiveSet<T> {
+    fn default() -> Self {
+        Self {
+            bits: 0,
+            released: 0,
+            basis: [None, None],
+            fixed: false,
+            curved: false,
+        }
+    }
+}
+
+impl<T: Real> ActiveSet<T> {
+    /// Whether constraint `k` is held.
+    pub(super) fn holds(&self, k: usize) -> bool {
+        k < CONSTRAINTS && self.bits & (1 << k) != 0
+    }
+
+    /// Whether constraint `k` is held and may still be let go.
+    pub(super) fn releasable(&self, k: usize) -> bool {
+        self.holds(k) && self.released & (1 << k) == 0
+    }
+
+    /// Stops holding constraint `k` (the walk wants to leave it inward), once per allocation.
+    pub(super) fn release(&mut self, k: usize) {
+        if k < CONSTRAINTS {
+            self.bits &= !(1 << k);
+            self.released |= 1 << k;
+        }
+    }
+
+    /// Whether the held normals span all three directions: the agent cannot move.
+    pub(super) fn fixed(&self) -> bool {
+        self.fixed
+    }
+
+    /// Holds constraint `k` from now on.
+    pub(super) fn hold(&mut self, k: usize) {
+        if k < CONSTRAINTS {
+            self.bits |= 1 << k;
+        }
+    }
+
+    /// Recomputes the normals at `force` (they turn with the force on a cone or a sphere).
+    pub(super) fn update(
+        &mut self,
+        constraints: &[Constraint<T>; CONSTRAINTS],
+        force: &Vector3<T>,
+    ) {
+        self.basis = [None, None];
+        self.fixed = false;
+        self.curved = false;
+        for (k, c) in constraints.iter().enumerate() {
+            if !self.holds(k) {
+                continue;
+            }
+            self.curved |= c.curved();
+            let mut v = c.gradient(force);
+            let length = norm(&v);
+            if length <= T::zero() {
+                continue;
+            }
+            v /= length;
+            for u in self.basis.iter().flatten() {
+                v -= u * u.dot(&v);
+            }
+            let rest = norm(&v);
+            // A normal this close to the span of the others adds no direction of its own.
+            if rest <= lit(1e-3) {
+                continue;
+            }
+            let v = v / rest;
+            match self.basis.iter_mut().find(|b| b.is_none()) {
+                Some(slot) => *slot = Some(v),
+                None => self.fixed = true,
+            }
+        }
+    }
+
+    /// `P d`, the part of `d` in every held tangent plane.
+    pub(super) fn project(&self, d: &Vector3<T>) -> Vector3<T> {
+        if self.fixed {
+            return Vector3::zeros();
+        }
+        let mut p = *d;
+        for u in self.basis.iter().flatten() {
+            p -= u * u.dot(d);
+        }
+        p
+    }
+
+    /// Turns the agent's term `B B^T` of a Gram matrix into `B P B^T` (`B` its effectiveness
+    /// block; `P` symmetric and idempotent, so `B P (B P)^T = B P B^T`): one rank-one downdate per
+    /// held normal, or the whole term for a fixed agent.
+    pub(super) fn downdate(&self, block: &Matrix6x3<T>, gram: &mut nalgebra::Matrix6<T>) {
+        if self.fixed {
+            *gram -= block * block.transpose();
+            return;
+        }
+        for u in self.basis.iter().flatten() {
+            let bu: Vector6<T> = block * u;
+            *gram -= bu * bu.transpose();
+        }
+    }
+
+    /// Whether a held constraint is a cone or a sphere.
+    pub(super) fn curved(&self) -> bool {
+        self.curved
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use crate::admissible::AdmissibleSet;
+    use crate::allocation::exact_boundary::constraint::constraints;
+    use crate::gimbal::GimbalCommand;
+    use crate::limits::Interval;
+
+    #[test]
+    fn held_normals_are_removed_from_steps_and_three_fix_the_agent() {
+        let set = AdmissibleSet::new(
+            Interval { lo: -0.5, hi: 0.5 },
+            Interval { lo: -0.5, hi: 0.5 },
+            Interval { lo: 0.0, hi: 10.0 },
+        )
+        .unwrap();
+        let cs = constraints(&set);
+        // On the corner eta_x = 0.5, eta_y = 0.5, T = 10: three independent normals.
+        let corner = GimbalCommand {
+            thrust: 10.0,
+            eta_x: 0.5,
+            eta_y: 0.5,
+        }
+        .force();
+        let mut active = ActiveSet::<f64>::default();
+        let d = Vector3::new(1.0, -2.0, 3.0);
+        active.hold(4);
+        active.update(&cs, &corner);
+        let p = active.project(&d);
+        assert!(p.dot(&cs[4].gradient(&corner)).abs() < 1e-12);
+        assert!((active.project(&p) - p).norm() < 1e-12);
+        active.hold(0);
+        active.update(&cs, &corner);
+        let p = active.project(&d);
+        assert!(p.dot(&cs[0].gradient(&corner)).abs() < 1e-12);
+        assert!(p.dot(&cs[4].gradient(&corner)).abs() < 1e-12);
+        assert!(!active.fixed() && p.norm() > 1e-3);
+        active.hold(2);
+        active.update(&cs, &corner);
+        assert!(active.fixed());
+        assert_eq!(active.project(&d), Vector3::zeros());
+    }
+
+    #[test]
+    fn downdate_gives_the_projected_block_product() {
+        let block = Matrix6x3::<f64>::from_fn(|i, j| (i as f64 * 0.7 + j as f64 * 1.3).sin());
+        let set = AdmissibleSet::new(
+            Interval { lo: -0.5, hi: 0.5 },
+            Interval { lo: -0.5, hi: 0.5 },
+            Interval { lo: 0.0, hi: 10.0 },
+        )
+        .unwrap();
+        let cs = constraints(&set);
+        let f = Vector3::<f64>::new(1.0, 2.0, 9.0);
+        let mut active = ActiveSet::default();
+        active.hold(4);
+        active.update(&cs, &f);
+        let n = f / f.norm();
+        let p = nalgebra::Matrix3::identity() - n * n.transpose();
+        let want = block * p * block.transpose();
+        let mut got = block * block.transpose();
+        active.downdate(&block, &mut got);
+        assert!((got - want).norm() < 1e-12);
+    }
+}

@@ -1,0 +1,382 @@
+//! Exact-boundary incremental redistribution (the authors' "EBRCA", `docs/method.md`,
+//! "Allocation"): walk from admissible forces toward the request and stop each agent on the
+//! exact boundary of its admissible set, found in closed form, instead of clamping.
+
+mod active;
+mod constraint;
+
+use nalgebra::{Matrix6, Vector3, Vector6};
+
+use self::active::ActiveSet;
+use self::constraint::{constraints, regular, Constraint, CONSTRAINTS};
+use super::{
+    outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
+};
+use crate::admissible::AdmissibleSet;
+use crate::effectiveness::Effectiveness;
+use crate::linalg::{max_abs, norm, solve_gram};
+use crate::real::{eps, lit, Real};
+
+/// Incremental allocation on the exact admissible boundary.
+///
+/// Each period starts from admissible forces `f`: the previous period's forces (saturated into
+/// this period's sets) or the redistributed pseudo-inverse's, whichever leaves the smaller
+/// wrench error. Then, in rounds:
+/// 1. the remaining wrench `r = u_d - M f` is spread over the agents that can still move,
+///    each restricted to the tangent planes of the boundaries it is held on:
+///    `delta_i = P_i M_i^T (sum_j M_j P_j M_j^T)^-1 r`;
+/// 2. the step `tau <= 1` along `delta` stops where the first agent reaches a constraint of its
+///    exact set (gimbal cones and planes of eq. 1, thrust spheres; closed form, see
+///    `constraint.rs`), so no agent is ever clamped;
+/// 3. that agent is held on that boundary from now on (a cone or sphere is re-entered after a
+///    tangent step); an agent held on three independent boundaries stops moving.
+///
+/// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds. A start that
+/// already meets the request is returned as it is. The walk keeps `|eta_x|` one milliradian
+/// inside `pi/2`, where the gimbal inverse is singular (see `constraint::regular`). Every force is
+/// inside its set (the last rounds' forces are saturated if round-off left one outside).
+/// `rounds` counts the start's rounds and the walk's; `saturated` marks agents that end on a boundary.
+/// The previous forces are forgotten by [`Allocator::configure`] (new team or failures) and
+/// [`Allocator::reset`].
+///
+/// ```
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::{ExactBoundaryRedistribution, GimbalCommand, RedistributedPseudoInverse};
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let set = AdmissibleSet::from_limits(team.limits());
+/// let sets = [set; 4];
+/// // Every agent on the same corner of its gimbal set: attainable by construction, and far
+/// // beyond what clamping each angle separately recovers.
+/// let corner = GimbalCommand { eta_x: set.eta_x().hi, eta_y: set.eta_y().hi, thrust: 4.0 };
+/// let wrench = effectiveness.wrench(&[corner.force(); 4]);
+/// let request = AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench };
+/// let walked = ExactBoundaryRedistribution::new().allocate(&request);
+/// let clamped = RedistributedPseudoInverse.allocate(&request);
+/// // Measured: 0.0185 against 0.936 (N and N m, the whole wrench).
+/// assert!(walked.wrench_error < 0.05 * clamped.wrench_error);
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactBoundaryRedistribution<T: Real, const N: usize> {
+    previous: Option<[Vector3<T>; N]>,
+}
+
+impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
+    fn default() -> Self {
+        Self { previous: None }
+    }
+}
+
+impl<T: Real, const N: usize> ExactBoundaryRedistribution<T, N> {
+    /// A new allocator with no previous forces.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The forces of the last allocation, the next one's candidate start.
+    pub fn previous(&self) -> Option<&[Vector3<T>; N]> {
+        self.previous.as_ref()
+    }
+}
+
+/// The walk's state over the agents.
+struct Walk<'a, T: Real, const N: usize> {
+    effectiveness: &'a Effectiveness<T, N>,
+    sets: &'a [AdmissibleSet<T>; N],
+    bounds: [[Constraint<T>; CONSTRAINTS]; N],
+    /// `sum_i M_i M_i^T` over the working agents, before any is held.
+    gram: Matrix6<T>,
+    working: [bool; N],
+    forces: [Vector3<T>; N],
+    active: [ActiveSet<T>; N],
+}
+
+impl<T: Real, const N: usize> Walk<'_, T, N> {
+    fn remaining(&self, wrench: &Vector6<T>) -> Vector6<T> {
+        wrench - self.effectiveness.wrench(&self.forces)
+    }
+
+    /// `delta` of step 1, or `None` when nothing can move or the solve is not finite.
+    fn direction(&mut self, r: &Vector6<T>, release: bool) -> Option<[Vector3<T>; N]> {
+        let mut gram = self.gram;
+        let mut movable = false;
+        for (((block, a), f), (w, b)) in self
+            .effectiveness
+            .blocks()
+            .iter()
+            .zip(self.active.iter_mut())
+            .zip(&self.forces)
+            .zip(self.working.iter().zip(&self.bounds))
+        {
+            if let (Some(block), true) = (block, *w) {
+                a.update(b, f);
+                a.downdate(block, &mut gram);
+                movable |= !a.fixed();
+            }
+        }
+        if !movable {
+            return None;
+        }
+        let lambda = solve_gram(&gram, r);
+        if release && self.release_one(&lambda) {
+            return self.direction(r, false);
+        }
+        let mut delta = [Vector3::zeros(); N];
+        for (((d, block), a), w) in delta
+            .iter_mut()
+            .zip(self.effectiveness.blocks())
+            .zip(&self.active)
+            .zip(&self.working)
+        {
+            if let (Some(block), true) = (block, *w) {
+                *d = a.project(&block.tr_mul(&lambda));
+            }
+        }
+        delta
+            .iter()
+            .all(|d| d.iter().all(|x| x.is_finite()))
+            .then_some(delta)
+    }
+
+    /// Lets go of the held constraint the free increment `M_i^T lambda` leaves most steeply
+    /// inward (an active-set method's multiplier test), if any: holding it would keep the agent
+    /// on a boundary the request pulls it away from.
+    fn release_one(&mut self, lambda: &Vector6<T>) -> bool {
+        let mut worst: Option<(usize, usize, T)> = None;
+        for (i, (((block, a), f), (w, b))) in self
+            .effectiveness
+            .blocks()
+            .iter()
+            .zip(&self.active)
+            .zip(&self.forces)
+            .zip(self.working.iter().zip(&self.bounds))
+            .enumerate()
+        {
+            let (Some(block), true) = (block, *w) else {
+                continue;
+            };
+            let free = block.tr_mul(lambda);
+            for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
+                let g = c.gradient(f);
+                let scale = norm(&g) * norm(&free);
+                if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                    continue;
+                }
+                let slope = g.dot(&free) / scale;
+                if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
+                    worst = Some((i, k, slope));
+                }
+            }
+        }
+        match worst.and_then(|(i, k, _)| self.active.get_mut(i).map(|a| (a, k))) {
+            Some((a, k)) => {
+                a.release(k);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Step 2: the largest `tau <= 1`, and for each agent the constraint it stops on: the one
+    /// agent that stops the step, or, when the step is zero, every agent already on a boundary
+    /// the increment leaves (held together, one round instead of one each).
+    fn step(&self, delta: &[Vector3<T>; N]) -> (T, [Option<usize>; N]) {
+        let mut tau = T::one();
+        let mut first = None;
+        let mut at_once = [None; N];
+        for (i, ((((f, d), b), a), (w, now))) in self
+            .forces
+            .iter()
+            .zip(delta)
+            .zip(&self.bounds)
+            .zip(&self.active)
+            .zip(self.working.iter().zip(at_once.iter_mut()))
+            .enumerate()
+        {
+            if !*w || a.fixed() {
+                continue;
+            }
+            for (k, c) in b.iter().enumerate() {
+                if a.holds(k) {
+                    continue;
+                }
+                if let Some(t) = c.first_exit(f, d) {
+                    if t == T::zero() && now.is_none() {
+                        *now = Some(k);
+                    }
+                    if t < tau {
+                        tau = t;
+                        first = Some((i, k));
+                    }
+                }
+            }
+        }
+        if tau > T::zero() {
+            at_once = [None; N];
+            if let Some((i, k)) = first {
+                if let Some(slot) = at_once.get_mut(i) {
+                    *slot = Some(k);
+                }
+            }
+        }
+        (tau, at_once)
+    }
+
+    /// Moves by `tau delta`; agents that left their set by moving along a curved boundary's
+    /// tangent (or by round-off) are put back on it.
+    fn advance(&mut self, tau: T, delta: &[Vector3<T>; N]) {
+        for (((f, d), (set, w)), a) in self
+            .forces
+            .iter_mut()
+            .zip(delta)
+            .zip(self.sets.iter().zip(&self.working))
+            .zip(&self.active)
+        {
+            if *w {
+                *f += d * tau;
+                // Only a tangent step on a cone or sphere leaves the set by more than round-off
+                // (the final forces are checked anyway).
+                if a.curved() && outside(set, f) {
+                    *f = set.saturate(f);
+                }
+            }
+        }
+    }
+}
+
+/// `f` of every set, computed once per run of equal sets (the agents usually share one set, and
+/// the constraints cost trigonometry).
+fn per_set<T: Real, U: Copy, const N: usize>(
+    sets: &[AdmissibleSet<T>; N],
+    f: impl Fn(&AdmissibleSet<T>) -> U,
+) -> [U; N] {
+    let mut last: Option<(&AdmissibleSet<T>, U)> = None;
+    sets.each_ref().map(|s| match last {
+        Some((l, u)) if l == s => u,
+        _ => {
+            let u = f(s);
+            last = Some((s, u));
+            u
+        }
+    })
+}
+
+/// Whether `f` is on a constraint of its set, within `sqrt(eps)` of the largest thrust.
+fn on_boundary<T: Real>(
+    bounds: &[Constraint<T>; CONSTRAINTS],
+    set: &AdmissibleSet<T>,
+    f: &Vector3<T>,
+) -> bool {
+    let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
+    bounds.iter().any(|c| c.value(f) > -tol)
+}
+
+impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T, N> {
+    /// Forgets the previous forces: they belong to another team or failure mask.
+    fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {
+        self.previous = None;
+    }
+
+    fn reset(&mut self) {
+        self.previous = None;
+    }
+
+    fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
+        let e = request.effectiveness;
+        let working = working_mask(e);
+        let sets = &per_set(request.sets, regular);
+        let scale = max_abs(&request.wrench).max(T::one());
+        let tol = eps::<T>() * lit(64.0) * scale;
+        let start = RedistributedPseudoInverse.allocate(request);
+        let mut forces = start.forces;
+        let mut moved = false;
+        for (f, set) in forces.iter_mut().zip(sets) {
+            if outside(set, f) {
+                *f = set.saturate(f);
+                moved = true;
+            }
+        }
+        // Met by the start (hover, and most requests inside the attainable set): nothing to walk.
+        if !moved && max_abs(&(request.wrench - start.wrench)) <= tol {
+            self.previous = Some(start.forces);
+            return start;
+        }
+        if let Some(previous) = &self.previous {
+            let mut kept = [Vector3::zeros(); N];
+            for (((k, p), set), w) in kept.iter_mut().zip(previous).zip(sets).zip(&working) {
+                if *w {
+                    *k = if outside(set, p) { set.saturate(p) } else { *p };
+                }
+            }
+            if norm(&(request.wrench - e.wrench(&kept))) < start.wrench_error {
+                forces = kept;
+            }
+        }
+        let bounds = per_set(sets, |s| constraints(s));
+        let mut walk = Walk {
+            effectiveness: e,
+            sets,
+            bounds,
+            gram: e.gram(),
+            working,
+            forces,
+            active: [ActiveSet::default(); N],
+        };
+        let limit = 2 * e.working_count() + 4;
+        let mut rounds: u32 = 0;
+        // The walk's best forces: a retraction onto a curved boundary can cost more wrench
+        // than its step gained, and the result is never worse than the start.
+        let mut best = (T::max_value().unwrap_or_else(T::one), walk.forces);
+        while (rounds as usize) < limit {
+            let r = walk.remaining(&request.wrench);
+            let error = norm(&r);
+            if error < best.0 {
+                best = (error, walk.forces);
+            }
+            // Written so a NaN residual stops the walk too.
+            if max_abs(&r).partial_cmp(&tol) != Some(core::cmp::Ordering::Greater) {
+                break;
+            }
+            let Some(delta) = walk.direction(&r, true) else {
+                break;
+            };
+            rounds += 1;
+            let (tau, stop) = walk.step(&delta);
+            walk.advance(tau, &delta);
+            for (a, k) in walk.active.iter_mut().zip(stop) {
+                if let Some(k) = k {
+                    a.hold(k);
+                }
+            }
+        }
+        let r = walk.remaining(&request.wrench);
+        if norm(&r) < best.0 {
+            best = (norm(&r), walk.forces);
+        }
+        let mut forces = best.1;
+        let mut saturated = [false; N];
+        for ((((f, set), b), w), s) in forces
+            .iter_mut()
+            .zip(sets)
+            .zip(&walk.bounds)
+            .zip(&working)
+            .zip(saturated.iter_mut())
+        {
+            if !*w {
+                *f = Vector3::zeros();
+                continue;
+            }
+            if outside(set, f) {
+                *f = set.saturate(f);
+            }
+            *s = on_boundary(b, set, f);
+        }
+        self.previous = Some(forces);
+        Allocation::from_forces(request, forces, start.rounds + rounds, saturated)
+    }
+
+    fn name(&self) -> &'static str {
+        super::any::EXACT_BOUNDARY_REDISTRIBUTION
+    }
+}
