@@ -74,6 +74,11 @@ step "panic-free link check: f32 control cycle on thumbv7em with an undefined pa
 # Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).
 cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf
 
+step "the C interface: header as C99/C++11, the C test program and its bit-exact replay, thumbv7em staticlib and panic-free link check"
+# See scripts/ffi.sh. Measured on the 2-core development machine: 6 s warm; the link check's
+# own thumbv7em build from scratch about 55 s (plus apt-get of g++ where c++ is missing).
+bash scripts/ffi.sh
+
 step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"
 # See scripts/target.sh. Measured on the 2-core development machine: 50 s to apt-get install
 # qemu-system-arm where it is missing, about 70 s to build the firmware from scratch, and under

@@ -369,6 +369,8 @@ pub unsafe extern "C" fn tvmd_actuator_commands(
         };
     }
     let out = core::slice::from_raw_parts_mut(commands, agents.len());
-    out.copy_from_slice(decoded.get(..agents.len()).unwrap_or(&[]));
+    for (slot, c) in out.iter_mut().zip(&decoded) {
+        *slot = *c;
+    }
     TVMD_OK
 }
