@@ -391,8 +391,9 @@ typedef struct {
 // range `<= 0`, or `|trim| + sigma / range > 1` (the gimbal's travel would leave `[-1, 1]`).
 #define TVMD_ERR_MAP_SERVO 53
 
-// An actuator output given to the inverse mapping is not finite, outside its range, or an
-// agent's two motor channels differ.
+// A command given to `tvmd_actuator_outputs` is not finite or outside `E_f`; or an actuator
+// output given to the inverse mapping is not finite, outside its range, or an agent's two
+// motor channels differ.
 #define TVMD_ERR_ACTUATOR_VALUE 54
 
 #ifdef __cplusplus
@@ -423,8 +424,9 @@ TvmdStatus tvmd_actuator_map_validate(const TvmdController *handle, const TvmdAc
 
 // Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
 // and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
-// mask) get motors 0 and servos at trim; channels no agent uses are NaN. On an error `outputs`
-// is not written. Map `tvmd_step`'s output on an error status too: its commands are the held
+// mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
+// command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
+// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status too: its commands are the held
 // ones.
 //
 // # Safety

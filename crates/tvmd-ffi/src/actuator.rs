@@ -17,6 +17,7 @@
 //! - Unused channels are NaN, as PX4 marks a channel it does not drive; a failed agent's
 //!   motors are 0 and its servos at trim.
 
+use tvmd_core::command::command_tolerance;
 use tvmd_core::AgentLimits;
 
 use crate::handle::{controller, FfiController, TvmdController};
@@ -149,6 +150,19 @@ unsafe fn checked<'a>(
     Ok((controller, validate(map, controller)?, map.motor_curve))
 }
 
+/// Whether a command is finite and inside `E_f` (eq. 6) up to the core's round-off tolerance,
+/// so that no output is clipped beyond round-off.
+fn admissible(limits: &AgentLimits<f32>, c: &TvmdAgentCommand) -> bool {
+    let tol = command_tolerance::<f32>();
+    let within = |x: f32, hi: f32| x.is_finite() && x >= -tol * hi && x <= hi * (1.0 + tol);
+    c.eta_x.is_finite()
+        && c.eta_y.is_finite()
+        && c.eta_x.abs() <= limits.sigma_x() + tol
+        && c.eta_y.abs() <= limits.sigma_y() + tol
+        && within(c.thrust, limits.max_thrust())
+        && within(c.omega, limits.max_speed())
+}
+
 fn motor_value(curve: u32, limits: &AgentLimits<f32>, c: &TvmdAgentCommand) -> f32 {
     let value = if curve == TVMD_MOTOR_CURVE_THRUST {
         c.thrust / limits.max_thrust()
@@ -219,8 +233,9 @@ pub unsafe extern "C" fn tvmd_actuator_map_validate(
 
 /// Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
 /// and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
-/// mask) get motors 0 and servos at trim; channels no agent uses are NaN. On an error `outputs`
-/// is not written. Map `tvmd_step`'s output on an error status too: its commands are the held
+/// mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
+/// command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
+/// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status too: its commands are the held
 /// ones.
 ///
 /// # Safety
@@ -250,6 +265,15 @@ pub unsafe extern "C" fn tvmd_actuator_outputs(
     let commands = core::slice::from_raw_parts(commands, agents.len());
     let limits = controller.team().limits();
     let failures = controller.failures();
+    let working = commands
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !failures.is_failed(*i));
+    for (_, c) in working {
+        if !admissible(limits, c) {
+            return TVMD_ERR_ACTUATOR_VALUE;
+        }
+    }
     let mut motors = [f32::NAN; TVMD_MAX_AGENTS];
     let mut servos = [f32::NAN; TVMD_MAX_AGENTS];
     for (i, (agent, c)) in agents.iter().zip(commands).enumerate() {

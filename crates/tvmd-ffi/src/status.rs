@@ -84,8 +84,9 @@ pub const TVMD_ERR_MAP_DUPLICATE_CHANNEL: TvmdStatus = 52;
 /// A servo's trim, direction or range is unusable: not finite, direction not `+1`/`-1`,
 /// range `<= 0`, or `|trim| + sigma / range > 1` (the gimbal's travel would leave `[-1, 1]`).
 pub const TVMD_ERR_MAP_SERVO: TvmdStatus = 53;
-/// An actuator output given to the inverse mapping is not finite, outside its range, or an
-/// agent's two motor channels differ.
+/// A command given to `tvmd_actuator_outputs` is not finite or outside `E_f`; or an actuator
+/// output given to the inverse mapping is not finite, outside its range, or an agent's two
+/// motor channels differ.
 pub const TVMD_ERR_ACTUATOR_VALUE: TvmdStatus = 54;
 
 /// The code of a core input error.

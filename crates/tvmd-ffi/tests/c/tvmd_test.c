@@ -345,6 +345,20 @@ static void test_actuators(TvmdController *c, const TvmdOutput *o, uint32_t fail
   CHECK_STATUS(tvmd_actuator_outputs(c, &map, o->commands, TVMD_MAX_AGENTS, NULL), TVMD_ERR_NULL_POINTER);
   round.size = 0;
   CHECK_STATUS(tvmd_actuator_outputs(c, &map, o->commands, TVMD_MAX_AGENTS, &round), TVMD_ERR_SIZE);
+  round.size = sizeof round;
+  memcpy(back, o->commands, sizeof back);
+  back[3].eta_y = NAN; /* agent 3 works in every mask of this test */
+  CHECK_STATUS(tvmd_actuator_outputs(c, &map, back, TVMD_MAX_AGENTS, &round), TVMD_ERR_ACTUATOR_VALUE);
+  memcpy(back, o->commands, sizeof back);
+  back[3].eta_x = 1.1f * sigma_x; /* outside E_f: refused, not clipped */
+  CHECK_STATUS(tvmd_actuator_outputs(c, &map, back, TVMD_MAX_AGENTS, &round), TVMD_ERR_ACTUATOR_VALUE);
+  memcpy(back, o->commands, sizeof back);
+  back[3].thrust = 100.0f;
+  CHECK_STATUS(tvmd_actuator_outputs(c, &map, back, TVMD_MAX_AGENTS, &round), TVMD_ERR_ACTUATOR_VALUE);
+  CHECK(memcmp(&round, &act, sizeof act) == 0);
+  memcpy(back, o->commands, sizeof back);
+  back[TVMD_MAX_AGENTS - 1].thrust = NAN; /* beyond the team: not read */
+  CHECK_STATUS(tvmd_actuator_outputs(c, &map, back, TVMD_MAX_AGENTS, &round), TVMD_OK);
   round = act;
   for (i = 0; i < 4 && ((failed_mask >> i) & 1u); ++i) {
   }
