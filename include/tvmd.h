@@ -426,8 +426,8 @@ TvmdStatus tvmd_actuator_map_validate(const TvmdController *handle, const TvmdAc
 // and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
 // mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
 // command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
-// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status too: its commands are the held
-// ones.
+// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status
+// too: its commands are the held ones.
 //
 // # Safety
 // `commands` is null or points to `count` commands; the other pointers as

@@ -51,8 +51,11 @@ echo "libtvmd_ffi.a (thumbv7em-none-eabihf, release): $(wc -c <"$lib") bytes"
 
 step "panic-free link check: every C entry point on thumbv7em with an undefined panic handler"
 # Links only if no panic path survives (see embedded/ffi-check/src/main.rs).
-cargo build --release --locked --manifest-path embedded/ffi-check/Cargo.toml --target thumbv7em-none-eabihf
-check_dir="${CARGO_TARGET_DIR:-embedded/ffi-check/target}"
+# Its own target directory even when CARGO_TARGET_DIR is set: it builds tvmd-ffi with the
+# link-check feature, whose libtvmd_ffi.a must not replace the one measured above.
+check_dir=embedded/ffi-check/target
+cargo build --release --locked --manifest-path embedded/ffi-check/Cargo.toml \
+  --target thumbv7em-none-eabihf --target-dir "$check_dir"
 if command -v size >/dev/null 2>&1; then
   size "$check_dir/thumbv7em-none-eabihf/release/tvmd-ffi-check" || true
 fi
