@@ -1,0 +1,413 @@
+//! The opaque controller handle in caller memory, and the entry points that use it.
+//!
+//! `TvmdController` is plain storage of `TVMD_CONTROLLER_SIZE` bytes, 8-byte aligned, that the
+//! caller owns (a `static`, a member of a C++ class, a stack variable): the library never uses
+//! the heap. `tvmd_create` writes a `tvmd_core::Controller` (f32, 16 agents, the allocator
+//! chosen at run time) into it; nothing needs freeing. A handle is not thread-safe: call its
+//! entry points from one task (the control loop), or serialize them.
+
+use core::mem::{align_of, size_of};
+
+use tvmd_core::allocation::{
+    AllocatorOptions, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+};
+use tvmd_core::team::presets;
+use tvmd_core::{
+    AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings, FailureMask, Navigator,
+    RateLimits, Relaxation, TeamConfig,
+};
+
+use crate::status::*;
+use crate::types::*;
+use crate::TVMD_MAX_AGENTS;
+
+/// The controller behind the handle.
+pub(crate) type FfiController =
+    Controller<f32, TVMD_MAX_AGENTS, AnyAllocator<f32, TVMD_MAX_AGENTS>>;
+
+/// Bytes of a [`TvmdController`]: at least the controller's size on every supported target
+/// (checked at compile time), with room for the core to grow within one ABI version.
+pub const TVMD_CONTROLLER_SIZE: usize = 4096;
+
+/// `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C
+/// without compiler extensions).
+pub const TVMD_CONTROLLER_WORDS: usize = TVMD_CONTROLLER_SIZE / 8;
+
+/// Written by a successful `tvmd_create`; anything else means "not initialized".
+const MAGIC: u64 = 0x7476_6d64_6666_6931;
+
+/// What the storage holds.
+struct Inner {
+    magic: u64,
+    controller: FfiController,
+}
+
+// The header's size and alignment hold the real controller, on the target that compiles this.
+const _: () = assert!(size_of::<Inner>() <= TVMD_CONTROLLER_SIZE);
+const _: () = assert!(align_of::<Inner>() <= align_of::<TvmdController>());
+const _: () = assert!(TVMD_CONTROLLER_SIZE % 8 == 0);
+
+/// Caller-owned storage of one controller. Zero-initialize it (or call `tvmd_create` first):
+/// a handle that was never created is refused with `TVMD_ERR_NOT_INITIALIZED`.
+#[repr(C)]
+pub struct TvmdController {
+    /// Opaque; only the library reads or writes it.
+    pub opaque: [u64; TVMD_CONTROLLER_WORDS],
+}
+
+/// The bytes of caller memory a controller needs (`sizeof(TvmdController)`).
+#[no_mangle]
+pub extern "C" fn tvmd_controller_size() -> usize {
+    size_of::<TvmdController>()
+}
+
+/// The alignment, in bytes, caller memory for a controller needs.
+#[no_mangle]
+pub extern "C" fn tvmd_controller_align() -> usize {
+    align_of::<TvmdController>()
+}
+
+fn checked_size<T>(size: u32) -> Result<(), TvmdStatus> {
+    if usize::try_from(size).ok() == Some(size_of::<T>()) {
+        Ok(())
+    } else {
+        Err(TVMD_ERR_SIZE)
+    }
+}
+
+/// The created controller behind `handle`, or the status that refuses it.
+///
+/// # Safety
+/// `handle` is null or points to a `TvmdController` (possibly never created).
+unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStatus> {
+    if handle.is_null() {
+        return Err(TVMD_ERR_NULL_POINTER);
+    }
+    if handle as usize % align_of::<Inner>() != 0 {
+        return Err(TVMD_ERR_ALIGNMENT);
+    }
+    let inner = &*handle.cast::<Inner>();
+    if inner.magic == MAGIC {
+        Ok(inner)
+    } else {
+        Err(TVMD_ERR_NOT_INITIALIZED)
+    }
+}
+
+/// As [`inner`], mutable.
+///
+/// # Safety
+/// As [`inner`], and no other reference to the handle is alive.
+unsafe fn inner_mut<'a>(handle: *mut TvmdController) -> Result<&'a mut Inner, TvmdStatus> {
+    inner(handle)?;
+    Ok(&mut *handle.cast::<Inner>())
+}
+
+/// The created controller behind a handle (for the actuator mapping).
+///
+/// # Safety
+/// As [`inner`].
+pub(crate) unsafe fn controller<'a>(
+    handle: *const TvmdController,
+) -> Result<&'a FfiController, TvmdStatus> {
+    inner(handle).map(|i| &i.controller)
+}
+
+/// Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
+/// square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
+/// `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
+/// no rate limits, the redistributed pseudo-inverse. The caller sets `config->size` first.
+///
+/// # Safety
+/// `config` is null or points to a writable `TvmdConfig`.
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_config_paper(config: *mut TvmdConfig) -> TvmdStatus {
+    let Some(config) = config.as_mut() else {
+        return TVMD_ERR_NULL_POINTER;
+    };
+    if let Err(status) = checked_size::<TvmdConfig>(config.size) {
+        return status;
+    }
+    let team = match presets::a4_inc::<f32, TVMD_MAX_AGENTS>() {
+        Ok(team) => team,
+        Err(e) => return config_status(&e),
+    };
+    let settings = ControllerSettings::<f32>::paper();
+    let limits = team.limits();
+    let mut agents = [TvmdAgent::default(); TVMD_MAX_AGENTS];
+    for (slot, agent) in agents.iter_mut().zip(team.agents()) {
+        *slot = TvmdAgent {
+            position: agent.position.into(),
+            quarter_turns: agent.quarter_turns,
+            mass: agent.mass,
+            inertia: row_major(&agent.inertia),
+        };
+    }
+    *config = TvmdConfig {
+        size: config.size,
+        agent_count: u32::try_from(team.len()).unwrap_or(0),
+        agents,
+        navigator_mass: team.navigator().mass,
+        navigator_inertia: row_major(&team.navigator().inertia),
+        limits: TvmdLimits {
+            sigma_x: limits.sigma_x(),
+            sigma_y: limits.sigma_y(),
+            max_thrust: limits.max_thrust(),
+            min_thrust: limits.min_thrust(),
+            rotor_model: TVMD_ROTOR_NORMALIZED,
+            ..TvmdLimits::default()
+        },
+        gains: TvmdGains::from_core(&settings.gains),
+        relaxation: settings.relaxation.get(),
+        gravity: settings.gravity,
+        period: settings.period,
+        rate_limited: 0,
+        rate_limits: [0.0; 2],
+        allocator: TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE,
+        agent_weights: [1.0; TVMD_MAX_AGENTS],
+    };
+    TVMD_OK
+}
+
+/// The core controller a configuration describes.
+fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
+    let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
+    let Some(agents) = config.agents.get(..count) else {
+        return Err(ConfigError::TooManyAgents {
+            count,
+            capacity: TVMD_MAX_AGENTS,
+        }
+        .into());
+    };
+    let mut specs = [AgentSpec::new(vector(&[0.0; 3]), 0, 0.0); TVMD_MAX_AGENTS];
+    for (spec, agent) in specs.iter_mut().zip(agents) {
+        *spec = agent.to_core();
+    }
+    let navigator = Navigator {
+        mass: config.navigator_mass,
+        inertia: matrix(&config.navigator_inertia),
+    };
+    let limits = config.limits.to_core()?;
+    let team = TeamConfig::new(specs.get(..count).unwrap_or(&[]), limits, navigator)?;
+    let rate_limits = if config.rate_limited != 0 {
+        let [x, y] = config.rate_limits;
+        Some(RateLimits::new(x, y)?)
+    } else {
+        None
+    };
+    let settings = ControllerSettings {
+        gains: config.gains.to_core()?,
+        relaxation: Relaxation::new(config.relaxation)?,
+        gravity: config.gravity,
+        period: config.period,
+        rate_limits,
+    };
+    let name = match config.allocator {
+        TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_PSEUDO_INVERSE => PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE => WEIGHTED_PSEUDO_INVERSE,
+        _ => "",
+    };
+    let mut options = AllocatorOptions::default();
+    if name == WEIGHTED_PSEUDO_INVERSE {
+        // Slots beyond the team are unused; the core wants a valid weight in each.
+        let mut weights = [1.0; TVMD_MAX_AGENTS];
+        for (w, given) in weights.iter_mut().zip(&config.agent_weights).take(count) {
+            *w = *given;
+        }
+        options.agent_weights = Some(weights);
+    }
+    let allocator = AnyAllocator::from_name(name, &options)?;
+    Ok(Controller::new(team, settings, allocator)?)
+}
+
+/// Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
+/// On an error the storage is marked not initialized, and every other entry point refuses it.
+/// Calling it again on a created handle replaces the controller.
+///
+/// # Safety
+/// `storage` is null or points to writable memory of `storage_size` bytes not used otherwise;
+/// `config` is null or points to a `TvmdConfig`.
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_create(
+    storage: *mut TvmdController,
+    storage_size: usize,
+    config: *const TvmdConfig,
+) -> TvmdStatus {
+    if storage.is_null() || config.is_null() {
+        return TVMD_ERR_NULL_POINTER;
+    }
+    if storage_size != size_of::<TvmdController>() {
+        return TVMD_ERR_SIZE;
+    }
+    if storage as usize % align_of::<TvmdController>() != 0 {
+        return TVMD_ERR_ALIGNMENT;
+    }
+    let inner = storage.cast::<Inner>();
+    // Not initialized until the controller is in place.
+    core::ptr::addr_of_mut!((*inner).magic).write(0);
+    let config = &*config;
+    if let Err(status) = checked_size::<TvmdConfig>(config.size) {
+        return status;
+    }
+    match build(config) {
+        Ok(controller) => {
+            inner.write(Inner {
+                magic: MAGIC,
+                controller,
+            });
+            TVMD_OK
+        }
+        Err(e) => e.status(),
+    }
+}
+
+/// One control period. Fills `out` (whose `size` the caller sets) and returns its status.
+///
+/// On any error after `out` was found usable, `out` holds the previous good commands (see
+/// [`TvmdOutput`]): null `state`/`reference`, a wrong `size`, a non-finite, non-rotation or
+/// out-of-range input, an unattainable request. A null or wrongly sized `out` is not written.
+///
+/// # Safety
+/// Each pointer is null or points to its struct; `handle` as for [`tvmd_create`].
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_step(
+    handle: *mut TvmdController,
+    state: *const TvmdState,
+    reference: *const TvmdReference,
+    out: *mut TvmdOutput,
+) -> TvmdStatus {
+    let Some(out) = out.as_mut() else {
+        return TVMD_ERR_NULL_POINTER;
+    };
+    if let Err(status) = checked_size::<TvmdOutput>(out.size) {
+        return status;
+    }
+    let inner = match inner_mut(handle) {
+        Ok(inner) => inner,
+        Err(status) => {
+            out.held(status, 0, &[]);
+            return status;
+        }
+    };
+    let controller = &mut inner.controller;
+    let n = controller.team().len();
+    let hold = |out: &mut TvmdOutput, status, controller: &FfiController| {
+        let mut held = [TvmdAgentCommand::default(); TVMD_MAX_AGENTS];
+        for (slot, c) in held.iter_mut().zip(controller.previous_commands()) {
+            *slot = c.into();
+        }
+        out.held(status, n, &held);
+        status
+    };
+    let (Some(state), Some(reference)) = (state.as_ref(), reference.as_ref()) else {
+        return hold(out, TVMD_ERR_NULL_POINTER, controller);
+    };
+    if let Err(status) = checked_size::<TvmdState>(state.size)
+        .and_then(|()| checked_size::<TvmdReference>(reference.size))
+    {
+        return hold(out, status, controller);
+    }
+    match controller.step(&state.to_core(), &reference.to_core()) {
+        Ok(o) => {
+            out.status = TVMD_OK;
+            out.agent_count = u32::try_from(n).unwrap_or(0);
+            for (slot, c) in out.commands.iter_mut().zip(&o.commands) {
+                *slot = c.into();
+            }
+            out.e_f = o.allocation.e_f;
+            out.planned_attitude = row_major(&o.planner.r_d);
+            out.planner_theta = o.planner.theta;
+            out.planner_status = planner_status_code(o.planner.status);
+            out.planner_iterations = o.planner.iterations;
+            TVMD_OK
+        }
+        // The core's error carries the previous commands, the same as `previous_commands`.
+        Err(e) => hold(out, input_status(&e.error), controller),
+    }
+}
+
+/// Marks the agents whose bit is set in `failed_mask` (bit `i` = agent `i`) as failed and
+/// classifies whether the working agents can hold hover; fills `hover` unless it is null.
+/// On an error (a bit at or beyond the team's size, no working agent, a rank-deficient
+/// remaining team) the previous mask stays in force.
+///
+/// # Safety
+/// `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_set_failures(
+    handle: *mut TvmdController,
+    failed_mask: u32,
+    hover: *mut TvmdHover,
+) -> TvmdStatus {
+    let hover = hover.as_mut();
+    if let Some(h) = &hover {
+        if let Err(status) = checked_size::<TvmdHover>(h.size) {
+            return status;
+        }
+    }
+    let inner = match inner_mut(handle) {
+        Ok(inner) => inner,
+        Err(status) => return status,
+    };
+    let mut mask = FailureMask::none();
+    for bit in 0..u32::BITS {
+        if failed_mask & (1 << bit) != 0 {
+            if let Err(e) = usize::try_from(bit)
+                .map_err(|_| ConfigError::FailureIndex { agent: usize::MAX })
+                .and_then(|agent| mask.set(agent, true))
+            {
+                return config_status(&e);
+            }
+        }
+    }
+    match inner.controller.set_failures(mask) {
+        Ok(capability) => {
+            if let Some(h) = hover {
+                h.fill(&capability);
+            }
+            TVMD_OK
+        }
+        Err(e) => config_status(&e),
+    }
+}
+
+/// The hover classification of the mask in force (the full team's after `tvmd_create`).
+///
+/// # Safety
+/// `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_hover_capability(
+    handle: *const TvmdController,
+    hover: *mut TvmdHover,
+) -> TvmdStatus {
+    let Some(hover) = hover.as_mut() else {
+        return TVMD_ERR_NULL_POINTER;
+    };
+    if let Err(status) = checked_size::<TvmdHover>(hover.size) {
+        return status;
+    }
+    match inner(handle) {
+        Ok(inner) => {
+            hover.fill(inner.controller.hover_capability());
+            TVMD_OK
+        }
+        Err(status) => status,
+    }
+}
+
+/// Forgets the previous command: the next held command is idle, and rate limits restart from
+/// a centred gimbal. Configuration and failure mask are kept.
+///
+/// # Safety
+/// `handle` as for [`tvmd_step`].
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
+    match inner_mut(handle) {
+        Ok(inner) => {
+            inner.controller.reset();
+            TVMD_OK
+        }
+        Err(status) => status,
+    }
+}

@@ -1,0 +1,400 @@
+//! The plain C structs of the interface and their conversions to the core's types.
+//!
+//! Conventions: `f32` everywhere; SI units; z up; a 3x3 matrix is 9 floats row-major
+//! (`m[3 * row + col]`); a boolean is a `uint32_t` (0 false, anything else true). Every struct
+//! passed by pointer starts with `size`, which the caller sets to `sizeof` of the struct (the
+//! library checks it against its own and returns `TVMD_ERR_SIZE` on a mismatch).
+
+use tvmd_core::nalgebra::{Matrix3, Vector3};
+use tvmd_core::{
+    AgentCommand, AgentLimits, AgentSpec, ConfigError, Gains, HoverCapability, HoverLimit,
+    PlannerStatus, Reference, RigidState,
+};
+
+use crate::status::{TvmdStatus, TVMD_ERR_ENUM_VALUE};
+use crate::TVMD_MAX_AGENTS;
+
+/// One agent of the team (paper, "Modeling"): its gimbal centre, yaw and mass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdAgent {
+    /// `p_i`, the gimbal centre in the team CoM frame `{C}` (m).
+    pub position: [f32; 3],
+    /// The yaw `psi_i = quarter_turns * pi/2`.
+    pub quarter_turns: i32,
+    /// `m_i` (kg), a point mass at `p_i`.
+    pub mass: f32,
+    /// The agent's own inertia about its centre in `{C}` axes (kg m^2), row-major; zeros for
+    /// the paper's point-mass model.
+    pub inertia: [f32; 9],
+}
+
+/// `limits.rotor_model`: `omega` normalized to 1 at `max_thrust` (`rho d^4 c_l = max_thrust`).
+pub const TVMD_ROTOR_NORMALIZED: u32 = 0;
+/// `limits.rotor_model`: the rotor constants of eq. (5), `T = rho d^4 c_l omega^2`, give
+/// `max_thrust = rho d^4 c_l sigma_omega^2` and `omega` in rad/s (`max_thrust` is ignored).
+pub const TVMD_ROTOR_CONSTANTS: u32 = 1;
+
+/// Limits shared by every agent: gimbal limits and thrust range (eq. 6), rotor model (eq. 5).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdLimits {
+    /// `sigma_x`, limit of `|eta_x|` (rad), in `(0, pi/2]`.
+    pub sigma_x: f32,
+    /// `sigma_y`, limit of `|eta_y|` (rad), in `(0, pi/2]`.
+    pub sigma_y: f32,
+    /// `sigma_Tf`, the maximum thrust of one agent (N) (with `TVMD_ROTOR_NORMALIZED`).
+    pub max_thrust: f32,
+    /// The idle thrust (N), in `[0, sigma_Tf)`.
+    pub min_thrust: f32,
+    /// `TVMD_ROTOR_NORMALIZED` or `TVMD_ROTOR_CONSTANTS`.
+    pub rotor_model: u32,
+    /// Air density `rho` (kg/m^3) (with `TVMD_ROTOR_CONSTANTS`).
+    pub rho: f32,
+    /// Rotor diameter `d` (m) (with `TVMD_ROTOR_CONSTANTS`).
+    pub rotor_diameter: f32,
+    /// Lift coefficient `c_l` (with `TVMD_ROTOR_CONSTANTS`).
+    pub lift_coefficient: f32,
+    /// `sigma_omega`, the maximum rotor speed (rad/s) (with `TVMD_ROTOR_CONSTANTS`).
+    pub max_rotor_speed: f32,
+}
+
+/// The gains of eq. (12), each a symmetric positive definite 3x3 matrix, row-major.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdGains {
+    /// `K_x`, position gain.
+    pub k_x: [f32; 9],
+    /// `K_R`, attitude gain.
+    pub k_r: [f32; 9],
+    /// `K_Omega`, angular-velocity block of `K_xi`.
+    pub k_omega: [f32; 9],
+    /// `K_v`, velocity block of `K_xi`.
+    pub k_v: [f32; 9],
+}
+
+/// `allocator`: the redistributed pseudo-inverse (the paper's; the default).
+pub const TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE: u32 = 0;
+/// `allocator`: the plain pseudo-inverse.
+pub const TVMD_ALLOCATOR_PSEUDO_INVERSE: u32 = 1;
+/// `allocator`: the weighted pseudo-inverse with `agent_weights`.
+pub const TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE: u32 = 2;
+
+/// Everything `tvmd_create` needs. `tvmd_config_paper` fills the paper's team and settings.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TvmdConfig {
+    /// `sizeof(TvmdConfig)`.
+    pub size: u32,
+    /// `n`, the number of agents, `1..=TVMD_MAX_AGENTS`.
+    pub agent_count: u32,
+    /// The agents (the first `agent_count` are used).
+    pub agents: [TvmdAgent; TVMD_MAX_AGENTS],
+    /// `m_0`, the navigator's mass at the team CoM (kg), `>= 0`.
+    pub navigator_mass: f32,
+    /// `J_0`, the navigator's inertia about the team CoM (kg m^2), row-major.
+    pub navigator_inertia: [f32; 9],
+    /// The agent limits.
+    pub limits: TvmdLimits,
+    /// The gains.
+    pub gains: TvmdGains,
+    /// The AFS relaxation `s` of the planner, in `(0, 1]` (eq. 8).
+    pub relaxation: f32,
+    /// `g` (m/s^2).
+    pub gravity: f32,
+    /// The control period `dt` (s).
+    pub period: f32,
+    /// Non-zero: limit the gimbal rates to `rate_limits` (rad/s, `[eta_x, eta_y]`).
+    pub rate_limited: u32,
+    /// Gimbal rate limits (rad/s) when `rate_limited`.
+    pub rate_limits: [f32; 2],
+    /// One of `TVMD_ALLOCATOR_*`.
+    pub allocator: u32,
+    /// Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
+    /// are used; ignored by the other allocators).
+    pub agent_weights: [f32; TVMD_MAX_AGENTS],
+}
+
+/// The measured state: pose and body-frame twist.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdState {
+    /// `sizeof(TvmdState)`.
+    pub size: u32,
+    /// `x`, CoM position, inertial frame (m), z up.
+    pub position: [f32; 3],
+    /// `R`, body-to-inertial rotation, row-major.
+    pub attitude: [f32; 9],
+    /// `Omega`, body-frame angular velocity (rad/s).
+    pub angular_velocity: [f32; 3],
+    /// `v`, body-frame linear velocity (m/s), `x_dot = R v`.
+    pub velocity: [f32; 3],
+}
+
+/// The full-pose reference.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdReference {
+    /// `sizeof(TvmdReference)`.
+    pub size: u32,
+    /// `x_r` (m).
+    pub position: [f32; 3],
+    /// `x_r_dot` (m/s), inertial.
+    pub velocity: [f32; 3],
+    /// `x_r_ddot` (m/s^2), inertial.
+    pub acceleration: [f32; 3],
+    /// `R_r`, the reference attitude, row-major.
+    pub attitude: [f32; 9],
+    /// `Omega_d` (rad/s), body frame of the reference.
+    pub angular_velocity: [f32; 3],
+    /// `Omega_d_dot` (rad/s^2).
+    pub angular_acceleration: [f32; 3],
+}
+
+/// One agent's command (eq. 6): gimbal angles, thrust and rotor speed.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdAgentCommand {
+    /// Inner gimbal angle `eta_x` (rad), `|eta_x| <= sigma_x`.
+    pub eta_x: f32,
+    /// Outer gimbal angle `eta_y` (rad), `|eta_y| <= sigma_y`.
+    pub eta_y: f32,
+    /// Thrust `T` (N), in `[min_thrust, max_thrust]` (0 for a failed agent).
+    pub thrust: f32,
+    /// Rotor speed `omega` of both coaxial rotors (eq. 5: `omega_P1 = omega_P2`).
+    pub omega: f32,
+}
+
+impl From<&AgentCommand<f32>> for TvmdAgentCommand {
+    fn from(c: &AgentCommand<f32>) -> Self {
+        Self {
+            eta_x: c.eta_x,
+            eta_y: c.eta_y,
+            thrust: c.thrust,
+            omega: c.omega,
+        }
+    }
+}
+
+/// `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
+pub const TVMD_PLANNER_ALREADY_FEASIBLE: u32 = 0;
+/// `planner_status`: the search found the smallest feasible tilt (the planner saturating).
+pub const TVMD_PLANNER_PLANNED: u32 = 1;
+/// `planner_status`: `f_r = 0`, `R_d = R_r`.
+pub const TVMD_PLANNER_ZERO_FORCE: u32 = 2;
+/// `planner_status`: `||f_r|| > n sigma_Tf`, `b_zd` as close to `f_r` as the rotation allows.
+pub const TVMD_PLANNER_UNREACHABLE: u32 = 3;
+
+/// What one `tvmd_step` produced.
+///
+/// On an error status ("hold"), `commands` are the last good period's commands (idle before
+/// the first good period, or when the handle is not initialized): inside `E_f`, never NaN, to
+/// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`) are NaN and
+/// `planner_status`/`planner_iterations` 0 then: they were not computed this period.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TvmdOutput {
+    /// `sizeof(TvmdOutput)`, set by the caller.
+    pub size: u32,
+    /// The status `tvmd_step` returned.
+    pub status: i32,
+    /// `n`; commands beyond it are idle.
+    pub agent_count: u32,
+    /// Per-agent commands inside `E_f` (idle for failed agents).
+    pub commands: [TvmdAgentCommand; TVMD_MAX_AGENTS],
+    /// `e_f = ||u_fd - u_f||` (N), the allocation error of the force part.
+    pub e_f: f32,
+    /// `R_d`, the planned attitude, row-major.
+    pub planned_attitude: [f32; 9],
+    /// `theta*`, the planner's tilt from `b_zr` toward `f_r` (rad).
+    pub planner_theta: f32,
+    /// One of `TVMD_PLANNER_*`.
+    pub planner_status: u32,
+    /// The planner's search steps.
+    pub planner_iterations: u32,
+}
+
+impl TvmdOutput {
+    /// The held output of an error: `commands`, NaN diagnostics, `status`.
+    pub(crate) fn held(
+        &mut self,
+        status: TvmdStatus,
+        agent_count: usize,
+        commands: &[TvmdAgentCommand],
+    ) {
+        self.status = status;
+        self.agent_count = u32::try_from(agent_count).unwrap_or(0);
+        self.commands = [TvmdAgentCommand::default(); TVMD_MAX_AGENTS];
+        for (slot, c) in self.commands.iter_mut().zip(commands) {
+            *slot = *c;
+        }
+        self.e_f = f32::NAN;
+        self.planned_attitude = [f32::NAN; 9];
+        self.planner_theta = f32::NAN;
+        self.planner_status = 0;
+        self.planner_iterations = 0;
+    }
+}
+
+/// `hover.limit`: the maximum thrust `sigma_Tf`.
+pub const TVMD_HOVER_LIMIT_MAX_THRUST: u32 = 0;
+/// `hover.limit`: the idle thrust.
+pub const TVMD_HOVER_LIMIT_MIN_THRUST: u32 = 1;
+/// `hover.limit`: the inner gimbal limit `sigma_x`.
+pub const TVMD_HOVER_LIMIT_GIMBAL_X: u32 = 2;
+/// `hover.limit`: the outer gimbal limit `sigma_y`.
+pub const TVMD_HOVER_LIMIT_GIMBAL_Y: u32 = 3;
+
+/// Whether the working agents can hold hover with a margin (the core's `HoverCapability`),
+/// classified when the failure mask is set.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TvmdHover {
+    /// `sizeof(TvmdHover)`, set by the caller.
+    pub size: u32,
+    /// Non-zero when the hover wrench is strictly inside the attainable set.
+    pub capable: u32,
+    /// The smallest normalized slack of any working agent (`<= 1`; `<= 0` at a bound).
+    pub margin: f32,
+    /// The agent whose slack is `margin`, or -1.
+    pub limiting_agent: i32,
+    /// The bound that agent is closest to, one of `TVMD_HOVER_LIMIT_*`.
+    pub limit: u32,
+    /// `m_C g` (N).
+    pub weight: f32,
+}
+
+impl TvmdHover {
+    pub(crate) fn fill(&mut self, hover: &HoverCapability<f32>) {
+        self.capable = u32::from(hover.capable);
+        self.margin = hover.margin;
+        self.limiting_agent = hover
+            .limiting_agent
+            .and_then(|i| i32::try_from(i).ok())
+            .unwrap_or(-1);
+        self.limit = match hover.limit {
+            HoverLimit::MaxThrust => TVMD_HOVER_LIMIT_MAX_THRUST,
+            HoverLimit::MinThrust => TVMD_HOVER_LIMIT_MIN_THRUST,
+            HoverLimit::GimbalX => TVMD_HOVER_LIMIT_GIMBAL_X,
+            HoverLimit::GimbalY => TVMD_HOVER_LIMIT_GIMBAL_Y,
+        };
+        self.weight = hover.weight;
+    }
+}
+
+/// The C code of a planner status.
+pub fn planner_status_code(status: PlannerStatus) -> u32 {
+    match status {
+        PlannerStatus::AlreadyFeasible => TVMD_PLANNER_ALREADY_FEASIBLE,
+        PlannerStatus::Planned => TVMD_PLANNER_PLANNED,
+        PlannerStatus::ZeroForce => TVMD_PLANNER_ZERO_FORCE,
+        PlannerStatus::Unreachable => TVMD_PLANNER_UNREACHABLE,
+    }
+}
+
+pub(crate) fn vector(v: &[f32; 3]) -> Vector3<f32> {
+    Vector3::from(*v)
+}
+
+pub(crate) fn matrix(m: &[f32; 9]) -> Matrix3<f32> {
+    Matrix3::from_row_slice(m)
+}
+
+pub(crate) fn row_major(m: &Matrix3<f32>) -> [f32; 9] {
+    let mut out = [0.0; 9];
+    for (slot, x) in out.iter_mut().zip(m.transpose().iter()) {
+        *slot = *x;
+    }
+    out
+}
+
+impl TvmdState {
+    pub(crate) fn to_core(self) -> RigidState<f32> {
+        RigidState {
+            position: vector(&self.position),
+            attitude: matrix(&self.attitude),
+            angular_velocity: vector(&self.angular_velocity),
+            velocity: vector(&self.velocity),
+        }
+    }
+}
+
+impl TvmdReference {
+    pub(crate) fn to_core(self) -> Reference<f32> {
+        Reference {
+            position: vector(&self.position),
+            velocity: vector(&self.velocity),
+            acceleration: vector(&self.acceleration),
+            attitude: matrix(&self.attitude),
+            angular_velocity: vector(&self.angular_velocity),
+            angular_acceleration: vector(&self.angular_acceleration),
+        }
+    }
+}
+
+impl TvmdAgent {
+    pub(crate) fn to_core(self) -> AgentSpec<f32> {
+        let mut spec = AgentSpec::new(vector(&self.position), self.quarter_turns, self.mass);
+        spec.inertia = matrix(&self.inertia);
+        spec
+    }
+}
+
+/// Why a configuration could not be converted: an enum value, or a core error.
+pub(crate) enum ConvertError {
+    EnumValue,
+    Config(ConfigError),
+}
+
+impl ConvertError {
+    pub(crate) fn status(&self) -> TvmdStatus {
+        match self {
+            Self::EnumValue => TVMD_ERR_ENUM_VALUE,
+            Self::Config(e) => crate::status::config_status(e),
+        }
+    }
+}
+
+impl From<ConfigError> for ConvertError {
+    fn from(e: ConfigError) -> Self {
+        Self::Config(e)
+    }
+}
+
+impl TvmdLimits {
+    pub(crate) fn to_core(self) -> Result<AgentLimits<f32>, ConvertError> {
+        let limits = match self.rotor_model {
+            TVMD_ROTOR_NORMALIZED => AgentLimits::new(self.sigma_x, self.sigma_y, self.max_thrust)?,
+            TVMD_ROTOR_CONSTANTS => AgentLimits::from_rotor(
+                self.sigma_x,
+                self.sigma_y,
+                self.rho,
+                self.rotor_diameter,
+                self.lift_coefficient,
+                self.max_rotor_speed,
+            )?,
+            _ => return Err(ConvertError::EnumValue),
+        };
+        Ok(limits.with_min_thrust(self.min_thrust)?)
+    }
+}
+
+impl TvmdGains {
+    pub(crate) fn to_core(self) -> Result<Gains<f32>, ConfigError> {
+        Gains::new(
+            matrix(&self.k_x),
+            matrix(&self.k_r),
+            matrix(&self.k_omega),
+            matrix(&self.k_v),
+        )
+    }
+
+    pub(crate) fn from_core(gains: &Gains<f32>) -> Self {
+        Self {
+            k_x: row_major(&gains.k_x()),
+            k_r: row_major(&gains.k_r()),
+            k_omega: row_major(&gains.k_omega()),
+            k_v: row_major(&gains.k_v()),
+        }
+    }
+}

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The C interface (crates/tvmd-ffi, include/tvmd.h): the header compiles as C99 and C++11 with
+# warnings as errors; the C test program, linked against the staticlib, runs the paper team
+# (hover, the saturating tilt, failure masks, every error path, the actuator channel map) and
+# its record is replayed on the Rust API bit for bit; the thumbv7em staticlib builds and every
+# entry point links there without a panic path (embedded/ffi-check). The header's staleness is
+# checked by `cargo test -p tvmd-ffi --test header` (part of `cargo test --workspace`).
+# Installs a C/C++ compiler with apt-get where one is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n==> %s\n' "$*"; }
+
+export PYO3_BUILD_EXTENSION_MODULE=1
+target_dir="${CARGO_TARGET_DIR:-target}"
+case "$target_dir" in /*) ;; *) target_dir="$PWD/$target_dir" ;; esac
+out="$target_dir/ffi"
+mkdir -p "$out"
+
+if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then
+  step "installing gcc and g++ (cc or c++ is missing)"
+  if [ "$(id -u)" -eq 0 ]; then
+    sudo_cmd=()
+  elif command -v sudo >/dev/null 2>&1; then
+    sudo_cmd=(sudo)
+  else
+    echo "error: cc/c++ missing and neither root nor sudo is available to apt-get install gcc g++" >&2
+    exit 1
+  fi
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq gcc g++ >/dev/null
+fi
+
+step "include/tvmd.h compiles as C99 and as C++11 (-Wall -Wextra -Werror -pedantic)"
+printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 1 ? 0 : 1; }\n' >"$out/header.c"
+cp "$out/header.c" "$out/header.cpp"
+cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.c" -o "$out/header_c.o"
+c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o "$out/header_cpp.o"
+
+step "C test program against the staticlib, then its record replayed on the Rust API"
+cargo build --locked -p tvmd-ffi
+cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tvmd_test.c \
+  "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl -o "$out/tvmd_test"
+"$out/tvmd_test" "$out/record.txt"
+TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
+
+step "staticlib for thumbv7em-none-eabihf (no_std) and its size"
+cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release
+lib="$target_dir/thumbv7em-none-eabihf/release/libtvmd_ffi.a"
+echo "libtvmd_ffi.a (thumbv7em-none-eabihf, release): $(wc -c <"$lib") bytes"
+
+step "panic-free link check: every C entry point on thumbv7em with an undefined panic handler"
+# Links only if no panic path survives (see embedded/ffi-check/src/main.rs).
+# Its own target directory even when CARGO_TARGET_DIR is set: it builds tvmd-ffi with the
+# link-check feature, whose libtvmd_ffi.a must not replace the one measured above.
+check_dir=embedded/ffi-check/target
+cargo build --release --locked --manifest-path embedded/ffi-check/Cargo.toml \
+  --target thumbv7em-none-eabihf --target-dir "$check_dir"
+if command -v size >/dev/null 2>&1; then
+  size "$check_dir/thumbv7em-none-eabihf/release/tvmd-ffi-check" || true
+fi
