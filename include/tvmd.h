@@ -45,6 +45,10 @@
 // `allocator`: the weighted pseudo-inverse with `agent_weights`.
 #define TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE 2
 
+// `allocator`: the exact-boundary incremental redistribution (starts from the previous
+// period's forces; `tvmd_reset` and `tvmd_set_failures` forget them).
+#define TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION 3
+
 // `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
 #define TVMD_PLANNER_ALREADY_FEASIBLE 0
 

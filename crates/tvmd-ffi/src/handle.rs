@@ -9,7 +9,8 @@
 use core::mem::{align_of, size_of};
 
 use tvmd_core::allocation::{
-    AllocatorOptions, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+    AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
+    WEIGHTED_PSEUDO_INVERSE,
 };
 use tvmd_core::team::presets;
 use tvmd_core::{
@@ -206,6 +207,7 @@ fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,
         TVMD_ALLOCATOR_PSEUDO_INVERSE => PSEUDO_INVERSE,
         TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE => WEIGHTED_PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION => EXACT_BOUNDARY_REDISTRIBUTION,
         _ => "",
     };
     let mut options = AllocatorOptions::default();

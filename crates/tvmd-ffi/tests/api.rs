@@ -132,3 +132,39 @@ fn actuator_channels_follow_the_map_and_round_trip() {
     let duplicate = unsafe { tvmd_actuator_map_validate(&*handle, &map) };
     assert_eq!(duplicate, TVMD_ERR_MAP_DUPLICATE_CHANNEL);
 }
+
+#[test]
+fn every_allocator_constant_creates_a_controller_that_flies() {
+    for allocator in [
+        TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE,
+        TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
+    ] {
+        let mut storage = Box::new(TvmdController {
+            opaque: [0; TVMD_CONTROLLER_WORDS],
+        });
+        let mut config: TvmdConfig = unsafe { std::mem::zeroed() };
+        config.size = size_of::<TvmdConfig>() as u32;
+        // SAFETY: valid pointers to live values.
+        unsafe {
+            assert_eq!(tvmd_config_paper(&mut config), TVMD_OK);
+            config.allocator = allocator;
+            assert_eq!(
+                tvmd_create(&mut *storage, size_of::<TvmdController>(), &config),
+                TVMD_OK,
+                "allocator {allocator}"
+            );
+        }
+        for x in [0.2, 0.1, 0.0] {
+            let (status, out) = step(&mut storage, x);
+            assert_eq!(status, TVMD_OK, "allocator {allocator}");
+            assert!(
+                out.e_f.is_finite() && out.e_f < 1e-3,
+                "allocator {allocator}: {}",
+                out.e_f
+            );
+            assert!(out.commands[..4].iter().all(|c| c.thrust > 0.0));
+        }
+    }
+}
