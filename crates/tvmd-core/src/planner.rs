@@ -152,6 +152,18 @@ impl<T: Real> AttitudePlanner<T> {
         f_r: &Vector3<T>,
     ) -> Result<PlannerOutput<T>, InputError> {
         validate_rotation(r_r, "planner.r_r")?;
+        self.plan_in_valid_attitude(cone, r_r, f_r)
+    }
+
+    /// As [`Self::plan_in`] for an `r_r` the caller has already validated with
+    /// [`validate_rotation`] (the controller checks `reference.attitude` on entry to the cycle,
+    /// so checking it again here would repeat the same test each period). `f_r` is still checked.
+    pub(crate) fn plan_in_valid_attitude(
+        &self,
+        cone: &EllipticCone<T>,
+        r_r: &Matrix3<T>,
+        f_r: &Vector3<T>,
+    ) -> Result<PlannerOutput<T>, InputError> {
         if !f_r.iter().all(|x| x.is_finite()) {
             return Err(InputError::NonFinite {
                 field: "planner.f_r",
