@@ -57,17 +57,26 @@ fn team<const N: usize>() -> Option<TeamConfig<f32, N>> {
 struct Measured {
     instructions: u32,
     stack: usize,
+    setup_stack: usize,
     status: PlannerStatus,
     iterations: u32,
 }
 
 fn measure<const N: usize>(searching: bool, per_tick: u32) -> Option<Measured> {
-    let mut c = Controller::new(
-        team::<N>()?,
-        ControllerSettings::paper(),
-        RedistributedPseudoInverse,
-    )
-    .ok()?;
+    let team = team::<N>()?;
+    let mut built = None;
+    // Set-up (the team's effectiveness, the Gram factor): once per change of team or failures.
+    let setup_stack = stack::peak(&mut || {
+        built = black_box(
+            Controller::new(
+                team,
+                ControllerSettings::paper(),
+                RedistributedPseudoInverse,
+            )
+            .ok(),
+        );
+    });
+    let mut c = built?;
     let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
     let mut reference = Reference::hover(if searching {
         Vector3::new(0.0, 0.0, 1.5)
@@ -105,6 +114,7 @@ fn measure<const N: usize>(searching: bool, per_tick: u32) -> Option<Measured> {
     Some(Measured {
         instructions,
         stack,
+        setup_stack,
         status,
         iterations,
     })
@@ -119,11 +129,12 @@ fn report<const N: usize>(per_tick: u32) -> bool {
                 let as_intended = (m.status == PlannerStatus::AlreadyFeasible) != searching;
                 ok &= as_intended;
                 hprintln!(
-                    "cost: n = {:2} {:9} cycle: {:6} instructions, peak stack {:5} B (planner {:?}, {} iterations){}",
+                    "cost: n = {:2} {:9} cycle: {:6} instructions, peak stack {:5} B (Controller::new {:5} B; planner {:?}, {} iterations){}",
                     N,
                     name,
                     m.instructions,
                     m.stack,
+                    m.setup_stack,
                     m.status,
                     m.iterations,
                     if as_intended { "" } else { "  FAIL: not the intended planner case" }
