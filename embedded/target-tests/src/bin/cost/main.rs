@@ -24,8 +24,9 @@ use tvmd_core::{
 mod clock;
 mod stack;
 
-/// Cycles per measurement: the tick quantization (one tick, 40 instructions) is spread over
-/// them, so each count is exact to 40 / REPS instructions.
+/// Cycles per measurement: the tick quantization (one tick, 40 instructions, at each end of the
+/// cycles' timing and of the overhead's) is spread over them: each count is within
+/// 4 * 40 / REPS = 0.8 instructions.
 const REPS: u32 = 200;
 
 type Cycle<const N: usize> = Controller<f32, N, RedistributedPseudoInverse>;
