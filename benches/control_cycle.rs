@@ -63,6 +63,11 @@ fn bench_size<T: Real, const N: usize>(c: &mut Criterion, float: &str) {
     g.bench_with_input(BenchmarkId::new("planner", N), &f_r, |b, f_r| {
         b.iter(|| planner.plan(&afs, black_box(&reference.attitude), black_box(f_r)))
     });
+    // As the controller plans: the cone at the planner's `s` kept between periods (`plan_in`).
+    let cone = afs.cone(settings.relaxation);
+    g.bench_with_input(BenchmarkId::new("planner_in", N), &f_r, |b, f_r| {
+        b.iter(|| planner.plan_in(&cone, black_box(&reference.attitude), black_box(f_r)))
+    });
     let plant = tvmd::core::law::Plant::new(team.mass(), team.inertia(), lit(9.81))
         .expect("the preset team's plant is valid");
     let r_d = roll(lit(0.33));

@@ -51,6 +51,21 @@ for machine in mps2-an386 mps2-an500; do
   fi
 done
 
+# On-target cost (BENCHMARKS.md): instructions per f32 control cycle, counted with
+# `-icount shift=0` (one instruction = 1 ns of virtual time, read through the SysTick and
+# calibrated on nop loops by the firmware), and the cycle's peak stack (painted).
+cost_elf="$target_dir/thumbv7em-none-eabihf/release/cost"
+for machine in mps2-an386 mps2-an500; do
+  echo "==> $machine: on-target cost (-icount shift=0)"
+  rc=0
+  timeout 120 qemu-system-arm -machine "$machine" -nographic -monitor none -icount shift=0 \
+    -semihosting-config enable=on,target=native -kernel "$cost_elf" || rc=$?
+  if [ "$rc" -ne 0 ]; then
+    echo "error: $machine: the cost measurement failed (exit status $rc)" >&2
+    status=1
+  fi
+done
+
 # Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
 # tvmd-pil firmware, built above with the target tests) on both boards, compared with the
 # in-process f32 flight (crates/tvmd-sim/tests/pil.rs, #[ignore]d in plain cargo test).

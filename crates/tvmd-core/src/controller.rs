@@ -326,9 +326,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let u_fr = force_request(&self.plant, gains, state, reference);
         let projection = project_force_in(&self.full_cone, &u_fr);
         let f_r = state.attitude * u_fr * projection.t_tf;
+        // `reference.attitude` passed `reference.validate()` above.
         let planner = self
             .planner
-            .plan_in(&self.planner_cone, &reference.attitude, &f_r)
+            .plan_in_valid_attitude(&self.planner_cone, &reference.attitude, &f_r)
             .map_err(reject)?;
         let law = control_wrench(
             &self.plant,

@@ -152,6 +152,18 @@ impl<T: Real> AttitudePlanner<T> {
         f_r: &Vector3<T>,
     ) -> Result<PlannerOutput<T>, InputError> {
         validate_rotation(r_r, "planner.r_r")?;
+        self.plan_in_valid_attitude(cone, r_r, f_r)
+    }
+
+    /// As [`Self::plan_in`] for an `r_r` the caller has already validated with
+    /// [`validate_rotation`] (the controller checks `reference.attitude` on entry to the cycle,
+    /// so checking it again here would repeat the same test each period). `f_r` is still checked.
+    pub(crate) fn plan_in_valid_attitude(
+        &self,
+        cone: &EllipticCone<T>,
+        r_r: &Matrix3<T>,
+        f_r: &Vector3<T>,
+    ) -> Result<PlannerOutput<T>, InputError> {
         if !f_r.iter().all(|x| x.is_finite()) {
             return Err(InputError::NonFinite {
                 field: "planner.f_r",
@@ -166,16 +178,18 @@ impl<T: Real> AttitudePlanner<T> {
         // ||R^T f_r|| = ||f_r||: the thrust bound is checked once, the cross-section per attitude.
         let norm = norm(f_r);
         let within_thrust = norm <= cone.max_force();
-        let feasible = |r: &Matrix3<T>| within_thrust && cone.admits(&(r.transpose() * f_r));
         if norm == T::zero() {
             return Ok(unchanged(PlannerStatus::ZeroForce));
         }
-        if feasible(r_r) {
+        // Each end's membership and search guide from one evaluation (see `guide`).
+        let (phi_r, admits_r) = guide(cone, &(r_r.transpose() * f_r));
+        if within_thrust && admits_r {
             return Ok(unchanged(PlannerStatus::AlreadyFeasible));
         }
         let tilt = Tilt::new(r_r, f_r);
         let end = tilt.attitude(tilt.theta_max);
-        if !feasible(&end) {
+        let (phi_end, admits_end) = guide(cone, &(end.transpose() * f_r));
+        if !(within_thrust && admits_end) {
             return Ok(PlannerOutput {
                 r_d: end,
                 theta: tilt.theta_max,
@@ -183,38 +197,26 @@ impl<T: Real> AttitudePlanner<T> {
                 status: PlannerStatus::Unreachable,
             });
         }
-        Ok(self.search(cone, r_r, f_r, &tilt, end))
+        Ok(self.search(cone, f_r, &tilt, (end, phi_end), phi_r))
     }
 
-    /// The search between `theta = 0` (infeasible) and `theta_max` (`end`, feasible; so
-    /// `||f_r||` is within the thrust bound and only the cross-section is tested).
+    /// The search between `theta = 0` (infeasible, guide `phi_r`) and `theta_max` (`end`,
+    /// feasible, guide `phi_end`; so `||f_r||` is within the thrust bound and only the
+    /// cross-section is tested).
     fn search(
         &self,
         cone: &EllipticCone<T>,
-        r_r: &Matrix3<T>,
         f_r: &Vector3<T>,
         tilt: &Tilt<T>,
-        end: Matrix3<T>,
+        (end, phi_end): (Matrix3<T>, T),
+        phi_r: T,
     ) -> PlannerOutput<T> {
-        // The search's guide: `phi = sqrt(u^T C u) - 1` at `u = R_d(theta)^T f_r`, continuous in
-        // `theta`, positive outside the cross-section and `<= 0` inside (for a round cone of
-        // half-angle `alpha`, `tan(angle) / tan(alpha) - 1`: nearer linear in `theta` than
-        // `u^T C u - 1` or the cone's division-free margin, so fewer secant steps). The ratios
-        // of `quadratic_form` neither overflow nor underflow. Where it cannot guide (`z < 0`,
-        // where `|z|` mirrors the cone; a zero semi-axis, `+inf`), the search bisects.
-        let phi = |u: &Vector3<T>| {
-            if u.z < T::zero() {
-                return T::one() / T::zero();
-            }
-            cone.quadratic_form(u).sqrt() - T::one()
-        };
         // Regula falsi on `phi(theta)` with the Anderson-Bjorck fix against a stalled end,
         // bracketed by the membership test. Invariant: `lo` infeasible, `hi` feasible; `hi` is
         // returned.
         let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
         let (mut z_lo, mut z_hi) = (tilt.b_zr, end.column(2).into_owned());
-        let (mut phi_lo, mut phi_hi) =
-            (phi(&(r_r.transpose() * f_r)), phi(&(end.transpose() * f_r)));
+        let (mut phi_lo, mut phi_hi) = (phi_r, phi_end);
         // Which end moved last: a second move of the same end scales the other end's phi by
         // `1 - phi_new / phi_old` (Anderson-Bjorck; by 1/2, the Illinois factor, when that is
         // not positive). Illinois's fixed 1/2 stalls where phi is steep near `z = 0`.
@@ -265,8 +267,8 @@ impl<T: Real> AttitudePlanner<T> {
             };
             let r = tilt.frame(z);
             let u = r.transpose() * f_r;
-            let value = phi(&u);
-            if cone.admits(&u) {
+            let (value, inside) = guide(cone, &u);
+            if inside {
                 if last_moved_hi == Some(true) {
                     phi_lo *= shrink(value, phi_hi);
                 }
@@ -287,6 +289,22 @@ impl<T: Real> AttitudePlanner<T> {
             status: PlannerStatus::Planned,
         }
     }
+}
+
+/// The search's guide and the membership test at `u = R_d(theta)^T f_r` from one evaluation of
+/// the quadratic form: `(phi, cone.admits(u))`, each exactly as evaluated apart.
+/// `phi = sqrt(u^T C u) - 1` is continuous in `theta`, positive outside the cross-section and
+/// `<= 0` inside (for a round cone of half-angle `alpha`, `tan(angle) / tan(alpha) - 1`: nearer
+/// linear in `theta` than `u^T C u - 1` or the cone's division-free margin, so fewer secant
+/// steps). The ratios of `quadratic_form` neither overflow nor underflow. Where it cannot guide
+/// (`z < 0`, where `|z|` mirrors the cone; a zero semi-axis, `+inf`), the search bisects.
+fn guide<T: Real>(cone: &EllipticCone<T>, u: &Vector3<T>) -> (T, bool) {
+    if u.z < T::zero() {
+        return (T::one() / T::zero(), false);
+    }
+    let q = cone.quadratic_form(u);
+    // `u.z >= 0` is not implied here: a NaN height reaches this line and is not admitted.
+    (q.sqrt() - T::one(), u.z >= T::zero() && q <= T::one())
 }
 
 /// `R_d(theta)` of eqs. (10)-(11): `R_r` tilted by `theta` toward `f_r`, the family the planner
@@ -362,5 +380,49 @@ impl<T: Real> Tilt<T> {
             (b_xd, b_zd.cross(&b_xd))
         };
         Matrix3::from_columns(&[b_xd, b_yd, b_zd])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::team::presets;
+    use crate::FailureMask;
+
+    /// `guide` is `(phi, cone.admits(u))` with `phi` as the search evaluated it on its own:
+    /// `+inf` below the apex, `sqrt(u^T C u) - 1` elsewhere (NaN for a NaN height, which is not
+    /// admitted even where the form would pass, e.g. on the axis).
+    #[test]
+    fn guide_agrees_with_the_separate_evaluations() {
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let cone = team
+            .afs(&FailureMask::none())
+            .unwrap()
+            .cone(Relaxation::new(0.5).unwrap());
+        let w = 2.8 * 9.81;
+        for u in [
+            Vector3::new(0.0, 0.0, w),
+            Vector3::new(1.0, -0.5, w),
+            Vector3::new(30.0, 0.0, w),
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(1.0, 2.0, -w),
+            Vector3::new(0.0, 0.0, f64::NAN),
+            Vector3::new(1.0, 0.0, f64::NAN),
+        ] {
+            let (phi, admits) = guide(&cone, &u);
+            assert_eq!(admits, cone.admits(&u), "admits at {u:?}");
+            let apart = if u.z < 0.0 {
+                f64::INFINITY
+            } else {
+                cone.quadratic_form(&u).sqrt() - 1.0
+            };
+            assert!(
+                phi.to_bits() == apart.to_bits() || (phi.is_nan() && apart.is_nan()),
+                "phi at {u:?}: {phi} vs {apart}"
+            );
+        }
+        assert!(!guide(&cone, &Vector3::new(0.0, 0.0, f64::NAN)).1);
     }
 }

@@ -1,0 +1,219 @@
+//! On-target cost of the f32 control cycle (`Controller::step`, redistributed pseudo-inverse):
+//! instructions per cycle counted on QEMU (`mps2-an386` Cortex-M4F, `mps2-an500` Cortex-M7)
+//! run with `-icount shift=0`, and the cycle's peak stack measured by painting. Cases: hover and
+//! planner-searching cycles of the paper's team (n = 4, A4-Inc) and of a 16-agent inconsistent
+//! ring (the inputs of `examples/cycle_instructions.rs` and `benches/control_cycle.rs`).
+//! Prints one line per case over semihosting; exits with failure if the clock cannot be
+//! calibrated or a cycle does not run as intended. Run by `scripts/target.sh`.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+use core::panic::PanicInfo;
+
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hprintln};
+use tvmd_core::controller::roll;
+use tvmd_core::nalgebra::{convert, ComplexField, Vector3};
+use tvmd_core::team::presets;
+use tvmd_core::{
+    Controller, ControllerSettings, PlannerStatus, RedistributedPseudoInverse, Reference,
+    RigidState, TeamConfig,
+};
+
+mod clock;
+mod stack;
+
+/// Cycles per measurement: the tick quantization (one tick, 40 instructions, at each end of the
+/// cycles' timing and of the overhead's) is spread over them: each count is within
+/// 4 * 40 / REPS = 0.8 instructions.
+const REPS: u32 = 200;
+
+type Cycle<const N: usize> = Controller<f32, N, RedistributedPseudoInverse>;
+
+/// The measured unit: one cycle behind a call, as callgrind's `tvmd_cycle_f32` on x86.
+#[inline(never)]
+fn cycle<const N: usize>(c: &mut Cycle<N>, s: &RigidState<f32>, r: &Reference<f32>) -> f32 {
+    c.step(s, r).map(|o| o.commands[0].thrust).unwrap_or(-1.0)
+}
+
+/// The same call shape with no work: its cost (call, return, loop) is subtracted.
+#[inline(never)]
+fn empty<const N: usize>(_c: &mut Cycle<N>, s: &RigidState<f32>, _r: &Reference<f32>) -> f32 {
+    s.position.x
+}
+
+/// The team of `examples/cycle_instructions.rs` (n = 4) and `benches/control_cycle.rs`
+/// (n = 16: an inconsistent ring of radius `0.5 sqrt(n / 4)`).
+fn team<const N: usize>() -> Option<TeamConfig<f32, N>> {
+    if N == 4 {
+        presets::a4_inc().ok()
+    } else {
+        let radius = 0.5 * ComplexField::sqrt(N as f32 / 4.0);
+        presets::ring(N, radius, true, presets::paper_limits()).ok()
+    }
+}
+
+/// One measured case; `None` if the team or controller was refused.
+struct Measured {
+    instructions: u32,
+    stack: usize,
+    setup_stack: usize,
+    status: PlannerStatus,
+    iterations: u32,
+}
+
+fn measure<const N: usize>(searching: bool, per_tick: u32) -> Option<Measured> {
+    let team = team::<N>()?;
+    let mut built = None;
+    // Set-up (the team's effectiveness, the Gram factor): once per change of team or failures.
+    let setup_stack = stack::peak(&mut || {
+        built = black_box(
+            Controller::new(
+                team,
+                ControllerSettings::paper(),
+                RedistributedPseudoInverse,
+            )
+            .ok(),
+        );
+    });
+    let mut c = built?;
+    let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
+    let mut reference = Reference::hover(if searching {
+        Vector3::new(0.0, 0.0, 1.5)
+    } else {
+        state.position
+    });
+    if searching {
+        reference.attitude = roll(convert::<f64, f32>(core::f64::consts::FRAC_PI_3));
+    }
+    let out = c.step(&state, &reference).ok()?;
+    let (status, iterations) = (out.planner.status, out.planner.iterations);
+    let work = clock::ticks(REPS, &mut || {
+        black_box(cycle(
+            black_box(&mut c),
+            black_box(&state),
+            black_box(&reference),
+        ));
+    });
+    let overhead = clock::ticks(REPS, &mut || {
+        black_box(empty(
+            black_box(&mut c),
+            black_box(&state),
+            black_box(&reference),
+        ));
+    });
+    let per_cycle = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
+    let instructions = ((per_cycle + u64::from(REPS) / 2) / u64::from(REPS)) as u32;
+    let stack = stack::peak(&mut || {
+        black_box(cycle(
+            black_box(&mut c),
+            black_box(&state),
+            black_box(&reference),
+        ));
+    });
+    Some(Measured {
+        instructions,
+        stack,
+        setup_stack,
+        status,
+        iterations,
+    })
+}
+
+fn report<const N: usize>(per_tick: u32) -> bool {
+    let mut ok = true;
+    for searching in [false, true] {
+        let name = if searching { "searching" } else { "hover" };
+        match measure::<N>(searching, per_tick) {
+            Some(m) => {
+                let as_intended = (m.status == PlannerStatus::AlreadyFeasible) != searching;
+                ok &= as_intended;
+                hprintln!(
+                    "cost: n = {:2} {:9} cycle: {:6} instructions, peak stack {:5} B (Controller::new {:5} B; planner {:?}, {} iterations){}",
+                    N,
+                    name,
+                    m.instructions,
+                    m.stack,
+                    m.setup_stack,
+                    m.status,
+                    m.iterations,
+                    if as_intended { "" } else { "  FAIL: not the intended planner case" }
+                );
+            }
+            None => {
+                ok = false;
+                hprintln!("cost: n = {} {}: FAIL: team or controller refused", N, name);
+            }
+        }
+    }
+    hprintln!(
+        "cost: n = {:2} controller state (size_of Controller<f32, {}, _>): {} B",
+        N,
+        N,
+        core::mem::size_of::<Cycle<N>>()
+    );
+    ok
+}
+
+#[entry]
+fn main() -> ! {
+    let ok = run();
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+fn run() -> bool {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        hprintln!("cost: FAIL: core peripherals already taken");
+        return false;
+    };
+    hprintln!(
+        "cost: DWT CYCCNT {}",
+        if clock::dwt_cyccnt_runs(&mut cp.DCB, &mut cp.DWT) {
+            "runs"
+        } else {
+            "does not run (not modelled): SysTick used"
+        }
+    );
+    clock::start(&mut cp.SYST);
+    let cal = clock::calibrate();
+    let per_tick = cal.instructions_per_tick();
+    hprintln!(
+        "cost: calibration: nop loops of 1,002,002 and 11,022,002 instructions took {} and {} SysTick ticks: {} instructions per tick{}",
+        cal.short,
+        cal.long,
+        per_tick,
+        if cal.is_exact() { " (exact)" } else { " (NOT exact)" }
+    );
+    if per_tick == 0 || !cal.is_exact() {
+        hprintln!(
+            "cost: FAIL: the SysTick does not count instructions (run QEMU with -icount shift=0)"
+        );
+        return false;
+    }
+    let a = report::<4>(per_tick);
+    let b = report::<16>(per_tick);
+    a && b
+}
+
+#[panic_handler]
+fn panic(info: &PanicInfo<'_>) -> ! {
+    hprintln!("cost: panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[exception]
+unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+    hprintln!("cost: hard fault at pc {:#010x}", frame.pc());
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
