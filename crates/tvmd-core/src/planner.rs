@@ -364,7 +364,7 @@ impl<T: Real> Tilt<T> {
 
     /// `b_zd(theta) = rot(b_zr, k, theta)`.
     fn direction(&self, theta: T) -> Vector3<T> {
-        let (s, c) = theta.sin_cos();
+        let (s, c) = crate::real::sin_cos(theta);
         (self.b_zr * c + self.k_cross_bz * s).normalize()
     }
 
