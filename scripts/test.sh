@@ -81,8 +81,9 @@ bash scripts/ffi.sh
 
 step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"
 # See scripts/target.sh. Measured on the 2-core development machine: 50 s to apt-get install
-# qemu-system-arm where it is missing, about 70 s to build the firmware from scratch, and under
-# a second per board to run it.
+# qemu-system-arm where it is missing, about 70 s to build the firmwares from scratch, a second
+# per board for the target tests and the cost count, and about 45-95 s for the four
+# processor-in-the-loop flights (the whole step: 82 s with the firmware built).
 bash scripts/target.sh
 
 step "Python wheel (maturin, abi3) and pytest"
