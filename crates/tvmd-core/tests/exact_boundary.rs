@@ -8,18 +8,26 @@ use rand::{rngs::StdRng, Rng, SeedableRng};
 use tvmd_core::team::presets;
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution,
-    FailureMask, GimbalCommand, RedistributedPseudoInverse, TeamConfig,
+    FailureMask, GimbalCommand, Real, RedistributedPseudoInverse, TeamConfig,
 };
 
 const CAP: usize = 10;
 type Team = TeamConfig<f64, CAP>;
 
-fn team_by_index(which: usize) -> Team {
+fn team_by_index<T: Real>(which: usize) -> TeamConfig<T, CAP> {
     match which % 4 {
         0 => presets::a4_inc().unwrap(),
         1 => presets::a4_con().unwrap(),
-        2 => presets::ring(6, 0.5, true, presets::paper_limits()).unwrap(),
-        _ => presets::ring(8, 0.6, false, presets::paper_limits()).unwrap(),
+        2 => presets::ring(6, nalgebra::convert(0.5), true, presets::paper_limits()).unwrap(),
+        _ => presets::ring(8, nalgebra::convert(0.6), false, presets::paper_limits()).unwrap(),
+    }
+}
+
+/// Every set narrowed by the rate window `w` (rad/s over 1 s) around `previous`.
+fn narrow<T: Real>(sets: &mut [AdmissibleSet<T>; CAP], previous: &GimbalCommand<T>, w: T) {
+    let rates = tvmd_core::admissible::RateLimits::new(w, w).unwrap();
+    for s in sets.iter_mut() {
+        *s = s.with_rate_limit(previous, &rates, T::one());
     }
 }
 
@@ -131,11 +139,7 @@ proptest! {
         };
         let e = team.effectiveness(&mask);
         if let Some(w) = window {
-            let previous = GimbalCommand { thrust: 2.0, eta_x: 0.3, eta_y: -0.2 };
-            let rates = tvmd_core::admissible::RateLimits::new(w, w).unwrap();
-            for s in sets.iter_mut() {
-                *s = s.with_rate_limit(&previous, &rates, 1.0);
-            }
+            narrow(&mut sets, &GimbalCommand { thrust: 2.0, eta_x: 0.3, eta_y: -0.2 }, w);
         }
         let wrench = Vector6::from(u) * scale;
         let request = AllocationRequest { effectiveness: &e, sets: &sets, wrench };
@@ -280,8 +284,8 @@ fn reset_and_configure_forget_the_previous_forces() {
 
 #[test]
 fn f32_agrees_with_f64_on_attainable_requests() {
-    let team64 = team_by_index(0);
-    let team32: TeamConfig<f32, CAP> = presets::a4_inc().unwrap();
+    let team64: Team = team_by_index(0);
+    let team32 = team_by_index::<f32>(0);
     let (e64, e32) = (
         team64.effectiveness(&FailureMask::none()),
         team32.effectiveness(&FailureMask::none()),
@@ -326,20 +330,12 @@ proptest! {
         window in proptest::option::of(0.001f32..0.3),
         repeat in 1usize..5,
     ) {
-        let team: TeamConfig<f32, CAP> = match which % 4 {
-            0 => presets::a4_inc().unwrap(),
-            1 => presets::a4_con().unwrap(),
-            2 => presets::ring(6, 0.5, true, presets::paper_limits()).unwrap(),
-            _ => presets::ring(8, 0.6, false, presets::paper_limits()).unwrap(),
-        };
+        let team = team_by_index::<f32>(which);
         let e = team.effectiveness(&FailureMask::none());
         let mut sets = [AdmissibleSet::from_limits(team.limits()); CAP];
         if let Some(w) = window {
             let previous = GimbalCommand { thrust: 2.0, eta_x: centre[0] * 0.5, eta_y: centre[1] * 0.8 };
-            let rates = tvmd_core::admissible::RateLimits::new(w, w).unwrap();
-            for s in sets.iter_mut() {
-                *s = s.with_rate_limit(&previous, &rates, 1.0);
-            }
+            narrow(&mut sets, &previous, w);
         }
         let wrench = Vector6::from(u) * scale;
         let request = AllocationRequest { effectiveness: &e, sets: &sets, wrench };

@@ -9,6 +9,11 @@ use tvmd_ffi::status::*;
 use tvmd_ffi::types::*;
 
 fn created() -> Box<TvmdController> {
+    created_with(TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE)
+}
+
+/// The paper's controller with one of the `TVMD_ALLOCATOR_*`.
+fn created_with(allocator: u32) -> Box<TvmdController> {
     let mut storage = Box::new(TvmdController {
         opaque: [0; TVMD_CONTROLLER_WORDS],
     });
@@ -17,9 +22,11 @@ fn created() -> Box<TvmdController> {
     // SAFETY: valid pointers to live values.
     unsafe {
         assert_eq!(tvmd_config_paper(&mut config), TVMD_OK);
+        config.allocator = allocator;
         assert_eq!(
             tvmd_create(&mut *storage, size_of::<TvmdController>(), &config),
-            TVMD_OK
+            TVMD_OK,
+            "allocator {allocator}"
         );
     }
     storage
@@ -141,21 +148,7 @@ fn every_allocator_constant_creates_a_controller_that_flies() {
         TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE,
         TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
     ] {
-        let mut storage = Box::new(TvmdController {
-            opaque: [0; TVMD_CONTROLLER_WORDS],
-        });
-        let mut config: TvmdConfig = unsafe { std::mem::zeroed() };
-        config.size = size_of::<TvmdConfig>() as u32;
-        // SAFETY: valid pointers to live values.
-        unsafe {
-            assert_eq!(tvmd_config_paper(&mut config), TVMD_OK);
-            config.allocator = allocator;
-            assert_eq!(
-                tvmd_create(&mut *storage, size_of::<TvmdController>(), &config),
-                TVMD_OK,
-                "allocator {allocator}"
-            );
-        }
+        let mut storage = created_with(allocator);
         for x in [0.2, 0.1, 0.0] {
             let (status, out) = step(&mut storage, x);
             assert_eq!(status, TVMD_OK, "allocator {allocator}");
