@@ -21,7 +21,10 @@ use crate::real::{eps, lit, Real};
 ///
 /// Each period starts from admissible forces `f`: the previous period's forces (saturated into
 /// this period's sets) or the redistributed pseudo-inverse's, whichever leaves the smaller
-/// wrench error. Then, in rounds:
+/// wrench error. A previous-period start that does not meet the request first moves in
+/// `null(M)` toward the minimum-norm forces of its own wrench, as far as the exact sets allow,
+/// so the internal forces of a saturation bleed off as the request returns inside instead of
+/// jumping away at once later. Then, in rounds:
 /// 1. the remaining wrench `r = u_d - M f` is spread over the agents that can still move,
 ///    each restricted to the tangent planes of the boundaries it is held on:
 ///    `delta_i = P_i M_i^T (sum_j M_j P_j M_j^T)^-1 r`;
@@ -245,6 +248,32 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     }
 }
 
+impl<T: Real, const N: usize> Walk<'_, T, N> {
+    /// Moves the forces in `null(M)` toward the minimum-norm forces of their own wrench, as far
+    /// as every agent's exact set allows (`M f` unchanged to round-off). The previous period's
+    /// forces carry the internal forces of the last saturation; without this they persist
+    /// until the redistributed pseudo-inverse's start is exact again, and the commands jump
+    /// there (measured: 0.17 rad in one period on paper-tilt at `s = 1`).
+    fn shed_internal(&mut self) {
+        let lambda = solve_gram(&self.gram, &self.effectiveness.wrench(&self.forces));
+        let mut delta = [Vector3::zeros(); N];
+        for (((d, block), f), w) in delta
+            .iter_mut()
+            .zip(self.effectiveness.blocks())
+            .zip(&self.forces)
+            .zip(&self.working)
+        {
+            if let (Some(block), true) = (block, *w) {
+                *d = block.tr_mul(&lambda) - f;
+            }
+        }
+        if delta.iter().all(|d| d.iter().all(|x| x.is_finite())) {
+            let (tau, _) = self.step(&delta);
+            self.advance(tau, &delta);
+        }
+    }
+}
+
 /// `f` of every set, computed once per run of equal sets (the agents usually share one set, and
 /// the constraints cost trigonometry).
 fn per_set<T: Real, U: Copy, const N: usize>(
@@ -323,6 +352,11 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             forces,
             active: [ActiveSet::default(); N],
         };
+        // A kept start that already meets the request stays as it is (a repeated request keeps
+        // its forces); any other sheds internal force before it walks.
+        if forces != start.forces && max_abs(&walk.remaining(&request.wrench)) > tol {
+            walk.shed_internal();
+        }
         let limit = 2 * e.working_count() + 4;
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
