@@ -36,7 +36,7 @@
 // `max_thrust = rho d^4 c_l sigma_omega^2` and `omega` in rad/s (`max_thrust` is ignored).
 #define TVMD_ROTOR_CONSTANTS 1
 
-// `allocator`: the redistributed pseudo-inverse (the paper's; the default).
+// `allocator`: the redistributed pseudo-inverse (the paper's).
 #define TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE 0
 
 // `allocator`: the plain pseudo-inverse.
@@ -45,8 +45,9 @@
 // `allocator`: the weighted pseudo-inverse with `agent_weights`.
 #define TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE 2
 
-// `allocator`: the exact-boundary incremental redistribution (starts from the previous
-// period's forces; `tvmd_reset` and `tvmd_set_failures` forget them).
+// `allocator`: the exact-boundary incremental redistribution, the default of
+// `tvmd_config_paper` (starts from the previous period's forces; `tvmd_reset` and
+// `tvmd_set_failures` forget them).
 #define TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION 3
 
 // `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
@@ -465,7 +466,8 @@ size_t tvmd_controller_align(void);
 // Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
 // square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
 // `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
-// no rate limits, the redistributed pseudo-inverse. The caller sets `config->size` first.
+// no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
+// and Python interfaces). The caller sets `config->size` first.
 //
 // # Safety
 // `config` is null or points to a writable `TvmdConfig`.

@@ -117,7 +117,8 @@ pub(crate) unsafe fn controller<'a>(
 /// Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
 /// square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
 /// `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
-/// no rate limits, the redistributed pseudo-inverse. The caller sets `config->size` first.
+/// no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
+/// and Python interfaces). The caller sets `config->size` first.
 ///
 /// # Safety
 /// `config` is null or points to a writable `TvmdConfig`.
@@ -164,7 +165,7 @@ pub unsafe extern "C" fn tvmd_config_paper(config: *mut TvmdConfig) -> TvmdStatu
         period: settings.period,
         rate_limited: 0,
         rate_limits: [0.0; 2],
-        allocator: TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE,
+        allocator: TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
         agent_weights: [1.0; TVMD_MAX_AGENTS],
     };
     TVMD_OK

@@ -73,14 +73,15 @@ pub struct TvmdGains {
     pub k_v: [f32; 9],
 }
 
-/// `allocator`: the redistributed pseudo-inverse (the paper's; the default).
+/// `allocator`: the redistributed pseudo-inverse (the paper's).
 pub const TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE: u32 = 0;
 /// `allocator`: the plain pseudo-inverse.
 pub const TVMD_ALLOCATOR_PSEUDO_INVERSE: u32 = 1;
 /// `allocator`: the weighted pseudo-inverse with `agent_weights`.
 pub const TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE: u32 = 2;
-/// `allocator`: the exact-boundary incremental redistribution (starts from the previous
-/// period's forces; `tvmd_reset` and `tvmd_set_failures` forget them).
+/// `allocator`: the exact-boundary incremental redistribution, the default of
+/// `tvmd_config_paper` (starts from the previous period's forces; `tvmd_reset` and
+/// `tvmd_set_failures` forget them).
 pub const TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION: u32 = 3;
 
 /// Everything `tvmd_create` needs. `tvmd_config_paper` fills the paper's team and settings.

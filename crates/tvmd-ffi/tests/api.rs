@@ -22,6 +22,11 @@ fn created_with(allocator: u32) -> Box<TvmdController> {
     // SAFETY: valid pointers to live values.
     unsafe {
         assert_eq!(tvmd_config_paper(&mut config), TVMD_OK);
+        // The default allocator, as `AnyAllocator::default()` in Rust.
+        assert_eq!(
+            config.allocator,
+            TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION
+        );
         config.allocator = allocator;
         assert_eq!(
             tvmd_create(&mut *storage, size_of::<TvmdController>(), &config),

@@ -25,7 +25,7 @@ pub struct PyController {
 #[pymethods]
 impl PyController {
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "redistributed-pseudo-inverse", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,

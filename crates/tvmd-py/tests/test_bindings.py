@@ -468,6 +468,9 @@ def test_pseudo_inverse_allocation_random(agreement):
             assert out.e_f < 1e-9 and out.wrench_error < 1e-9
             _close(out.wrench, u_d, rtol=1e-9, atol=1e-9)
             # Redistribution changes nothing when nothing saturates.
+            red = tvmd.allocate(team, u_d, method="redistributed-pseudo-inverse")
+            _close(red.forces, out.forces, rtol=1e-12, atol=1e-12)
+            # Nor does the exact-boundary walk (the default), which returns that start then.
             red = tvmd.allocate(team, u_d)
             _close(red.forces, out.forces, rtol=1e-12, atol=1e-12)
         # Weighted pseudo-inverse: per-agent weights w_i -> W = diag(repeat(w, 3)).
@@ -579,7 +582,8 @@ def test_controller_step_matches_reference(agreement):
 def test_controller_outputs_and_state():
     team = tvmd.Team.a4_inc()
     ctrl = tvmd.Controller(team, rate_limits=(2.0, 2.0))
-    assert ctrl.allocator == "redistributed-pseudo-inverse" and ctrl.relaxation == 0.5 and ctrl.period == 0.01
+    assert ctrl.allocator == "exact-boundary-redistribution" and ctrl.relaxation == 0.5 and ctrl.period == 0.01
+    assert tvmd.ALLOCATORS[0] == ctrl.allocator  # the default first, as the core's table
     assert ctrl.rate_limits == (2.0, 2.0) and ctrl.failed == [] and ctrl.gravity == 9.81
     assert ctrl.team.n == 4 and ctrl.afs.n == 4 and ctrl.planner_max_iterations == 64
     out = ctrl.step({"position": [0.5, -0.5, 0.0]}, {"position": [0.0, 0.0, 1.5], "attitude": ri.rot_x(1.0)})
@@ -599,7 +603,7 @@ def test_controller_outputs_and_state():
         assert value.dtype == (np.bool_ if key == "saturated" else np.float64), key
         np.testing.assert_array_equal(value, getattr(out if part is None else getattr(out, part), key))
     assert out.planner.status == "planned" and out.planner.theta > 0.0
-    assert out.allocation.method == "redistributed-pseudo-inverse" and out.allocation.report is None
+    assert out.allocation.method == "exact-boundary-redistribution" and out.allocation.report is None
     assert repr(out).startswith("StepOutput(planner=PlannerResult(R_d=array(") and "command_clamp=" in repr(out)
     # Every access returns fresh arrays.
     out.planner.R_d[:] = 0.0

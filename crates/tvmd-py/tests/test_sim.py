@@ -98,7 +98,7 @@ def test_paper_shapes_and_metadata(paper):
     assert len(paper) == K
     assert paper.scenario_name == "paper-tilt"
     assert paper.relaxation == PAPER_S
-    assert paper.allocator == "redistributed-pseudo-inverse"
+    assert paper.allocator == "exact-boundary-redistribution"
     assert paper.mcap_path is None
     assert paper.n_agents == 4
     assert math.isclose(paper.mass, 4 * 0.7)

@@ -6,9 +6,9 @@
 //!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
 //!              [--pil cortex-m4|cortex-m7]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
-//!                [--precision f64|f32]
+//!                [--allocator NAME] [--precision f64|f32]
 //! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
-//! tvmd-sim record-cycles [SCENARIO|FILE.toml] --out FILE [--cycles 1000]
+//! tvmd-sim record-cycles [SCENARIO|FILE.toml] --out FILE [--cycles 1000] [--allocator NAME]
 //! tvmd-sim list
 //! tvmd-sim show NAME
 //! ```
@@ -61,8 +61,8 @@ enum Command {
         /// Override the scenario's planner relaxation s.
         #[arg(long)]
         relaxation: Option<f64>,
-        /// Override the scenario's allocator (redistributed-pseudo-inverse, pseudo-inverse,
-        /// weighted-pseudo-inverse, exact-boundary-redistribution, clarabel).
+        /// Override the scenario's allocator (exact-boundary-redistribution, the default;
+        /// redistributed-pseudo-inverse, pseudo-inverse, weighted-pseudo-inverse, clarabel).
         #[arg(long)]
         allocator: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
@@ -89,6 +89,10 @@ enum Command {
         /// Consecutive control cycles to record, from the first.
         #[arg(long, default_value_t = 1000)]
         cycles: usize,
+        /// Override the scenario's allocator (the committed recording pins
+        /// redistributed-pseudo-inverse, the paper's cycle).
+        #[arg(long)]
+        allocator: Option<String>,
     },
     /// The relaxation study: the scenario flown once per relaxation s (in parallel threads).
     Sweep {
@@ -114,6 +118,9 @@ enum Command {
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
         precision: Option<String>,
+        /// Override the scenario's allocator (as `run --allocator`).
+        #[arg(long)]
+        allocator: Option<String>,
     },
     /// Re-plot runs from their MCAP logs: figures of each run, and the relaxation-study figure
     /// when several logs are given.
@@ -196,7 +203,8 @@ fn main() -> ExitCode {
             scenario,
             out,
             cycles,
-        } => cmd_record_cycles(&scenario, &out, cycles),
+            allocator,
+        } => cmd_record_cycles(&scenario, &out, cycles, allocator),
         Command::Sweep {
             relaxations,
             scenario,
@@ -205,15 +213,22 @@ fn main() -> ExitCode {
             summary,
             jobs,
             precision,
-        } => cmd_sweep(
-            &relaxations,
-            &scenario,
-            precision.as_deref(),
-            plots,
-            logs,
-            summary,
-            jobs,
-        ),
+            allocator,
+        } => precision_arg(precision.as_deref()).and_then(|precision| {
+            cmd_sweep(
+                &relaxations,
+                &scenario,
+                Overrides {
+                    precision,
+                    allocator,
+                    ..Overrides::default()
+                },
+                plots,
+                logs,
+                summary,
+                jobs,
+            )
+        }),
         Command::Plot { logs, out } => cmd_plot(&logs, &out),
         Command::List => {
             for name in BUILTIN_NAMES {
@@ -293,8 +308,16 @@ fn precision_arg(p: Option<&str>) -> Result<Option<Precision>, CliError> {
     Ok(p.map(str::parse).transpose()?)
 }
 
-fn cmd_record_cycles(scenario: &str, out: &Path, cycles: usize) -> Result<(), CliError> {
-    let scenario = Scenario::load(scenario)?;
+fn cmd_record_cycles(
+    scenario: &str,
+    out: &Path,
+    cycles: usize,
+    allocator: Option<String>,
+) -> Result<(), CliError> {
+    let scenario = Scenario::load(scenario)?.with_overrides(&Overrides {
+        allocator,
+        ..Overrides::default()
+    })?;
     let recording = record_cycles(&scenario, cycles)?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
@@ -483,6 +506,7 @@ fn print_run(r: &RunReport<'_>) {
 struct SweepRow {
     relaxation: f64,
     controller_precision: Precision,
+    allocator: String,
     max_planned_roll: Option<f64>,
     hover_roll_limit: f64,
     max_e_f: Option<f64>,
@@ -498,16 +522,13 @@ struct SweepRow {
 fn cmd_sweep(
     relaxations: &[f64],
     scenario_arg: &str,
-    precision: Option<&str>,
+    overrides: Overrides,
     plots: Option<PathBuf>,
     logs: Option<PathBuf>,
     summary: Option<PathBuf>,
     jobs: Option<usize>,
 ) -> Result<(), CliError> {
-    let base = Scenario::load(scenario_arg)?.with_overrides(&Overrides {
-        precision: precision_arg(precision)?,
-        ..Overrides::default()
-    })?;
+    let base = Scenario::load(scenario_arg)?.with_overrides(&overrides)?;
     let specs = sweep_specs(&base, relaxations, logs.as_deref())?;
     if specs.is_empty() {
         return Err(CliError::Other("no relaxation given".into()));
@@ -528,6 +549,7 @@ fn cmd_sweep(
         rows.push(SweepRow {
             relaxation: sc.relaxation,
             controller_precision: sc.controller_precision,
+            allocator: sc.allocator.clone(),
             max_planned_roll: s.max_planned_roll,
             hover_roll_limit: hover_roll_limit(sc, sc.relaxation)?,
             max_e_f: s.max_e_f,
@@ -545,7 +567,10 @@ fn cmd_sweep(
             &r.samples,
         ));
     }
-    println!("controller precision: {}", base.controller_precision);
+    println!(
+        "controller precision: {}, allocator: {}",
+        base.controller_precision, base.allocator
+    );
     let na =
         |v: Option<f64>, prec: usize| v.map_or_else(|| "-".to_string(), |x| format!("{x:.prec$}"));
     println!(

@@ -232,6 +232,28 @@ fn sweep_prints_one_row_per_relaxation() {
     assert_eq!(rows[0]["relaxation"], 0.5);
     assert!((rows[0]["hover_roll_limit"].as_f64().unwrap() - 0.328708).abs() < 1e-6);
     assert!(dir.join("relaxation.png").is_file());
+    assert_eq!(rows[0]["allocator"], "exact-boundary-redistribution");
+    // `--allocator` pins another one (the paper's, for its `s = 1` row).
+    let stdout = ok(bin()
+        .args(["sweep", "--relaxations", "1.0", "--scenario"])
+        .arg(&scenario)
+        .args(["--allocator", "redistributed-pseudo-inverse", "--summary"])
+        .arg(&table)
+        .output()
+        .unwrap());
+    assert!(
+        stdout.contains("allocator: redistributed-pseudo-inverse"),
+        "{stdout}"
+    );
+    let rows: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(&table).unwrap()).unwrap();
+    assert_eq!(rows[0]["allocator"], "redistributed-pseudo-inverse");
+    let out = bin()
+        .args(["sweep", "--relaxations", "1.0", "--allocator", "magic"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("allocator"));
     let out = bin()
         .args(["sweep", "--relaxations", "0.5,1.5"])
         .output()

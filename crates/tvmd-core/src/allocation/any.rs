@@ -13,9 +13,9 @@ use crate::real::Real;
 pub const PSEUDO_INVERSE: &str = "pseudo-inverse";
 /// Name of [`WeightedPseudoInverse`].
 pub const WEIGHTED_PSEUDO_INVERSE: &str = "weighted-pseudo-inverse";
-/// Name of [`RedistributedPseudoInverse`], the default (the paper's).
+/// Name of [`RedistributedPseudoInverse`] (the paper's).
 pub const REDISTRIBUTED_PSEUDO_INVERSE: &str = "redistributed-pseudo-inverse";
-/// Name of [`ExactBoundaryRedistribution`].
+/// Name of [`ExactBoundaryRedistribution`], the default (`docs/method.md`, "Allocation").
 pub const EXACT_BOUNDARY_REDISTRIBUTION: &str = "exact-boundary-redistribution";
 /// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without
 /// the feature can say what is missing).
@@ -23,18 +23,18 @@ pub const CLARABEL: &str = "clarabel";
 
 #[cfg(feature = "clarabel")]
 const NAMES: &[&str] = &[
+    EXACT_BOUNDARY_REDISTRIBUTION,
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
-    EXACT_BOUNDARY_REDISTRIBUTION,
     CLARABEL,
 ];
 #[cfg(not(feature = "clarabel"))]
 const NAMES: &[&str] = &[
+    EXACT_BOUNDARY_REDISTRIBUTION,
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
-    EXACT_BOUNDARY_REDISTRIBUTION,
 ];
 
 /// Options of [`AnyAllocator::from_name`]; each applies to one allocator only.
@@ -65,7 +65,8 @@ impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
 /// use tvmd_core::allocation::AllocatorOptions;
 ///
 /// let names = AnyAllocator::<f64, 4>::NAMES;
-/// assert_eq!(names[0], "redistributed-pseudo-inverse");
+/// assert_eq!(names[0], "exact-boundary-redistribution");
+/// assert_eq!(AnyAllocator::<f64, 4>::default().name(), names[0]);
 /// let a = AnyAllocator::<f64, 4>::from_name("pseudo-inverse", &AllocatorOptions::default())?;
 /// assert_eq!(a.name(), "pseudo-inverse");
 /// assert!(AnyAllocator::<f64, 4>::from_name("magic", &AllocatorOptions::default()).is_err());
@@ -91,7 +92,7 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
     pub const NAMES: &'static [&'static str] = NAMES;
 
     /// The name of the default allocator.
-    pub const DEFAULT_NAME: &'static str = REDISTRIBUTED_PSEUDO_INVERSE;
+    pub const DEFAULT_NAME: &'static str = EXACT_BOUNDARY_REDISTRIBUTION;
 
     /// The allocator named `name` (one of [`Self::NAMES`]) with `options`.
     ///
@@ -172,9 +173,9 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
 }
 
 impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
-    /// The redistributed pseudo-inverse.
+    /// The exact-boundary redistribution, with no previous forces.
     fn default() -> Self {
-        Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
+        Self::ExactBoundaryRedistribution(ExactBoundaryRedistribution::new())
     }
 }
 

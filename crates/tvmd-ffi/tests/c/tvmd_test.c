@@ -227,6 +227,8 @@ static void test_create_errors(void) {
   for (i = 0; i < TVMD_MAX_AGENTS; ++i) bad.agent_weights[i] = 0.0f; /* unused slots ignored */
   for (i = 0; i < bad.agent_count; ++i) bad.agent_weights[i] = 1.0f + (float)i;
   CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+  bad = config; bad.allocator = TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE; /* the paper's */
+  CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
   bad = config; bad.allocator = TVMD_ALLOCATOR_PSEUDO_INVERSE;
   bad.limits.rotor_model = TVMD_ROTOR_CONSTANTS;
   bad.limits.rho = 1.225f; bad.limits.rotor_diameter = 0.254f;

@@ -11,7 +11,8 @@ UAV*). Equation numbers refer to the paper.
 * :class:`AttitudePlanner` -- the bisection planner (eqs. 9-11).
 * :class:`Gains`, :class:`State`, :class:`Reference`, :class:`Plant`, :func:`force_request`,
   :func:`control_wrench` -- the control law (eq. 12).
-* :func:`allocate` -- the allocators (pseudo-inverse, weighted, redistributed, Clarabel).
+* :func:`allocate` -- the allocators (exact-boundary redistribution, the default; redistributed,
+  pseudo-inverse, weighted, Clarabel).
 * :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`
   (``out.planner``, ``out.projection``, ``out.law``, ``out.allocation``, ``out.commands``).
 * :mod:`tvmd.sim` -- the simulator ``tvmd-sim`` (the paper's simulation, relaxation study).

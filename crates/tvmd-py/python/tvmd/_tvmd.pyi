@@ -33,10 +33,10 @@ _StateLike = Union["State", Mapping[str, ArrayLike]]
 _ReferenceLike = Union["Reference", Mapping[str, ArrayLike]]
 
 AllocatorName = Literal[
+    "exact-boundary-redistribution",
+    "redistributed-pseudo-inverse",
     "pseudo-inverse",
     "weighted-pseudo-inverse",
-    "redistributed-pseudo-inverse",
-    "exact-boundary-redistribution",
     "clarabel",
 ]
 """The allocators (``"clarabel"`` only with the cargo feature, see ``ALLOCATORS``)."""
@@ -791,7 +791,7 @@ class Allocation:
 def allocate(
     team: Team,
     wrench: ArrayLike,
-    method: AllocatorName = "redistributed-pseudo-inverse",
+    method: AllocatorName = "exact-boundary-redistribution",
     weights: Optional[ArrayLike] = None,
     failed: _Failed = None,
     previous: Optional[ArrayLike] = None,
@@ -806,12 +806,14 @@ def allocate(
         "pseudo-inverse": ``f = M^T (M M^T)^-1 u_d``, then each agent outside ``E_f`` is clamped.
         "weighted-pseudo-inverse": minimizes ``sum_i w_i ||f_i||^2`` s.t. ``M f = u_d``, clamped;
             ``weights`` (n,) positive per-agent weights are required.
-        "redistributed-pseudo-inverse" (default): Jin 2005 redistribution: the agent leaving
-            ``E_f`` furthest is saturated and fixed, the rest of the wrench is redistributed.
-        "exact-boundary-redistribution": walks from the redistributed pseudo-inverse's forces
-            toward ``u_d``, stopping each agent on the exact boundary of ``E_f`` (closed form)
-            and moving it along that boundary afterwards; never clamps (a one-shot call has no
-            previous period to start from; the controller's allocator keeps one).
+        "redistributed-pseudo-inverse": Jin 2005 redistribution (the paper's): the agent
+            leaving ``E_f`` furthest is saturated and fixed, the rest of the wrench is
+            redistributed.
+        "exact-boundary-redistribution" (default): walks from the redistributed
+            pseudo-inverse's forces toward ``u_d``, stopping each agent on the exact boundary of
+            ``E_f`` (closed form) and moving it along that boundary afterwards; never clamps (a
+            one-shot call has no previous period to start from; the controller's allocator
+            keeps one).
         "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
             ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
             diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).
@@ -873,7 +875,7 @@ class Controller:
         relaxation: Optional[float] = None,
         gravity: float = ...,
         period: float = 0.01,
-        allocator: AllocatorName = "redistributed-pseudo-inverse",
+        allocator: AllocatorName = "exact-boundary-redistribution",
         rate_limits: Optional[ArrayLike] = None,
         failed: _Failed = None,
         weights: Optional[ArrayLike] = None,

@@ -11,7 +11,7 @@
 //! controller_period = 0.01
 //! initial_position = [0.5, -0.5, 0.0]
 //! relaxation = 0.5
-//! allocator = "redistributed-pseudo-inverse"   # "pseudo-inverse", "clarabel", ...
+//! allocator = "exact-boundary-redistribution" # "redistributed-pseudo-inverse", "clarabel", ...
 //! controller_precision = "f64"               # or "f32": the flight configuration
 //! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
 //!
@@ -389,9 +389,10 @@ pub struct Scenario {
     pub initial_position: [f64; 3],
     /// Planner relaxation `s` in `(0, 1]`; 0.5.
     pub relaxation: f64,
-    /// Allocator name, interpreted by the controller; `"redistributed-pseudo-inverse"`
-    /// (also `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights,
-    /// `"exact-boundary-redistribution"`, and `"clarabel"` with the `clarabel` feature).
+    /// Allocator name, interpreted by the controller; `"exact-boundary-redistribution"`
+    /// (the core's default; also `"redistributed-pseudo-inverse"`, the paper's,
+    /// `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and `"clarabel"` with
+    /// the `clarabel` feature).
     pub allocator: String,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
@@ -432,7 +433,7 @@ impl Default for Scenario {
             controller_period: 0.01,
             initial_position: [0.5, -0.5, 0.0],
             relaxation: 0.5,
-            allocator: "redistributed-pseudo-inverse".into(),
+            allocator: tvmd_core::AnyAllocator::<f64, 1>::DEFAULT_NAME.into(),
             controller_rate_limits: None,
             controller_precision: Precision::F64,
             physics: PhysicsConfig::default(),

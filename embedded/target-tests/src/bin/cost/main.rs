@@ -1,4 +1,5 @@
-//! On-target cost of the f32 control cycle (`Controller::step`, redistributed pseudo-inverse):
+//! On-target cost of the f32 control cycle (`Controller::step`, redistributed pseudo-inverse,
+//! named rather than the default allocator: BENCHMARKS.md's counts are of the paper's cycle):
 //! instructions per cycle counted on QEMU (`mps2-an386` Cortex-M4F, `mps2-an500` Cortex-M7)
 //! run with `-icount shift=0`, and the cycle's peak stack measured by painting. Cases: hover and
 //! planner-searching cycles of the paper's team (n = 4, A4-Inc) and of a 16-agent inconsistent
