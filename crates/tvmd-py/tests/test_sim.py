@@ -256,11 +256,15 @@ def test_relaxation_sweep_order_and_planned_roll(sweep):
     assert all(a < b for a, b in zip(rolls, rolls[1:])), rolls
     for r, roll in zip(sweep, rolls):
         assert abs(roll - hover_roll_limit(r.relaxation)) < 0.01, (r.relaxation, roll)
-    # s <= 0.75: no visible allocation error; s = 1: e_f > 0 near the largest tilt (paper).
-    for r in sweep[:3]:
+    # s <= 0.75: no visible allocation error; with the default exact-boundary redistribution
+    # not at s = 1 either (issue 16's done-when, <= 1e-6 m_C g).
+    assert all(r.allocator == "exact-boundary-redistribution" for r in sweep)
+    for r in sweep:
         assert r.summary["max_e_f_over_weight"] <= 1e-6
-    assert sweep[3].summary["max_e_f_over_weight"] > 1e-6
-    assert 4.0 < sweep[3].summary["max_e_f_time"] < 10.0
+    # The paper's observation with its allocator pinned: s = 1, e_f > 0 near the largest tilt.
+    rpi = sim.relaxation_sweep([1.0], allocator="redistributed-pseudo-inverse")[0]
+    assert rpi.summary["max_e_f_over_weight"] > 1e-6
+    assert 4.0 < rpi.summary["max_e_f_time"] < 10.0
 
 
 def test_relaxation_sweep_matches_single_runs(sweep, paper):
