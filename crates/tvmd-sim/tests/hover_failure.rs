@@ -29,8 +29,9 @@ fn run_with(name: &str, land: bool, precision: Precision, allocator: Option<&str
 fn a4_inc_failure_is_classified_not_capable_and_keeps_flying_by_default() {
     for precision in Precision::ALL {
         // Pinned to the redistributed pseudo-inverse, whose saturation issue 13 made honest.
-        // The default exact-boundary redistribution does not balance there: measured max tilt
-        // 0.613 rad in f64, 0.521 in f32, against 0.085 and 0.089 (not analysed; README, reproduction table).
+        // The default exact-boundary redistribution hovers as well after the failure but tilts
+        // more in the descent from 12 s: measured max tilt 0.613 rad in f64, 0.521 in f32, at
+        // t = 16 s, against 0.085 and 0.089 (not analysed; README, reproduction table).
         let r = run_with(
             "agent-failure",
             false,
