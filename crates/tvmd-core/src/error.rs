@@ -233,7 +233,8 @@ pub enum ConfigError {
     UnknownAllocator,
     /// The named allocator needs a cargo feature this build does not have.
     AllocatorUnavailable {
-        /// The allocator, which is also the feature (`"clarabel"`).
+        /// The allocator (`"clarabel"` or `"clarabel-sequential"`, both of the feature
+        /// `clarabel`).
         name: &'static str,
     },
     /// An option given to [`crate::AnyAllocator::from_name`] that the named allocator does not
@@ -345,7 +346,7 @@ impl fmt::Display for ConfigError {
             ),
             Self::AllocatorUnavailable { name } => write!(
                 f,
-                "allocator `{name}` needs the cargo feature `{name}`, which this build lacks"
+                "allocator `{name}` needs the cargo feature `clarabel`, which this build lacks"
             ),
             Self::UnusedOption { field } => {
                 write!(f, "the allocator takes no `{field}` option")
