@@ -518,6 +518,23 @@ def test_clarabel_allocation():
     assert step.allocation.report is not None and step.allocation.method == "clarabel"
 
 
+@pytest.mark.skipif(not tvmd.HAS_CLARABEL, reason="built without the cargo feature `clarabel`")
+def test_clarabel_sequential_allocation():
+    team = tvmd.Team.a4_inc()
+    # A saturating request: never worse than the redistributed pseudo-inverse.
+    mg = team.mass * 9.81
+    u_d = np.array([0.5, -0.4, 0.1, 12.0, -9.0, mg])
+    rpi = tvmd.allocate(team, u_d, method="redistributed-pseudo-inverse")
+    out = tvmd.allocate(team, u_d, method="clarabel-sequential")
+    assert out.method == "clarabel-sequential" and out.report is not None and "convex steps" in out.report
+    assert out.wrench_error <= rpi.wrench_error * (1 + 1e-12) + 1e-12
+    assert "clarabel-sequential" in tvmd.ALLOCATORS
+    ctrl = tvmd.Controller(team, allocator="clarabel-sequential")
+    step = ctrl.step({"position": [0, 0, 1]}, {"position": [0, 0, 1]})
+    assert step.allocation.report is not None and step.allocation.method == "clarabel-sequential"
+    assert step.allocation.e_f < 1e-9
+
+
 # ---------------------------------------------------------------------------
 # Controller
 # ---------------------------------------------------------------------------
@@ -804,6 +821,8 @@ def test_clarabel_not_built():
         tvmd.allocate(A4, np.zeros(6), method="clarabel")
     with pytest.raises(ValueError, match="cargo feature `clarabel`"):
         tvmd.Controller(A4, allocator="clarabel")
+    with pytest.raises(ValueError, match="'clarabel-sequential' is not available"):
+        tvmd.allocate(A4, np.zeros(6), method="clarabel-sequential")
 
 
 # ---------------------------------------------------------------------------

@@ -62,7 +62,8 @@ enum Command {
         #[arg(long)]
         relaxation: Option<f64>,
         /// Override the scenario's allocator (redistributed-pseudo-inverse, pseudo-inverse,
-        /// weighted-pseudo-inverse, exact-boundary-redistribution, clarabel).
+        /// weighted-pseudo-inverse, exact-boundary-redistribution, clarabel,
+        /// clarabel-sequential).
         #[arg(long)]
         allocator: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight

@@ -38,8 +38,10 @@ AllocatorName = Literal[
     "redistributed-pseudo-inverse",
     "exact-boundary-redistribution",
     "clarabel",
+    "clarabel-sequential",
 ]
-"""The allocators (``"clarabel"`` only with the cargo feature, see ``ALLOCATORS``)."""
+"""The allocators (``"clarabel"`` and ``"clarabel-sequential"`` only with the cargo feature, see
+``ALLOCATORS``)."""
 PlannerStatus = Literal["already-feasible", "planned", "zero-force", "unreachable"]
 """How the attitude planner reached its output."""
 Arrangement = Literal["Con", "Inc"]
@@ -754,7 +756,8 @@ class Allocation:
         saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
         fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
         method: the allocator's name.
-        report: Clarabel's solve report (text), None for the other allocators.
+        report: the solve report (text) of "clarabel" and "clarabel-sequential", None for the
+            other allocators.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -784,7 +787,7 @@ class Allocation:
         """The allocator's name."""
     @property
     def report(self) -> Optional[str]:
-        """Clarabel's solve report, None otherwise."""
+        """The solve report of "clarabel" and "clarabel-sequential", None otherwise."""
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
 
@@ -815,6 +818,13 @@ def allocate(
         "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
             ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
             diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).
+        "clarabel-sequential": the same objective over the exact ``E_f`` by sequential convex
+            steps: from the redistributed pseudo-inverse's forces, each step a QP over ``E_f``
+            linearized at the current forces (an inner bound that keeps the gimbal corners the
+            "clarabel" pyramid drops), at most 5 steps, stopping when the wrench is exact
+            (relative 1e-9) or the objective decreases by less than 1e-6 relatively; never worse
+            than "redistributed-pseudo-inverse". Needs the cargo feature ``clarabel``;
+            ``weights`` (6,) is ``W``, ``regularization`` is ``lambda`` (default 0).
 
     Args:
         team: the ``Team``.
@@ -827,13 +837,13 @@ def allocate(
         rate_limits: ``(eta_x_rate, eta_y_rate)`` (rad/s): narrows each gimbal range to
             ``|eta - eta_prev| <= rate dt``.
         dt: the control period (s), required with ``rate_limits``.
-        regularization: ``lambda`` of "clarabel".
+        regularization: ``lambda`` of "clarabel" and "clarabel-sequential".
 
     Returns:
         Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
 
     Raises:
-        ValueError: an unknown method, "clarabel" without the feature, options that do not
+        ValueError: an unknown method, "clarabel" or "clarabel-sequential" without the feature, options that do not
             apply to the method, wrong shapes, NaN/inf input.
         ConfigError: a degraded team that cannot produce every wrench, bad weights or rates.
     """
@@ -856,14 +866,15 @@ class Controller:
         rate_limits: optional ``(eta_x_rate, eta_y_rate)`` gimbal rate limits (rad/s).
         failed: None or failed agent indices.
         weights: allocator weights (see ``tvmd.allocate``).
-        regularization: ``lambda`` of the "clarabel" allocator.
+        regularization: ``lambda`` of the "clarabel" and "clarabel-sequential" allocators.
         planner_tolerance: bisection tolerance (rad); default ``max(1e-10, 8 eps)``.
         planner_max_iterations: bisection iteration cap; default 64.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
             produce every wrench.
-        ValueError: unknown allocator, "clarabel" without the cargo feature, wrong shapes.
+        ValueError: unknown allocator, "clarabel" or "clarabel-sequential" without the cargo
+            feature, wrong shapes.
     """
 
     def __new__(

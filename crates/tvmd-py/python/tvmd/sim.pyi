@@ -209,8 +209,8 @@ def run(
         mcap: write an MCAP log there (parent directories are created; open it in Foxglove).
         relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
         allocator: override the allocator ("redistributed-pseudo-inverse", "pseudo-inverse",
-            "weighted-pseudo-inverse", "exact-boundary-redistribution", "clarabel" with the
-            cargo feature).
+            "weighted-pseudo-inverse", "exact-boundary-redistribution", "clarabel" and
+            "clarabel-sequential" with the cargo feature).
         precision: override the controller's float type (scenario field
             ``controller_precision``): "f32" flies ``tvmd_core::Controller<f32, ..>``, the type a
             flight controller runs; "f64" (the default). The physics stays f64; the summary's

@@ -143,8 +143,10 @@ pub fn allocator<T: CoreFloat>(name: &str) -> Result<AnyAllocator<T, MAX_AGENTS>
         ),
         ConfigError::AllocatorUnavailable { .. } => invalid(
             "allocator",
-            "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
-             (cargo build --features clarabel)",
+            format!(
+                "allocator `{name}` needs tvmd-sim built with the `clarabel` feature \
+                 (cargo build --features clarabel)"
+            ),
         ),
         e => config_error(e),
     })

@@ -74,7 +74,8 @@ pub use overrides::Overrides;
 use validate::invalid;
 
 /// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
-/// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
+/// scenario may also name `"clarabel"` or `"clarabel-sequential"`, which need the `clarabel`
+/// feature at run time.
 pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
 
 /// The float type the controller runs in (the physics is always f64).
@@ -391,7 +392,8 @@ pub struct Scenario {
     pub relaxation: f64,
     /// Allocator name, interpreted by the controller; `"redistributed-pseudo-inverse"`
     /// (also `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights,
-    /// `"exact-boundary-redistribution"`, and `"clarabel"` with the `clarabel` feature).
+    /// `"exact-boundary-redistribution"`, and `"clarabel"`, `"clarabel-sequential"` with the
+    /// `clarabel` feature).
     pub allocator: String,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
