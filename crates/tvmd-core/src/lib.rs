@@ -71,7 +71,8 @@ pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::ClarabelAllocator;
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
-    ExactBoundaryRedistribution, PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
+    ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
+    PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};

@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
-//!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
+//!              [--relaxation S] [--allocator NAME] [--null-space margin|inward-tilt=RAD]
+//!              [--precision f64|f32]
 //!              [--pil cortex-m4|cortex-m7]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
 //!                [--precision f64|f32]
@@ -65,6 +66,10 @@ enum Command {
         /// weighted-pseudo-inverse, exact-boundary-redistribution, clarabel).
         #[arg(long)]
         allocator: Option<String>,
+        /// Run a null-space stage after the allocator: `margin`, or `inward-tilt=<rad>`
+        /// (the scenario's `null_space`; see docs/method.md, "Null-space stage").
+        #[arg(long, value_name = "OBJECTIVE")]
+        null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
@@ -179,6 +184,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         } => cmd_run(RunArgs {
@@ -189,6 +195,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         }),
@@ -265,6 +272,9 @@ struct RunReport<'a> {
     scenario: &'a str,
     relaxation: f64,
     allocator: &'a str,
+    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    null_space: Option<String>,
     /// The controller's float type, `"f64"` or `"f32"`.
     controller_precision: Precision,
     /// Where the controller ran: `"host"` or the emulated target.
@@ -284,6 +294,7 @@ struct RunArgs {
     summary: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
     precision: Option<String>,
     pil: Option<String>,
 }
@@ -323,6 +334,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         relaxation: a.relaxation,
         allocator: a.allocator,
         precision,
+        null_space: a.null_space,
     })?;
     let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
     let log = if a.no_log {
@@ -342,6 +354,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
+        null_space: scenario.null_space.map(|n| n.to_string()),
         controller_precision: scenario.controller_precision,
         controller_target: &result.summary.controller_target,
         hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),

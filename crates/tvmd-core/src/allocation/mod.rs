@@ -9,6 +9,7 @@ mod any;
 #[cfg(feature = "clarabel")]
 mod clarabel;
 mod exact_boundary;
+mod null_space;
 mod pseudo_inverse;
 mod redistributed;
 
@@ -19,6 +20,9 @@ pub use any::{
 #[cfg(feature = "clarabel")]
 pub use clarabel::{ClarabelAllocator, ClarabelStatus, FallbackReason, SolveReport};
 pub use exact_boundary::ExactBoundaryRedistribution;
+pub use null_space::{
+    NullSpaceObjective, NullSpaceReport, NullSpaceStage, MAX_NULL_SPACE_ITERATIONS,
+};
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
 pub use redistributed::RedistributedPseudoInverse;
 
