@@ -51,18 +51,20 @@ fn saturated_flight(precision: Precision) {
     let mut plain = Scenario::builtin("paper-tilt").unwrap();
     plain.relaxation = 1.0;
     plain.controller_precision = precision;
+    // Through the end of the tilt (4-10 s), where the allocator saturates.
+    plain.duration = 10.5;
     let mut staged = plain.clone();
     staged.null_space = Some("margin".parse().unwrap());
     let a = run_scenario(&plain, None, None).unwrap().summary;
     let b = run_scenario(&staged, None, None).unwrap().summary;
     assert!(a.null_space.is_none());
     let ns = b.null_space.expect("the stage ran");
-    assert!(ns.periods > 1000 && ns.raised_periods > 100, "{ns:?}");
+    assert!(ns.periods >= 1050 && ns.raised_periods > 100, "{ns:?}");
     assert!(ns.mean_margin_after > ns.mean_margin_before, "{ns:?}");
     // An agent the allocator left on its boundary by round-off keeps its force, so the flight's
     // lowest margin stays about zero; it never falls.
     assert!(ns.min_margin_after >= ns.min_margin_before, "{ns:?}");
-    // Fewer periods end with an agent on a boundary (measured: 276 -> 47 in f64, 120 in f32).
+    // Fewer periods end with an agent on a boundary (the whole 16 s flight, measured: 276 -> 47 in f64, 120 in f32).
     assert!(
         b.saturated_periods < a.saturated_periods,
         "{} {}",
