@@ -402,7 +402,7 @@ fn opt_e(v: Option<f64>, unit: &str) -> String {
 fn print_run(r: &RunReport<'_>) {
     let s = r.summary;
     let p = &r.paper;
-    let rows: Vec<(&str, String)> = vec![
+    let mut rows: Vec<(&str, String)> = vec![
         ("scenario", r.scenario.to_string()),
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
@@ -486,6 +486,16 @@ fn print_run(r: &RunReport<'_>) {
             ),
         ),
     ];
+    if let (Some(name), Some(n)) = (&r.null_space, &s.null_space) {
+        rows.push(("null-space stage", name.clone()));
+        rows.push((
+            "margin mean / min",
+            format!(
+                "{:.3} -> {:.3} / {:.3} -> {:.3}",
+                n.mean_margin_before, n.mean_margin_after, n.min_margin_before, n.min_margin_after
+            ),
+        ));
+    }
     for (k, v) in rows {
         println!("{k:<26} {v}");
     }
