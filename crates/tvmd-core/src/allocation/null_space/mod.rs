@@ -49,8 +49,11 @@ const HALVINGS: u32 = 8;
 ///    halving is kept.
 ///
 /// It never makes the allocation worse: a non-finite allocation or one with no agent inside its
-/// set is returned as it came (`ran = false`), an agent outside its set (by the round-off of a
-/// saturation) keeps its force, and every kept step satisfies all three tests of step 3. No allocation, no panic path, `f32` and `f64`.
+/// set is returned as it came (`ran = false`); an agent just outside its set (the round-off of
+/// a saturation) starts from its saturation when that is inside and within `sqrt(eps) T_max`,
+/// else keeps its force; every kept step satisfies all three tests of step 3; and a result whose
+/// objective (or smallest margin) ends below the input's is dropped for the input. No
+/// allocation, no panic path, `f32` and `f64`.
 ///
 /// ```
 /// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
@@ -139,16 +142,29 @@ impl<T: Real> NullSpaceStage<T> {
         let working = working_mask(e);
         let input = allocation.forces;
         let sets = &per_set(request.sets, regular);
-        // An agent the allocator left outside a set it walks in (round-off of a saturation,
-        // or the milliradian of `regular`) keeps its force.
+        // An agent the allocator left just outside a set it walks in (the round-off of a
+        // saturation) starts from its saturation when that is inside and within
+        // `sqrt(eps) T_max` (the drift check below still holds it to the input's wrench); one
+        // further out, or whose saturation is not inside either, keeps its force.
         let mut frozen = [false; N];
-        for (((z, f), (s, r)), w) in frozen
+        let mut begin = input;
+        for ((((z, b), f), (s, r)), w) in frozen
             .iter_mut()
+            .zip(begin.iter_mut())
             .zip(&input)
             .zip(request.sets.iter().zip(sets))
             .zip(&working)
         {
-            *z = *w && (outside(s, f) || outside(r, f));
+            if !*w || (!outside(s, f) && !outside(r, f)) {
+                continue;
+            }
+            let back = r.saturate(f);
+            let near = norm(&(back - f)) <= eps::<T>().sqrt() * r.thrust().hi.max(T::one());
+            if near && !outside(s, &back) && !outside(r, &back) {
+                *b = back;
+            } else {
+                *z = true;
+            }
         }
         let finite = input.iter().all(|f| f.iter().all(|x| x.is_finite()));
         if !finite || e.working_count() == 0 || frozen == working {
@@ -167,7 +183,11 @@ impl<T: Real> NullSpaceStage<T> {
         if !value0.is_finite() || !margin0.is_finite() || !max_abs(&start).is_finite() {
             return unchanged;
         }
-        let (mut forces, mut value, mut margin) = (input, value0, margin0);
+        let (mut forces, mut value, mut margin) = (
+            begin,
+            objective.value(&begin),
+            objective.smallest_margin(&begin),
+        );
         let mut iterations = 0;
         let margin_objective = matches!(self.objective, NullSpaceObjective::Margin);
         while iterations < self.iterations {
@@ -216,7 +236,11 @@ impl<T: Real> NullSpaceStage<T> {
             (forces, value, margin) = (next, v, m);
             iterations += 1;
         }
-        if iterations == 0 {
+        // Never worse than the input, also after the start's snap onto the sets.
+        // Written so a NaN counts as worse.
+        let at_least = |a: T, b: T| a >= b;
+        let worse = !at_least(value, value0) || (margin_objective && !at_least(margin, margin0));
+        if iterations == 0 || worse {
             let report = NullSpaceReport {
                 ran: true,
                 objective_before: value0,
