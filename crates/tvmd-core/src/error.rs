@@ -91,6 +91,10 @@ pub enum ConfigField {
     ClarabelWeights,
     /// Clarabel's tolerance.
     ClarabelTolerance,
+    /// The null-space stage's iteration cap.
+    NullSpaceIterations,
+    /// The null-space stage's inward tilt.
+    NullSpaceTilt,
 }
 
 impl ConfigField {
@@ -128,6 +132,8 @@ impl ConfigField {
             Self::ClarabelLambda => "clarabel.lambda",
             Self::ClarabelWeights => "clarabel.weights",
             Self::ClarabelTolerance => "clarabel.tolerance",
+            Self::NullSpaceIterations => "null_space.iterations",
+            Self::NullSpaceTilt => "null_space.tilt",
         }
     }
 }

@@ -69,7 +69,8 @@ pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
-    ExactBoundaryRedistribution, PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
+    ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
+    PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 #[cfg(feature = "clarabel")]
 pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};

@@ -602,7 +602,7 @@ def test_controller_outputs_and_state():
     out = ctrl.step({"position": [0.5, -0.5, 0.0]}, {"position": [0.0, 0.0, 1.5], "attitude": ri.rot_x(1.0)})
     d = out.to_dict()
     assert tuple(d) == tvmd.StepOutput.FIELDS
-    assert tvmd.StepOutput.FIELDS == ("planner", "projection", "f_r", "law", "allocation", "commands", "command_clamp")
+    assert tvmd.StepOutput.FIELDS == ("planner", "projection", "f_r", "law", "allocation", "commands", "command_clamp", "null_space")
     assert tuple(d["planner"]) == tvmd.PlannerResult.FIELDS and tuple(d["law"]) == tvmd.LawOutput.FIELDS
     assert tuple(d["allocation"]) == tvmd.Allocation.FIELDS
     assert tuple(d["projection"]) == tvmd.ForceProjection.FIELDS == ("force", "t_Tf", "t_eta")
@@ -838,3 +838,26 @@ def test_docstrings_present():
             for attr, value in vars(obj).items():
                 if not attr.startswith("_") and attr != "FIELDS":
                     assert getattr(value, "__doc__", None), f"{name}.{attr}"
+
+
+def test_controller_null_space_stage():
+    team = tvmd.Team.a4_inc()
+    c, s = math.cos(0.6), math.sin(0.6)
+    roll = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    state = {"position": [0.3, -0.2, 1.5]}
+    reference = {"position": [0.0, 0.0, 1.5], "attitude": roll}
+    plain = tvmd.Controller(team).step(state, reference)
+    assert not plain.null_space.ran and plain.null_space.iterations == 0
+    ctrl = tvmd.Controller(team, null_space="margin")
+    assert ctrl.null_space == "margin"
+    out = ctrl.step(state, reference)
+    r = out.null_space
+    assert r.ran and r.margin_after >= r.margin_before
+    assert r.objective_after >= r.objective_before
+    # The wrench is the allocator's to round-off.
+    np.testing.assert_allclose(out.allocation.wrench, plain.allocation.wrench, atol=1e-9)
+    assert set(r.to_dict()) == set(tvmd.NullSpaceReport.FIELDS)
+    assert tvmd.Controller(team, null_space="inward-tilt=0.1").null_space == "inward-tilt=0.1"
+    for bad in ["sideways", "inward-tilt", "inward-tilt=nan", "inward-tilt=1.6"]:
+        with pytest.raises(ValueError, match="null_space"):
+            tvmd.Controller(team, null_space=bad)

@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
-//!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
+//!              [--relaxation S] [--allocator NAME] [--null-space margin|inward-tilt=RAD]
+//!              [--precision f64|f32]
 //!              [--pil cortex-m4|cortex-m7]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
 //!                [--precision f64|f32]
@@ -66,6 +67,10 @@ enum Command {
         /// clarabel-sequential).
         #[arg(long)]
         allocator: Option<String>,
+        /// Run a null-space stage after the allocator: `margin`, or `inward-tilt=<rad>`
+        /// (the scenario's `null_space`; see docs/method.md, "Null-space stage").
+        #[arg(long, value_name = "OBJECTIVE")]
+        null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
@@ -180,6 +185,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         } => cmd_run(RunArgs {
@@ -190,6 +196,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         }),
@@ -266,6 +273,9 @@ struct RunReport<'a> {
     scenario: &'a str,
     relaxation: f64,
     allocator: &'a str,
+    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    null_space: Option<String>,
     /// The controller's float type, `"f64"` or `"f32"`.
     controller_precision: Precision,
     /// Where the controller ran: `"host"` or the emulated target.
@@ -285,6 +295,7 @@ struct RunArgs {
     summary: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
     precision: Option<String>,
     pil: Option<String>,
 }
@@ -324,6 +335,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         relaxation: a.relaxation,
         allocator: a.allocator,
         precision,
+        null_space: a.null_space,
     })?;
     let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
     let log = if a.no_log {
@@ -343,6 +355,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
+        null_space: scenario.null_space.map(|n| n.to_string()),
         controller_precision: scenario.controller_precision,
         controller_target: &result.summary.controller_target,
         hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
@@ -390,7 +403,7 @@ fn opt_e(v: Option<f64>, unit: &str) -> String {
 fn print_run(r: &RunReport<'_>) {
     let s = r.summary;
     let p = &r.paper;
-    let rows: Vec<(&str, String)> = vec![
+    let mut rows: Vec<(&str, String)> = vec![
         ("scenario", r.scenario.to_string()),
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
@@ -474,6 +487,16 @@ fn print_run(r: &RunReport<'_>) {
             ),
         ),
     ];
+    if let (Some(name), Some(n)) = (&r.null_space, &s.null_space) {
+        rows.push(("null-space stage", name.clone()));
+        rows.push((
+            "margin mean / min",
+            format!(
+                "{:.3} -> {:.3} / {:.3} -> {:.3}",
+                n.mean_margin_before, n.mean_margin_after, n.min_margin_before, n.min_margin_after
+            ),
+        ));
+    }
     for (k, v) in rows {
         println!("{k:<26} {v}");
     }

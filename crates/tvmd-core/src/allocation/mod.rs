@@ -9,6 +9,7 @@ mod any;
 #[cfg(feature = "clarabel")]
 mod clarabel;
 mod exact_boundary;
+mod null_space;
 mod pseudo_inverse;
 mod redistributed;
 
@@ -22,6 +23,9 @@ pub use clarabel::{
     SolveReport, StopReason,
 };
 pub use exact_boundary::ExactBoundaryRedistribution;
+pub use null_space::{
+    NullSpaceObjective, NullSpaceReport, NullSpaceStage, MAX_NULL_SPACE_ITERATIONS,
+};
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
 pub use redistributed::RedistributedPseudoInverse;
 

@@ -128,6 +128,11 @@ pub fn controller_settings<T: CoreFloat>(
         gravity: to_core(scenario.physics.gravity),
         period: to_core(scenario.controller_period),
         rate_limits,
+        null_space: scenario
+            .null_space
+            .as_ref()
+            .map(|n| n.stage::<T>())
+            .transpose()?,
     })
 }
 

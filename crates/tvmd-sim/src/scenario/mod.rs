@@ -14,6 +14,7 @@
 //! allocator = "redistributed-pseudo-inverse"   # "pseudo-inverse", "clarabel", ...
 //! controller_precision = "f64"               # or "f32": the flight configuration
 //! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
+//! # null_space = "margin"                     # null-space stage after the allocator
 //!
 //! [physics]
 //! dt = 0.001
@@ -66,10 +67,14 @@ use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
 
 mod builtin;
+mod null_space;
 mod overrides;
 mod validate;
 
 pub use builtin::BUILTIN_NAMES;
+pub use null_space::{
+    NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
+};
 pub use overrides::Overrides;
 use validate::invalid;
 
@@ -400,6 +405,10 @@ pub struct Scenario {
     /// plant's: give both to model a servo the controller knows about.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controller_rate_limits: Option<[f64; 2]>,
+    /// Optional null-space stage after the allocator (`"margin"`, `"inward-tilt=<rad>"`, or a
+    /// table, see [`NullSpaceConfig`]); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub null_space: Option<NullSpaceConfig>,
     /// The float type the controller runs in, `"f64"` (default) or `"f32"` (the flight
     /// configuration: `tvmd_core::Controller<f32, ..>`). The physics stays f64.
     pub controller_precision: Precision,
@@ -436,6 +445,7 @@ impl Default for Scenario {
             relaxation: 0.5,
             allocator: "redistributed-pseudo-inverse".into(),
             controller_rate_limits: None,
+            null_space: None,
             controller_precision: Precision::F64,
             physics: PhysicsConfig::default(),
             team: TeamSpec::default(),

@@ -20,11 +20,11 @@ use crate::linalg::{max_abs, norm};
 use crate::real::{eps, lit, Real};
 
 /// Number of constraints of one agent.
-pub(super) const CONSTRAINTS: usize = 6;
+pub(in crate::allocation) const CONSTRAINTS: usize = 6;
 
 /// `g(f) = c . f + s ||f|| + k <= 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Constraint<T: Real> {
+pub(in crate::allocation) struct Constraint<T: Real> {
     c: Vector3<T>,
     s: T,
     k: T,
@@ -32,12 +32,12 @@ pub(super) struct Constraint<T: Real> {
 
 impl<T: Real> Constraint<T> {
     /// `g(f)`, overflow-safe (the norm does not square).
-    pub(super) fn value(&self, f: &Vector3<T>) -> T {
+    pub(in crate::allocation) fn value(&self, f: &Vector3<T>) -> T {
         self.c.dot(f) + self.s * norm(f) + self.k
     }
 
     /// `grad g(f) = c + s f / ||f||` (`c` at the origin, where the cones have no normal).
-    pub(super) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
+    pub(in crate::allocation) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
         let n = norm(f);
         if n > T::zero() {
             self.c + f * (self.s / n)
@@ -48,7 +48,7 @@ impl<T: Real> Constraint<T> {
 
     /// Whether `g` is curved (a cone or a sphere): a step along its tangent plane leaves the
     /// boundary to second order, so the agent is retracted onto the set after it.
-    pub(super) fn curved(&self) -> bool {
+    pub(in crate::allocation) fn curved(&self) -> bool {
         self.s != T::zero()
     }
 
@@ -60,7 +60,7 @@ impl<T: Real> Constraint<T> {
     /// when it is a root of `g` itself (`s (c . x + k) <= 0`) and `g` increases through it.
     /// Everything is scaled by the largest input component first, which leaves `tau`
     /// unchanged (`g` is homogeneous of degree one in `(f, d, k)`) and keeps the squares finite.
-    pub(super) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
+    pub(in crate::allocation) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
         let m = max_abs(f).max(max_abs(d)).max(self.k.abs());
         if m <= T::zero() || !m.is_finite() {
             return None;
@@ -130,7 +130,7 @@ impl<T: Real> Constraint<T> {
 /// One milliradian short of the axis, every force the walk returns inverts to a command that
 /// reproduces it within `1e3 eps T`, in `f32` and `f64`. (`set` itself if the narrowed ranges
 /// do not make a set.)
-pub(super) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
+pub(in crate::allocation) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
     let cap = T::frac_pi_2() - lit(1e-3);
     let ex = set.eta_x();
     let hi = ex.hi.min(cap);
@@ -143,7 +143,9 @@ pub(super) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
 
 /// The six constraints of `set` (a bound that can never bind, `T >= 0`, is `-T_max <= 0`:
 /// never violated, never crossed, never on the boundary).
-pub(super) fn constraints<T: Real>(set: &AdmissibleSet<T>) -> [Constraint<T>; CONSTRAINTS] {
+pub(in crate::allocation) fn constraints<T: Real>(
+    set: &AdmissibleSet<T>,
+) -> [Constraint<T>; CONSTRAINTS] {
     let zero = T::zero();
     let y = Vector3::new(zero, T::one(), zero);
     let plane = |b: T, sign: T| {

@@ -2,8 +2,8 @@
 //! "Allocation"): walk from admissible forces toward the request and stop each agent on the
 //! exact boundary of its admissible set, found in closed form, instead of clamping.
 
-mod active;
-mod constraint;
+pub(super) mod active;
+pub(super) mod constraint;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
@@ -247,7 +247,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
 
 /// `f` of every set, computed once per run of equal sets (the agents usually share one set, and
 /// the constraints cost trigonometry).
-fn per_set<T: Real, U: Copy, const N: usize>(
+pub(in crate::allocation) fn per_set<T: Real, U: Copy, const N: usize>(
     sets: &[AdmissibleSet<T>; N],
     f: impl Fn(&AdmissibleSet<T>) -> U,
 ) -> [U; N] {
