@@ -164,3 +164,49 @@ fn no_allocator_beats_a_certificate() {
         }
     }
 }
+
+#[test]
+fn cli_writes_the_set_and_prints_the_tables() {
+    let dir = std::env::temp_dir().join(format!("tvmd-alloc-set-{}", std::process::id()));
+    let set = dir.join("set.json");
+    let bin = || std::process::Command::new(env!("CARGO_BIN_EXE_tvmd-sim"));
+    let out = bin()
+        .args(["allocation-set", "--out"])
+        .arg(&set)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    assert!(std::fs::read_to_string(&set).unwrap() == COMMITTED);
+    let json = dir.join("rows.json");
+    let out = bin()
+        .args([
+            "allocation-eval",
+            "--allocators",
+            "pseudo-inverse,redistributed-pseudo-inverse",
+        ])
+        .arg("--set")
+        .arg(&set)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        table.matches("| pseudo-inverse |").count(),
+        2 * 5,
+        "{table}"
+    );
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(rows["set"].as_array().unwrap().len(), 10);
+    assert!(rows["closed_loop"].is_null());
+    let out = bin()
+        .args(["allocation-eval", "--allocators", "magic", "--set"])
+        .arg(&set)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("magic"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -9,6 +9,7 @@ use tvmd_core::{AdmissibleSet, AllocationRequest, Allocator, AnyAllocator, Gimba
 use super::{failure_mask, team, team_size, AllocationSet, SetRequest, TeamRequests};
 use crate::runner::run_scenario;
 use crate::scenario::{Overrides, Scenario};
+use crate::sim::PaperMetrics;
 use crate::SimError;
 
 /// A request is allocated exactly when `e_f / ||u_fd|| <=` this (issue 16).
@@ -187,6 +188,10 @@ fn sci(v: Option<f64>) -> String {
     v.map_or_else(|| "-".into(), |x| format!("{x:.2e}"))
 }
 
+fn fixed(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".into(), |x| format!("{x:.4}"))
+}
+
 /// The evaluation as a markdown table.
 pub fn markdown_table(rows: &[EvaluationRow]) -> String {
     let mut out = String::from(
@@ -250,8 +255,15 @@ pub struct ClosedLoopRow {
     pub max_e_f: Option<f64>,
     /// `max e_f / (m_C g)`.
     pub max_e_f_over_weight: Option<f64>,
-    /// Largest position error (m).
+    /// Largest position error (m) (the initial offset of paper-tilt, 0.707 m, for a flight that
+    /// does not stray further).
     pub max_position_error: f64,
+    /// Largest position error from `t = 4 s` (m).
+    pub max_position_error_after_4s: f64,
+    /// Largest position error over `6 s <= t <= 12 s`, the tilt (m).
+    pub max_position_error_6_to_12s: Option<f64>,
+    /// Horizontal error at `t = 12 s` (m).
+    pub horizontal_error_at_12s: Option<f64>,
     /// Final position error (m).
     pub final_position_error: f64,
     /// Control periods with a saturated agent.
@@ -271,12 +283,17 @@ pub fn closed_loop_rows(names: &[&str]) -> Result<Vec<ClosedLoopRow>, SimError> 
                 allocator: Some((*name).to_string()),
                 ..Overrides::default()
             })?;
-            let s = run_scenario(&scenario, None, None)?.summary;
+            let result = run_scenario(&scenario, None, None)?;
+            let paper = PaperMetrics::new(&scenario, &result.samples);
+            let s = result.summary;
             Ok(ClosedLoopRow {
                 allocator: (*name).to_string(),
                 max_e_f: s.max_e_f,
                 max_e_f_over_weight: s.max_e_f_over_weight,
                 max_position_error: s.max_position_error,
+                max_position_error_after_4s: s.max_position_error_after_4s,
+                max_position_error_6_to_12s: paper.max_position_error_6_to_12s,
+                horizontal_error_at_12s: s.horizontal_error_at_12s,
                 final_position_error: s.final_position_error,
                 saturated_periods: s.saturated_periods,
                 cycle_errors: s.cycle_errors,
@@ -288,16 +305,20 @@ pub fn closed_loop_rows(names: &[&str]) -> Result<Vec<ClosedLoopRow>, SimError> 
 /// The closed-loop rows as a markdown table.
 pub fn markdown_closed_loop(rows: &[ClosedLoopRow]) -> String {
     let mut out = String::from(
-        "| allocator | max e_f (N) | max e_f / (m_C g) | max position error (m) | final position \
-         error (m) | saturated periods | skipped cycles |\n|---|---|---|---|---|---|---|\n",
+        "| allocator | max e_f (N) | max e_f / (m_C g) | max position error (m): all / t >= 4 s \
+         / 6-12 s | horizontal error at 12 s (m) | final position error (m) | saturated periods \
+         | skipped cycles |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         out += &format!(
-            "| {} | {} | {} | {:.4} | {:.4} | {} | {} |\n",
+            "| {} | {} | {} | {:.4} / {:.4} / {} | {} | {:.4} | {} | {} |\n",
             r.allocator,
             sci(r.max_e_f),
             sci(r.max_e_f_over_weight),
             r.max_position_error,
+            r.max_position_error_after_4s,
+            fixed(r.max_position_error_6_to_12s),
+            fixed(r.horizontal_error_at_12s),
             r.final_position_error,
             r.saturated_periods,
             r.cycle_errors,
