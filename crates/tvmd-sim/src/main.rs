@@ -10,6 +10,9 @@
 //!                [--precision f64|f32]
 //! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
 //! tvmd-sim record-cycles [SCENARIO|FILE.toml] --out FILE [--cycles 1000]
+//! tvmd-sim allocation-set [--out benches/data/allocation_set.json] [--seed 16]
+//! tvmd-sim allocation-eval [--set benches/data/allocation_set.json] [--allocators A,B]
+//!                          [--closed-loop] [--json FILE]
 //! tvmd-sim list
 //! tvmd-sim show NAME
 //! ```
@@ -22,6 +25,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
+use tvmd_sim::allocation_bench;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::plot::{self, PlotSeries};
@@ -131,6 +135,31 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Write the seeded allocation benchmark set (attainable and certified-outside requests for
+    /// A4-Inc, A6-Inc, A8-Inc, a 16-agent ring and A4-Inc with agent 1 failed).
+    AllocationSet {
+        /// File to write.
+        #[arg(long, default_value = tvmd_sim::allocation_bench::SET_PATH)]
+        out: PathBuf,
+        /// Seed of the generator.
+        #[arg(long, default_value_t = tvmd_sim::allocation_bench::SEED)]
+        seed: u64,
+    },
+    /// Evaluate allocators on the allocation set and print markdown tables.
+    AllocationEval {
+        /// The set file.
+        #[arg(long, default_value = tvmd_sim::allocation_bench::SET_PATH)]
+        set: PathBuf,
+        /// Allocators, comma-separated (default: every allocator of this build).
+        #[arg(long, value_delimiter = ',')]
+        allocators: Vec<String>,
+        /// Also fly paper-tilt at s = 1 with each allocator.
+        #[arg(long)]
+        closed_loop: bool,
+        /// JSON file for the rows.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// List the built-in scenarios.
     List,
     /// Print a built-in scenario as TOML (a starting point for a scenario file).
@@ -223,6 +252,22 @@ fn main() -> ExitCode {
             jobs,
         ),
         Command::Plot { logs, out } => cmd_plot(&logs, &out),
+        Command::AllocationSet { out, seed } => allocation_bench::cli::write_set(&out, seed)
+            .map(|m| println!("{m}"))
+            .map_err(CliError::from),
+        Command::AllocationEval {
+            set,
+            allocators,
+            closed_loop,
+            json,
+        } => allocation_bench::cli::evaluate(
+            &set,
+            &allocation_bench::cli::allocator_names(&allocators),
+            closed_loop,
+            json.as_deref(),
+        )
+        .map(|t| print!("{t}"))
+        .map_err(CliError::from),
         Command::List => {
             for name in BUILTIN_NAMES {
                 // Built-ins always exist.
