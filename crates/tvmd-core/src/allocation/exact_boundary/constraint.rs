@@ -36,6 +36,11 @@ impl<T: Real> Constraint<T> {
         self.c.dot(f) + self.s * norm(f) + self.k
     }
 
+    /// `g(f)` given `||f||`.
+    pub(super) fn value_with_norm(&self, f: &Vector3<T>, norm: T) -> T {
+        self.c.dot(f) + self.s * norm + self.k
+    }
+
     /// `grad g(f) = c + s f / ||f||` (`c` at the origin, where the cones have no normal).
     pub(super) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
         let n = norm(f);

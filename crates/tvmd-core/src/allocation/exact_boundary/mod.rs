@@ -229,18 +229,20 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     /// Moves by `tau delta`; agents that left their set by moving along a curved boundary's
     /// tangent (or by round-off) are put back on it.
     fn advance(&mut self, tau: T, delta: &[Vector3<T>; N]) {
-        for (((f, d), (set, w)), a) in self
+        for ((((f, d), (set, w)), a), b) in self
             .forces
             .iter_mut()
             .zip(delta)
             .zip(self.sets.iter().zip(&self.working))
             .zip(&self.active)
+            .zip(&self.bounds)
         {
             if *w {
                 *f += d * tau;
                 // Only a tangent step on a cone or sphere leaves the set by more than round-off
-                // (the final forces are checked anyway).
-                if a.curved() && outside(set, f) {
+                // (the final forces are checked with the gimbal inverse anyway). The set's own
+                // constraints decide without `asin`/`atan2`.
+                if a.curved() && violated(b, f) {
                     *f = set.saturate(f);
                 }
             }
@@ -289,6 +291,17 @@ fn per_set<T: Real, U: Copy, const N: usize>(
             u
         }
     })
+}
+
+/// Whether `f` is outside the set its constraints describe (or not finite): the same test as
+/// [`outside`] up to round-off, with a dot product per constraint and one norm instead of the
+/// gimbal inverse.
+fn violated<T: Real>(bounds: &[Constraint<T>; CONSTRAINTS], f: &Vector3<T>) -> bool {
+    if !f.iter().all(|x| x.is_finite()) {
+        return true;
+    }
+    let n = norm(f);
+    bounds.iter().any(|c| c.value_with_norm(f, n) > T::zero())
 }
 
 /// Whether `f` is on a constraint of its set, within `sqrt(eps)` of the largest thrust.
