@@ -60,45 +60,44 @@ impl<T: Real> Constraint<T> {
     /// The first `tau >= 0` at which `f + tau d` leaves `{g <= 0}`: `Some(0)` when `f` is on
     /// (or, by round-off, just beyond) the boundary and `d` points out; `None` when the ray never
     /// leaves. `f` and `d` finite.
+    #[cfg(test)]
+    pub(super) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
+        Ray::new(f, d, self.k.abs()).and_then(|ray| self.first_exit_along(&ray))
+    }
+
+    /// [`Self::first_exit`] along a ray scaled once for all of an agent's constraints.
     ///
     /// Closed form: squaring `c . x + k = -s ||x||` gives a quadratic in `tau`; a root is kept
     /// when it is a root of `g` itself (`s (c . x + k) <= 0`) and `g` increases through it.
-    /// Everything is scaled by the largest input component first, which leaves `tau`
+    /// The ray is scaled by the largest input component (`k` included), which leaves `tau`
     /// unchanged (`g` is homogeneous of degree one in `(f, d, k)`) and keeps the squares finite.
-    pub(super) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
-        let m = max_abs(f).max(max_abs(d)).max(self.k.abs());
-        if m <= T::zero() || !m.is_finite() {
-            return None;
-        }
-        let (f, d, k) = (f / m, d / m, self.k / m);
-        // Scaled to components of at most one: plain norms cannot overflow (an underflow is
-        // a force at the origin, which it is to this precision).
-        let len = |v: &Vector3<T>| v.dot(v).sqrt();
+    pub(super) fn first_exit_along(&self, ray: &Ray<T>) -> Option<T> {
+        let (f, d) = (&ray.f, &ray.d);
+        let k = self.k / ray.scale;
         let tol: T = eps::<T>() * lit(64.0);
-        let g0 = self.c.dot(&f) + self.s * len(&f) + k;
-        let slope = |x: &Vector3<T>| {
-            let n = len(x);
-            if n > T::zero() {
-                self.c.dot(&d) + self.s * x.dot(&d) / n
+        let p = self.c.dot(f) + k;
+        let q = self.c.dot(d);
+        let g0 = p + self.s * ray.f_len;
+        // The slope of `g` along `d` at a point `x` with `x . d` and `||x||` given.
+        let slope = |x_dot_d: T, x_len: T| {
+            if x_len > T::zero() {
+                q + self.s * x_dot_d / x_len
             } else {
-                self.c.dot(&d) + self.s * len(&d)
+                q + self.s * ray.d_len
             }
         };
-        let d_scale = len(&d);
-        if g0 > -tol && slope(&f) > tol * d_scale {
+        if g0 > -tol && slope(ray.fd, ray.f_len) > tol * ray.d_len {
             return Some(T::zero());
         }
-        let p = self.c.dot(&f) + k;
-        let q = self.c.dot(&d);
         if !self.curved() {
             return (q > T::zero()).then(|| (-p / q).max(T::zero()));
         }
         let s2 = self.s * self.s;
-        let a = q * q - s2 * d.dot(&d);
-        let b = p * q - s2 * f.dot(&d);
-        let c = p * p - s2 * f.dot(&f);
+        let a = q * q - s2 * ray.dd;
+        let b = p * q - s2 * ray.fd;
+        let c = p * p - s2 * ray.ff;
         let mut roots = [None, None];
-        if a.abs() <= tol * (q * q + s2 * d.dot(&d)) {
+        if a.abs() <= tol * (q * q + s2 * ray.dd) {
             if b != T::zero() {
                 roots[0] = Some(-c / (b + b));
             }
@@ -120,12 +119,54 @@ impl<T: Real> Constraint<T> {
             .filter(|t| t.is_finite() && *t >= T::zero())
             .filter(|t| {
                 let x = f + d * *t;
-                self.s * (p + q * *t) <= T::zero() && slope(&x) > T::zero()
+                self.s * (p + q * *t) <= T::zero() && slope(x.dot(d), x.dot(&x).sqrt()) > T::zero()
             })
             .fold(None, |best: Option<T>, t| match best {
                 Some(b) if b <= t => Some(b),
                 _ => Some(t),
             })
+    }
+
+    /// `|k|`, the part of the ray's scale this constraint needs.
+    pub(super) fn offset(&self) -> T {
+        self.k.abs()
+    }
+}
+
+/// A ray `f + tau d` scaled by its largest component (and the largest constraint offset `|k|`),
+/// with the products every constraint's first exit uses, computed once per agent and round.
+pub(super) struct Ray<T: Real> {
+    f: Vector3<T>,
+    d: Vector3<T>,
+    scale: T,
+    ff: T,
+    dd: T,
+    fd: T,
+    f_len: T,
+    d_len: T,
+}
+
+impl<T: Real> Ray<T> {
+    /// `None` when everything is zero or a component is not finite (no exit).
+    pub(super) fn new(f: &Vector3<T>, d: &Vector3<T>, offset: T) -> Option<Self> {
+        let scale = max_abs(f).max(max_abs(d)).max(offset);
+        if scale <= T::zero() || !scale.is_finite() {
+            return None;
+        }
+        let (f, d) = (f / scale, d / scale);
+        // Scaled to components of at most one: plain norms cannot overflow (an underflow is
+        // a force at the origin, which it is to this precision).
+        let (ff, dd) = (f.dot(&f), d.dot(&d));
+        Some(Self {
+            f,
+            d,
+            scale,
+            ff,
+            dd,
+            fd: f.dot(&d),
+            f_len: ff.sqrt(),
+            d_len: dd.sqrt(),
+        })
     }
 }
 

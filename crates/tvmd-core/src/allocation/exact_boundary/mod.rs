@@ -8,7 +8,7 @@ mod constraint;
 use nalgebra::{Matrix6, Vector3, Vector6};
 
 use self::active::ActiveSet;
-use self::constraint::{constraints, regular, Constraint, CONSTRAINTS};
+use self::constraint::{constraints, regular, Constraint, Ray, CONSTRAINTS};
 use super::{
     outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
 };
@@ -200,11 +200,15 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             if !*w || a.fixed() {
                 continue;
             }
+            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), T::max);
+            let Some(ray) = Ray::new(f, d, offset) else {
+                continue;
+            };
             for (k, c) in b.iter().enumerate() {
                 if a.holds(k) {
                     continue;
                 }
-                if let Some(t) = c.first_exit(f, d) {
+                if let Some(t) = c.first_exit_along(&ray) {
                     if t == T::zero() && now.is_none() {
                         *now = Some(k);
                     }
