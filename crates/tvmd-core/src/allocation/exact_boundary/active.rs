@@ -43,6 +43,11 @@ impl<T: Real> ActiveSet<T> {
         self.holds(k) && self.released & (1 << k) == 0
     }
 
+    /// Whether some held constraint may still be let go.
+    pub(super) fn any_releasable(&self) -> bool {
+        self.bits & !self.released != 0
+    }
+
     /// Stops holding constraint `k` (the walk wants to leave it inward), once per allocation.
     pub(super) fn release(&mut self, k: usize) {
         if k < CONSTRAINTS {

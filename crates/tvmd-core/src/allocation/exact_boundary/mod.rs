@@ -122,18 +122,23 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             return None;
         }
         let lambda = solve_gram(&gram, r);
-        if release && self.release_one(&lambda) {
-            return self.direction(r, false);
-        }
+        // `M_i^T lambda`, the free increments, once for the release test and the step.
         let mut delta = [Vector3::zeros(); N];
-        for (((d, block), a), w) in delta
+        for ((d, block), w) in delta
             .iter_mut()
             .zip(self.effectiveness.blocks())
-            .zip(&self.active)
             .zip(&self.working)
         {
             if let (Some(block), true) = (block, *w) {
-                *d = a.project(&block.tr_mul(&lambda));
+                *d = block.tr_mul(&lambda);
+            }
+        }
+        if release && self.release_one(&delta) {
+            return self.direction(r, false);
+        }
+        for ((d, a), w) in delta.iter_mut().zip(&self.active).zip(&self.working) {
+            if *w {
+                *d = a.project(d);
             }
         }
         delta
@@ -142,31 +147,29 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .then_some(delta)
     }
 
-    /// Lets go of the held constraint the free increment `M_i^T lambda` leaves most steeply
+    /// Lets go of the held constraint the free increment `free_i = M_i^T lambda` leaves most steeply
     /// inward (an active-set method's multiplier test), if any: holding it would keep the agent
     /// on a boundary the request pulls it away from.
-    fn release_one(&mut self, lambda: &Vector6<T>) -> bool {
+    fn release_one(&mut self, free: &[Vector3<T>; N]) -> bool {
         let mut worst: Option<(usize, usize, T)> = None;
-        for (i, (((block, a), f), (w, b))) in self
-            .effectiveness
-            .blocks()
+        for (i, (((free, a), f), (w, b))) in free
             .iter()
             .zip(&self.active)
             .zip(&self.forces)
             .zip(self.working.iter().zip(&self.bounds))
             .enumerate()
         {
-            let (Some(block), true) = (block, *w) else {
+            if !*w || !a.any_releasable() {
                 continue;
-            };
-            let free = block.tr_mul(lambda);
+            }
+            let free_norm = norm(free);
             for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
                 let g = c.gradient(f);
-                let scale = norm(&g) * norm(&free);
+                let scale = norm(&g) * free_norm;
                 if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                     continue;
                 }
-                let slope = g.dot(&free) / scale;
+                let slope = g.dot(free) / scale;
                 if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
                     worst = Some((i, k, slope));
                 }
