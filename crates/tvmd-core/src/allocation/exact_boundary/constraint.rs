@@ -28,6 +28,8 @@ pub(super) struct Constraint<T: Real> {
     c: Vector3<T>,
     s: T,
     k: T,
+    /// `|c| + |s|`, a Lipschitz constant of `g`.
+    lipschitz: T,
 }
 
 impl<T: Real> Constraint<T> {
@@ -62,16 +64,18 @@ impl<T: Real> Constraint<T> {
     /// leaves. `f` and `d` finite.
     #[cfg(test)]
     pub(super) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
-        Ray::new(f, d, self.k.abs()).and_then(|ray| self.first_exit_along(&ray))
+        Ray::new(f, d, self.k.abs())
+            .and_then(|ray| self.first_exit_along(&ray, T::max_value().unwrap_or_else(T::one)))
     }
 
-    /// [`Self::first_exit`] along a ray scaled once for all of an agent's constraints.
+    /// [`Self::first_exit`] along a ray scaled once for all of an agent's constraints, or
+    /// `None` for an exit that is certainly beyond `2 within`.
     ///
     /// Closed form: squaring `c . x + k = -s ||x||` gives a quadratic in `tau`; a root is kept
     /// when it is a root of `g` itself (`s (c . x + k) <= 0`) and `g` increases through it.
     /// The ray is scaled by the largest input component (`k` included), which leaves `tau`
     /// unchanged (`g` is homogeneous of degree one in `(f, d, k)`) and keeps the squares finite.
-    pub(super) fn first_exit_along(&self, ray: &Ray<T>) -> Option<T> {
+    pub(super) fn first_exit_along(&self, ray: &Ray<T>, within: T) -> Option<T> {
         let (f, d) = (&ray.f, &ray.d);
         let k = self.k / ray.scale;
         let tol: T = eps::<T>() * lit(64.0);
@@ -88,6 +92,13 @@ impl<T: Real> Constraint<T> {
         };
         if g0 > -tol && slope(ray.fd, ray.f_len) > tol * ray.d_len {
             return Some(T::zero());
+        }
+        // `g` changes by at most `(|c| + |s|) ||d||` per unit of `tau`: no exit before
+        // `-g0 / ((|c| + |s|) ||d||)`. Beyond twice `within` (round-off of the roots allowed for),
+        // the exit cannot be the walk's first and the quadratic is not solved.
+        let slope_bound = self.lipschitz * ray.d_len;
+        if -g0 > within * slope_bound * lit(2.0) {
+            return None;
         }
         if !self.curved() {
             return (q > T::zero()).then(|| (-p / q).max(T::zero()));
@@ -199,43 +210,21 @@ pub(super) fn constraints<T: Real>(set: &AdmissibleSet<T>) -> [Constraint<T>; CO
     let ex = set.eta_x();
     let ey = set.eta_y();
     let th = set.thrust();
-    let never = Constraint {
-        c: Vector3::zeros(),
-        s: zero,
-        k: -th.hi.max(T::one()),
+    let constraint = |c: Vector3<T>, s: T, k: T| Constraint {
+        c,
+        s,
+        k,
+        lipschitz: norm(&c) + s.abs(),
     };
+    let never = constraint(Vector3::zeros(), zero, -th.hi.max(T::one()));
     [
-        Constraint {
-            c: -y,
-            s: -ex.hi.sin(),
-            k: zero,
-        },
-        Constraint {
-            c: y,
-            s: ex.lo.sin(),
-            k: zero,
-        },
-        Constraint {
-            c: plane(ey.hi, T::one()),
-            s: zero,
-            k: zero,
-        },
-        Constraint {
-            c: plane(ey.lo, -T::one()),
-            s: zero,
-            k: zero,
-        },
-        Constraint {
-            c: Vector3::zeros(),
-            s: T::one(),
-            k: -th.hi,
-        },
+        constraint(-y, -ex.hi.sin(), zero),
+        constraint(y, ex.lo.sin(), zero),
+        constraint(plane(ey.hi, T::one()), zero, zero),
+        constraint(plane(ey.lo, -T::one()), zero, zero),
+        constraint(Vector3::zeros(), T::one(), -th.hi),
         if th.lo > zero {
-            Constraint {
-                c: Vector3::zeros(),
-                s: -T::one(),
-                k: th.lo,
-            }
+            constraint(Vector3::zeros(), -T::one(), th.lo)
         } else {
             never
         },

@@ -211,7 +211,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 if a.holds(k) {
                     continue;
                 }
-                if let Some(t) = c.first_exit_along(&ray) {
+                if let Some(t) = c.first_exit_along(&ray, tau) {
                     if t == T::zero() && now.is_none() {
                         *now = Some(k);
                     }
