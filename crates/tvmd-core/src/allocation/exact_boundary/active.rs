@@ -18,6 +18,9 @@ pub(super) struct ActiveSet<T: Real> {
     basis: [Option<Vector3<T>>; 2],
     fixed: bool,
     curved: bool,
+    /// The held bits and the force of the last [`Self::update`]: the normals are the same while
+    /// both are (a fixed agent, or every agent after a release re-solves).
+    updated: Option<(u8, Vector3<T>)>,
 }
 
 impl<T: Real> Default for ActiveSet<T> {
@@ -28,6 +31,7 @@ impl<T: Real> Default for ActiveSet<T> {
             basis: [None, None],
             fixed: false,
             curved: false,
+            updated: None,
         }
     }
 }
@@ -74,6 +78,10 @@ impl<T: Real> ActiveSet<T> {
         constraints: &[Constraint<T>; CONSTRAINTS],
         force: &Vector3<T>,
     ) {
+        if self.updated == Some((self.bits, *force)) {
+            return;
+        }
+        self.updated = Some((self.bits, *force));
         self.basis = [None, None];
         self.fixed = false;
         self.curved = false;
