@@ -18,6 +18,9 @@ pub(in crate::allocation) struct ActiveSet<T: Real> {
     basis: [Option<Vector3<T>>; 2],
     fixed: bool,
     curved: bool,
+    /// The held bits and the force of the last [`Self::update`]: the normals are the same while
+    /// both are (a fixed agent, or every agent after a release re-solves).
+    updated: Option<(u8, Vector3<T>)>,
 }
 
 impl<T: Real> Default for ActiveSet<T> {
@@ -28,6 +31,7 @@ impl<T: Real> Default for ActiveSet<T> {
             basis: [None, None],
             fixed: false,
             curved: false,
+            updated: None,
         }
     }
 }
@@ -41,6 +45,11 @@ impl<T: Real> ActiveSet<T> {
     /// Whether constraint `k` is held and may still be let go.
     pub(in crate::allocation) fn releasable(&self, k: usize) -> bool {
         self.holds(k) && self.released & (1 << k) == 0
+    }
+
+    /// Whether some held constraint may still be let go.
+    pub(super) fn any_releasable(&self) -> bool {
+        self.bits & !self.released != 0
     }
 
     /// Stops holding constraint `k` (the walk wants to leave it inward), once per allocation.
@@ -69,6 +78,10 @@ impl<T: Real> ActiveSet<T> {
         constraints: &[Constraint<T>; CONSTRAINTS],
         force: &Vector3<T>,
     ) {
+        if self.updated == Some((self.bits, *force)) {
+            return;
+        }
+        self.updated = Some((self.bits, *force));
         self.basis = [None, None];
         self.fixed = false;
         self.curved = false;
