@@ -37,6 +37,25 @@ fn a4_inc_failure_is_classified_not_capable_and_keeps_flying_by_default() {
     }
 }
 
+/// The exact-boundary walk chooses its result torque first
+/// (`ExactBoundaryRedistribution::TORQUE_PRIORITY`): chosen by the plain wrench error it left the
+/// torque short while the three agents sat on their limits, and the team tilted to 0.613 rad
+/// (f64; 0.521 rad in f32) in the descent from 12 s. Measured now: 0.046 rad.
+#[test]
+fn a4_inc_failure_keeps_its_attitude_with_the_exact_boundary_walk() {
+    for precision in Precision::ALL {
+        let mut s = Scenario::builtin("agent-failure").unwrap();
+        s.allocator = "exact-boundary-redistribution".into();
+        s.controller_precision = precision;
+        let r = run_scenario(&s, None, None).unwrap();
+        assert!(
+            r.summary.max_tilt < 0.15,
+            "{precision:?}: {}",
+            r.summary.max_tilt
+        );
+    }
+}
+
 #[test]
 fn a4_inc_failure_with_land_is_a_controlled_descent() {
     for precision in Precision::ALL {

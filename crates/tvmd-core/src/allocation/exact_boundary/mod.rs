@@ -21,7 +21,8 @@ use crate::real::{eps, lit, Real};
 ///
 /// Each period starts from admissible forces `f`: the previous period's forces (saturated into
 /// this period's sets) or the redistributed pseudo-inverse's, whichever leaves the smaller
-/// wrench error. A previous-period start that does not meet the request first moves in
+/// torque-first wrench error (torque weighted by [`Self::TORQUE_PRIORITY`]). A previous-period
+/// start that does not meet the request first moves in
 /// `null(M)` toward the minimum-norm forces of its own wrench, as far as the exact sets allow,
 /// so the internal forces of a saturation bleed off as the request returns inside instead of
 /// jumping away at once later. Then, in rounds:
@@ -35,7 +36,10 @@ use crate::real::{eps, lit, Real};
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
 /// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds. A start that
-/// already meets the request is returned as it is. The walk keeps `|eta_x|` one milliradian
+/// already meets the request is returned as it is. The result is the candidate (the
+/// redistributed pseudo-inverse's forces, the walk's start and each of its points) with the
+/// smallest torque-first error, so it is never worse than the redistributed pseudo-inverse by
+/// that measure. The walk keeps `|eta_x|` one milliradian
 /// inside `pi/2`, where the gimbal inverse is singular (see `constraint::regular`). Every force is
 /// inside its set (the last rounds' forces are saturated if round-off left one outside).
 /// `rounds` counts the start's rounds and the walk's; `saturated` marks agents that end on a boundary.
@@ -72,6 +76,17 @@ impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
 }
 
 impl<T: Real, const N: usize> ExactBoundaryRedistribution<T, N> {
+    /// How much a torque error counts against a force error when the request cannot be met:
+    /// 1 N m as much as `TORQUE_PRIORITY` N.
+    ///
+    /// The walk spreads the whole remaining wrench, so where it stalls the error can sit in the
+    /// torque, and an attitude loop fed a torque it does not get drifts (measured: A4-Inc with one
+    /// agent failed tilted to 0.6 rad in `agent-failure`'s descent when the walk's result was chosen
+    /// by the plain wrench error). Choosing by this error keeps the torque first, as the
+    /// redistributed pseudo-inverse does (it saturates agents, not the torque), and leaves every
+    /// request the walk meets exactly unchanged.
+    pub const TORQUE_PRIORITY: f64 = 100.0;
+
     /// A new allocator with no previous forces.
     pub fn new() -> Self {
         Self::default()
@@ -321,6 +336,22 @@ fn on_boundary<T: Real>(
     bounds.iter().any(|c| c.value(f) > -tol)
 }
 
+/// `||[w r_tau; r_f]||`, `w` = [`ExactBoundaryRedistribution::TORQUE_PRIORITY`]
+/// (overflow-safe norm).
+fn torque_first<T: Real>(r: &Vector6<T>) -> T {
+    let w: T = lit(ExactBoundaryRedistribution::<T, 1>::TORQUE_PRIORITY);
+    // Scaled first, so the weight cannot overflow a large but finite residual.
+    let m = max_abs(r);
+    if !(m > T::zero() && m.is_finite()) {
+        return norm(r);
+    }
+    let mut weighted = r / m;
+    for x in weighted.iter_mut().take(3) {
+        *x *= w;
+    }
+    norm(&weighted) * m
+}
+
 impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T, N> {
     /// Forgets the previous forces: they belong to another team or failure mask.
     fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {
@@ -351,6 +382,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             self.previous = Some(start.forces);
             return start;
         }
+        // The redistributed pseudo-inverse keeps the torque whenever it can (it saturates agents,
+        // not the torque); it stays a candidate for the result under the torque-first error.
+        let rpi = (torque_first(&(request.wrench - e.wrench(&forces))), forces);
         if let Some(previous) = &self.previous {
             let mut kept = [Vector3::zeros(); N];
             for (((k, p), set), w) in kept.iter_mut().zip(previous).zip(sets).zip(&working) {
@@ -358,7 +392,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
                     *k = if outside(set, p) { set.saturate(p) } else { *p };
                 }
             }
-            if norm(&(request.wrench - e.wrench(&kept))) < start.wrench_error {
+            if torque_first(&(request.wrench - e.wrench(&kept))) < rpi.0 {
                 forces = kept;
             }
         }
@@ -381,10 +415,10 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
         // than its step gained, and the result is never worse than the start.
-        let mut best = (T::max_value().unwrap_or_else(T::one), walk.forces);
+        let mut best = rpi;
         while (rounds as usize) < limit {
             let r = walk.remaining(&request.wrench);
-            let error = norm(&r);
+            let error = torque_first(&r);
             if error < best.0 {
                 best = (error, walk.forces);
             }
@@ -405,8 +439,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             }
         }
         let r = walk.remaining(&request.wrench);
-        if norm(&r) < best.0 {
-            best = (norm(&r), walk.forces);
+        let error = torque_first(&r);
+        if error < best.0 {
+            best = (error, walk.forces);
         }
         let mut forces = best.1;
         let mut saturated = [false; N];
