@@ -127,6 +127,14 @@ fn bench_size<T: Real, const N: usize>(c: &mut Criterion, float: &str) {
             &hover,
             |b, r| b.iter(|| qp.allocate(black_box(r))),
         );
+        // Without the warm start every call steps from the redistributed pseudo-inverse.
+        let mut sequential = tvmd::core::allocation::SequentialConvexAllocator::<T, N>::default()
+            .with_warm_start(false);
+        g.bench_with_input(
+            BenchmarkId::new("clarabel_sequential", N),
+            &saturating,
+            |b, r| b.iter(|| sequential.allocate(black_box(r))),
+        );
     }
     let mut controller =
         Controller::new(team, settings, RedistributedPseudoInverse).expect("controller");

@@ -8,7 +8,9 @@ pub use crate::rotation::roll;
 
 use crate::admissible::{admissible_sets, AdmissibleSet, RateLimits};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::allocation::{Allocation, AllocationRequest, Allocator};
+use crate::allocation::{
+    Allocation, AllocationRequest, Allocator, NullSpaceReport, NullSpaceStage,
+};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField, InputError};
@@ -32,10 +34,15 @@ pub struct ControllerSettings<T: Real> {
     pub period: T,
     /// Optional gimbal rate limits (the rate-constrained allocation).
     pub rate_limits: Option<RateLimits<T>>,
+    /// Optional null-space stage run after the allocator ([`NullSpaceStage`]; `None`: the
+    /// allocator's forces are used as they are, and [`ControlOutput::null_space`] is
+    /// [`NullSpaceReport::off`]).
+    pub null_space: Option<NullSpaceStage<T>>,
 }
 
 impl<T: Real> ControllerSettings<T> {
-    /// The paper's settings: its gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s, no rate limits.
+    /// The paper's settings: its gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s, no rate limits,
+    /// no null-space stage.
     pub fn paper() -> Self {
         Self {
             gains: Gains::paper(),
@@ -43,6 +50,7 @@ impl<T: Real> ControllerSettings<T> {
             gravity: lit(crate::team::presets::GRAVITY),
             period: lit(0.01),
             rate_limits: None,
+            null_space: None,
         }
     }
 
@@ -72,8 +80,11 @@ pub struct ControlOutput<T: Real, const N: usize> {
     pub f_r: Vector3<T>,
     /// The law: `e_x`, `e_R`, `e_xi`, `u_r`, `u_d`, `V_R`, `V_x`.
     pub law: LawOutput<T>,
-    /// The allocation: forces, allocated wrench, `e_f`, rounds, saturated agents.
+    /// The allocation: forces, allocated wrench, `e_f`, rounds, saturated agents (after the
+    /// null-space stage when one is set).
     pub allocation: Allocation<T, N>,
+    /// What the null-space stage changed ([`NullSpaceReport::off`] without one).
+    pub null_space: NullSpaceReport<T>,
     /// Per-agent commands inside `E_f` (idle for failed agents and unused slots).
     pub commands: [AgentCommand<T>; N],
     /// Largest clamp the inversion applied (normalized; at most
@@ -341,11 +352,16 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             &projection.gain(),
         );
         let sets = self.admissible_sets();
-        let allocation = self.allocator.allocate(&AllocationRequest {
+        let request = AllocationRequest {
             effectiveness: &self.effectiveness,
             sets: &sets,
             wrench: law.u_d,
-        });
+        };
+        let allocation = self.allocator.allocate(&request);
+        let (allocation, null_space) = match &self.settings.null_space {
+            Some(stage) => stage.refine(&request, &allocation),
+            None => (allocation, NullSpaceReport::off()),
+        };
         let mut commands = [AgentCommand::idle(); N];
         let mut command_clamp = T::zero();
         for (i, ((cmd, force), set)) in commands
@@ -366,6 +382,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             f_r,
             law,
             allocation,
+            null_space,
             commands,
             command_clamp,
         };

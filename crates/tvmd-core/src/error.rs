@@ -91,6 +91,10 @@ pub enum ConfigField {
     ClarabelWeights,
     /// Clarabel's tolerance.
     ClarabelTolerance,
+    /// The null-space stage's iteration cap.
+    NullSpaceIterations,
+    /// The null-space stage's inward tilt.
+    NullSpaceTilt,
 }
 
 impl ConfigField {
@@ -128,6 +132,8 @@ impl ConfigField {
             Self::ClarabelLambda => "clarabel.lambda",
             Self::ClarabelWeights => "clarabel.weights",
             Self::ClarabelTolerance => "clarabel.tolerance",
+            Self::NullSpaceIterations => "null_space.iterations",
+            Self::NullSpaceTilt => "null_space.tilt",
         }
     }
 }
@@ -233,7 +239,8 @@ pub enum ConfigError {
     UnknownAllocator,
     /// The named allocator needs a cargo feature this build does not have.
     AllocatorUnavailable {
-        /// The allocator, which is also the feature (`"clarabel"`).
+        /// The allocator (`"clarabel"` or `"clarabel-sequential"`, both of the feature
+        /// `clarabel`).
         name: &'static str,
     },
     /// An option given to [`crate::AnyAllocator::from_name`] that the named allocator does not
@@ -345,7 +352,7 @@ impl fmt::Display for ConfigError {
             ),
             Self::AllocatorUnavailable { name } => write!(
                 f,
-                "allocator `{name}` needs the cargo feature `{name}`, which this build lacks"
+                "allocator `{name}` needs the cargo feature `clarabel`, which this build lacks"
             ),
             Self::UnusedOption { field } => {
                 write!(f, "the allocator takes no `{field}` option")

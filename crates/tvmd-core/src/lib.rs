@@ -67,12 +67,13 @@ pub mod team;
 
 pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
-#[cfg(feature = "clarabel")]
-pub use allocation::ClarabelAllocator;
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
-    ExactBoundaryRedistribution, PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
+    ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
+    PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
 };
+#[cfg(feature = "clarabel")]
+pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
 pub use effectiveness::Effectiveness;

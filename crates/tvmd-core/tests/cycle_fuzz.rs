@@ -213,7 +213,11 @@ fn team<T: Real>(rng: &mut StdRng) -> Result<TeamConfig<T, N>, tvmd_core::Config
 fn allocator<T: Real>(rng: &mut StdRng, clarabel: bool) -> AnyAllocator<T, N> {
     let mut options = AllocatorOptions::<T, N>::default();
     let name = if clarabel {
-        "clarabel"
+        if rng.random_bool(0.5) {
+            "clarabel"
+        } else {
+            "clarabel-sequential"
+        }
     } else {
         match rng.random_range(0..4) {
             0 => "pseudo-inverse",

@@ -91,7 +91,7 @@ fn attainable_requests_are_met_more_often_than_by_the_redistributed_pseudo_inver
             let rpi = RedistributedPseudoInverse.allocate(&request);
             let a = ExactBoundaryRedistribution::new().allocate(&request);
             assert_admissible(&a, &sets, &team);
-            assert!(a.wrench_error <= rpi.wrench_error * (1.0 + 1e-12) + 1e-12);
+            assert!(torque_first(&a, &u) <= torque_first(&rpi, &u) * (1.0 + 1e-12) + 1e-12);
             total += 1;
             rounds = rounds.max(a.rounds);
             exact += usize::from(relative(&a, &u) <= 1e-9);
@@ -116,6 +116,21 @@ fn team_sets_request(
     let e = team.effectiveness(&FailureMask::none());
     let sets = sets_of(&team);
     (team, e, sets)
+}
+
+/// `||[w (u_tau - M_tau f); u_f - M_f f]||`, `w` = `ExactBoundaryRedistribution::TORQUE_PRIORITY`.
+fn torque_first<const N: usize>(a: &tvmd_core::Allocation<f64, N>, u: &Vector6<f64>) -> f64 {
+    let mut r = u - a.wrench;
+    for x in r.iter_mut().take(3) {
+        *x *= ExactBoundaryRedistribution::<f64, N>::TORQUE_PRIORITY;
+    }
+    // Beyond 1e300 the weighted torque overflows; the scaled norm stays finite.
+    let m = r.amax();
+    if m > 0.0 && m.is_finite() {
+        (r / m).norm() * m
+    } else {
+        r.norm()
+    }
 }
 
 proptest! {
@@ -151,7 +166,10 @@ proptest! {
                 prop_assert_eq!(a.forces[i], Vector3::zeros());
             }
             let rpi = RedistributedPseudoInverse.allocate(&request);
-            prop_assert!(a.wrench_error <= rpi.wrench_error * (1.0 + 1e-12) + 1e-12);
+            // Never worse than the redistributed pseudo-inverse by the torque-first error the
+            // walk chooses its result by.
+            let (tf, tf_rpi) = (torque_first(&a, &wrench), torque_first(&rpi, &wrench));
+            prop_assert!(tf <= tf_rpi * (1.0 + 1e-12) + 1e-12, "{tf} > {tf_rpi}");
             prop_assert!(a.rounds as usize <= 3 * team.len() + 4);
         }
     }
@@ -212,7 +230,7 @@ fn a_slowly_moving_request_starts_from_the_previous_forces() {
             }
         }
     }
-    // Measured: 179 and 180 of 180 exact, 947 and 924 rounds: the warm start keeps the
+    // Measured: 180 and 180 of 180 exact, 944 and 940 rounds: the warm start keeps the
     // forces continuous between periods but buys neither exactness nor rounds here.
     println!(
         "warm: {warm_exact} exact, {warm_rounds} rounds; fresh: {fresh_exact}, {fresh_rounds}"

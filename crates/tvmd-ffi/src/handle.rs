@@ -203,6 +203,7 @@ fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
         gravity: config.gravity,
         period: config.period,
         rate_limits,
+        null_space: None,
     };
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,

@@ -5,7 +5,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use tvmd_core::admissible::admissible_sets;
-use tvmd_core::allocation::{AllocatorOptions, CLARABEL, WEIGHTED_PSEUDO_INVERSE};
+use tvmd_core::allocation::{
+    AllocatorOptions, CLARABEL, CLARABEL_SEQUENTIAL, WEIGHTED_PSEUDO_INVERSE,
+};
 use tvmd_core::{AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator};
 use tvmd_core::{ConfigError, ConfigField, GimbalCommand, RateLimits};
 
@@ -46,7 +48,7 @@ pub(crate) fn make_allocator(
             padded.iter_mut().zip(&w).for_each(|(slot, w)| *slot = *w);
             options.agent_weights = Some(padded);
         }
-        (CLARABEL, Some(weights)) if cfg!(feature = "clarabel") => {
+        (CLARABEL | CLARABEL_SEQUENTIAL, Some(weights)) if cfg!(feature = "clarabel") => {
             options.wrench_weights = Some(arg::<6, 1>(weights, "weights")?.into());
         }
         // Any other allocator refuses them (the core says so).
@@ -58,10 +60,10 @@ pub(crate) fn make_allocator(
             "unknown allocator '{method}'; expected one of: {}",
             ALLOCATORS.join(", ")
         )),
-        ConfigError::AllocatorUnavailable { .. } => PyValueError::new_err(
-            "allocator 'clarabel' is not available: tvmd was built without the cargo feature \
-`clarabel` (rebuild with `maturin build --features clarabel`)",
-        ),
+        ConfigError::AllocatorUnavailable { .. } => PyValueError::new_err(format!(
+            "allocator '{method}' is not available: tvmd was built without the cargo feature \
+`clarabel` (rebuild with `maturin build --features clarabel`)"
+        )),
         ConfigError::UnusedOption { field } => {
             let option = match field {
                 ConfigField::ClarabelLambda => "regularization",
@@ -76,8 +78,10 @@ pub(crate) fn make_allocator(
 /// The last solve report of a Clarabel allocator, as text.
 pub(crate) fn report(allocator: &AnyAllocator<f64, CAPACITY>) -> Option<String> {
     #[cfg(feature = "clarabel")]
-    if let AnyAllocator::Clarabel(a) = allocator {
-        return a.last_report().map(ToString::to_string);
+    match allocator {
+        AnyAllocator::Clarabel(a) => return a.last_report().map(ToString::to_string),
+        AnyAllocator::ClarabelSequential(a) => return a.last_report().map(ToString::to_string),
+        _ => {}
     }
     let _ = allocator;
     None

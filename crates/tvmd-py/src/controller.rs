@@ -3,7 +3,10 @@
 use pyo3::prelude::*;
 
 use tvmd_core::team::presets;
-use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, HoverCapability};
+use tvmd_core::{
+    AnyAllocator, ControlOutput, Controller, ControllerSettings, HoverCapability, NullSpaceReport,
+};
+use tvmd_sim::scenario::NullSpaceConfig;
 
 use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};
@@ -12,6 +15,7 @@ use crate::errors::{cycle_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains, PyLawOutput};
 use crate::planner::{iteration_cap, planner, relaxation_arg, PyPlannerResult};
 use crate::record::record;
+use crate::sim::{null_space_arg, value_error};
 use crate::team::{failure_mask, PyTeam};
 use crate::CAPACITY;
 
@@ -20,12 +24,13 @@ use crate::CAPACITY;
 pub struct PyController {
     inner: Controller<f64, CAPACITY, AnyAllocator<f64, CAPACITY>>,
     max_iterations: u32,
+    null_space: Option<NullSpaceConfig>,
 }
 
 #[pymethods]
 impl PyController {
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,
@@ -41,15 +46,22 @@ impl PyController {
         planner_tolerance: Option<f64>,
         planner_max_iterations: Option<i64>,
         s: Option<f64>,
+        null_space: Option<&str>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
+        let null_space = null_space_arg(null_space)?;
+        let stage = match &null_space {
+            Some(c) => Some(c.stage::<f64>().map_err(value_error)?),
+            None => None,
+        };
         let settings = ControllerSettings {
             gains: gains_arg(gains)?,
             relaxation,
             gravity,
             period,
             rate_limits: rate_limits_arg(rate_limits)?,
+            null_space: stage,
         };
         let allocator = make_allocator(allocator, weights, regularization, team.len())?;
         let mask = failure_mask(&team, failed)?;
@@ -62,6 +74,7 @@ impl PyController {
         Ok(Self {
             inner,
             max_iterations,
+            null_space,
         })
     }
 
@@ -157,6 +170,12 @@ impl PyController {
         self.inner.allocator().name()
     }
 
+    /// The null-space stage ("margin", "inward-tilt=<rad>"), or None.
+    #[getter]
+    fn null_space(&self) -> Option<String> {
+        self.null_space.map(|n| n.to_string())
+    }
+
     /// The planner's bisection iteration cap.
     #[getter]
     fn planner_max_iterations(&self) -> u32 {
@@ -235,6 +254,30 @@ record! {
         commands => commands_array(py, &o.out.commands, o.n)?,
         /// Largest clamp of the command inversion (normalized).
         command_clamp => o.out.command_clamp,
+        /// What the null-space stage changed.
+        null_space => PyNullSpaceReport { inner: o.out.null_space },
+    }
+}
+
+record! {
+    /// What the null-space stage changed in one period. See the stub.
+    "NullSpaceReport" in "tvmd" => PyNullSpaceReport(NullSpaceReport<f64>) |py, o| {
+        /// The stage ran on this period's allocation.
+        ran => o.ran,
+        /// Accepted steps (0: the allocator's forces unchanged).
+        iterations => o.iterations,
+        /// The objective at the allocator's forces.
+        objective_before => o.objective_before,
+        /// The objective at the returned forces.
+        objective_after => o.objective_after,
+        /// Smallest normalized margin to the admissible boundary at the allocator's forces.
+        margin_before => o.margin_before,
+        /// The same at the returned forces.
+        margin_after => o.margin_after,
+        /// Largest change of one agent's force (N).
+        largest_force_change => o.largest_force_change,
+        /// `||M f' - M f||`, the wrench the stage moved (round-off).
+        wrench_drift => o.wrench_drift,
     }
 }
 
@@ -243,5 +286,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyController>()?;
     m.add_class::<PyStepOutput>()?;
     m.add_class::<PyHoverCapability>()?;
+    m.add_class::<PyNullSpaceReport>()?;
     Ok(())
 }

@@ -13,7 +13,7 @@ use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
-use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
+use tvmd_sim::scenario::{NullSpaceConfig, Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 use tvmd_sim::SimError;
 
@@ -32,6 +32,7 @@ const RUN_KEYS: &[&str] = &[
     "allocator",
     "precision",
     "pil",
+    "null_space",
 ];
 
 /// What was done with the file an I/O error names.
@@ -66,7 +67,7 @@ fn sim_error(error: SimError, context: &str, file: Option<(&str, &Path)>) -> PyE
 }
 
 /// A tvmd-sim error without a file.
-fn value_error(error: SimError) -> PyErr {
+pub(crate) fn value_error(error: SimError) -> PyErr {
     sim_error(error, "", None)
 }
 
@@ -98,8 +99,21 @@ struct RunArgs<'a, 'py> {
     mcap: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    null_space: Option<String>,
     precision: Option<String>,
     pil: Option<String>,
+}
+
+/// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
+pub(crate) fn null_space_arg(spec: Option<&str>) -> PyResult<Option<NullSpaceConfig>> {
+    let Some(spec) = spec else {
+        return Ok(None);
+    };
+    let config: NullSpaceConfig = spec
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("`null_space`: {e}")))?;
+    config.validate().map_err(value_error)?;
+    Ok(Some(config))
 }
 
 impl RunArgs<'_, '_> {
@@ -125,6 +139,7 @@ impl RunArgs<'_, '_> {
             relaxation: self.relaxation,
             allocator: self.allocator,
             precision,
+            null_space: null_space_arg(self.null_space.as_deref())?,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
         RunSpec::on_target(scenario, self.mcap, pil, precision).map_err(value_error)
@@ -181,6 +196,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         mcap: opt(dict, &name, "mcap")?,
         relaxation: opt(dict, &name, "relaxation")?,
         allocator: opt(dict, &name, "allocator")?,
+        null_space: opt(dict, &name, "null_space")?,
         precision: opt(dict, &name, "precision")?,
         pil: opt(dict, &name, "pil")?,
     }
@@ -236,7 +252,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -247,6 +263,7 @@ fn run(
     allocator: Option<String>,
     precision: Option<String>,
     pil: Option<String>,
+    null_space: Option<String>,
 ) -> PyResult<PySimResult> {
     let spec = RunArgs {
         scenario,
@@ -254,6 +271,7 @@ fn run(
         mcap,
         relaxation,
         allocator,
+        null_space,
         precision,
         pil,
     }
@@ -431,6 +449,8 @@ record! {
         relaxation => o.scenario.relaxation,
         /// Allocator of the run.
         allocator => o.scenario.allocator.as_str(),
+        /// The null-space stage of the run ("margin", "inward-tilt=<rad>"), or None.
+        null_space => o.scenario.null_space.map(|n| n.to_string()),
         /// The float type the controller flew in, "f64" or "f32".
         precision => o.scenario.controller_precision.as_str(),
         /// Where the controller ran: "host", or the emulated target of a processor-in-the-loop

@@ -521,6 +521,23 @@ def test_clarabel_allocation():
     assert step.allocation.report is not None and step.allocation.method == "clarabel"
 
 
+@pytest.mark.skipif(not tvmd.HAS_CLARABEL, reason="built without the cargo feature `clarabel`")
+def test_clarabel_sequential_allocation():
+    team = tvmd.Team.a4_inc()
+    # A saturating request: never worse than the redistributed pseudo-inverse.
+    mg = team.mass * 9.81
+    u_d = np.array([0.5, -0.4, 0.1, 12.0, -9.0, mg])
+    rpi = tvmd.allocate(team, u_d, method="redistributed-pseudo-inverse")
+    out = tvmd.allocate(team, u_d, method="clarabel-sequential")
+    assert out.method == "clarabel-sequential" and out.report is not None and "convex steps" in out.report
+    assert out.wrench_error <= rpi.wrench_error * (1 + 1e-12) + 1e-12
+    assert "clarabel-sequential" in tvmd.ALLOCATORS
+    ctrl = tvmd.Controller(team, allocator="clarabel-sequential")
+    step = ctrl.step({"position": [0, 0, 1]}, {"position": [0, 0, 1]})
+    assert step.allocation.report is not None and step.allocation.method == "clarabel-sequential"
+    assert step.allocation.e_f < 1e-9
+
+
 # ---------------------------------------------------------------------------
 # Controller
 # ---------------------------------------------------------------------------
@@ -589,7 +606,7 @@ def test_controller_outputs_and_state():
     out = ctrl.step({"position": [0.5, -0.5, 0.0]}, {"position": [0.0, 0.0, 1.5], "attitude": ri.rot_x(1.0)})
     d = out.to_dict()
     assert tuple(d) == tvmd.StepOutput.FIELDS
-    assert tvmd.StepOutput.FIELDS == ("planner", "projection", "f_r", "law", "allocation", "commands", "command_clamp")
+    assert tvmd.StepOutput.FIELDS == ("planner", "projection", "f_r", "law", "allocation", "commands", "command_clamp", "null_space")
     assert tuple(d["planner"]) == tvmd.PlannerResult.FIELDS and tuple(d["law"]) == tvmd.LawOutput.FIELDS
     assert tuple(d["allocation"]) == tvmd.Allocation.FIELDS
     assert tuple(d["projection"]) == tvmd.ForceProjection.FIELDS == ("force", "t_Tf", "t_eta")
@@ -808,6 +825,8 @@ def test_clarabel_not_built():
         tvmd.allocate(A4, np.zeros(6), method="clarabel")
     with pytest.raises(ValueError, match="cargo feature `clarabel`"):
         tvmd.Controller(A4, allocator="clarabel")
+    with pytest.raises(ValueError, match="'clarabel-sequential' is not available"):
+        tvmd.allocate(A4, np.zeros(6), method="clarabel-sequential")
 
 
 # ---------------------------------------------------------------------------
@@ -823,3 +842,26 @@ def test_docstrings_present():
             for attr, value in vars(obj).items():
                 if not attr.startswith("_") and attr != "FIELDS":
                     assert getattr(value, "__doc__", None), f"{name}.{attr}"
+
+
+def test_controller_null_space_stage():
+    team = tvmd.Team.a4_inc()
+    c, s = math.cos(0.6), math.sin(0.6)
+    roll = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    state = {"position": [0.3, -0.2, 1.5]}
+    reference = {"position": [0.0, 0.0, 1.5], "attitude": roll}
+    plain = tvmd.Controller(team).step(state, reference)
+    assert not plain.null_space.ran and plain.null_space.iterations == 0
+    ctrl = tvmd.Controller(team, null_space="margin")
+    assert ctrl.null_space == "margin"
+    out = ctrl.step(state, reference)
+    r = out.null_space
+    assert r.ran and r.margin_after >= r.margin_before
+    assert r.objective_after >= r.objective_before
+    # The wrench is the allocator's to round-off.
+    np.testing.assert_allclose(out.allocation.wrench, plain.allocation.wrench, atol=1e-9)
+    assert set(r.to_dict()) == set(tvmd.NullSpaceReport.FIELDS)
+    assert tvmd.Controller(team, null_space="inward-tilt=0.1").null_space == "inward-tilt=0.1"
+    for bad in ["sideways", "inward-tilt", "inward-tilt=nan", "inward-tilt=1.6"]:
+        with pytest.raises(ValueError, match="null_space"):
+            tvmd.Controller(team, null_space=bad)

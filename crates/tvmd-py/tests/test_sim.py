@@ -505,3 +505,37 @@ def test_pil_option_errors() -> None:
         sim.run(toml=SHORT, pil="cortex-m4", precision="f64")
     with pytest.raises(ValueError, match="runs\\[0\\]|unknown PIL target"):
         sim.run_many([{"toml": SHORT, "pil": "m4"}])
+
+
+def test_null_space_stage_keeps_the_flight_and_raises_the_margin():
+    # The same saturated s = 1 flight with and without the margin stage: the stage changes only
+    # forces inside null(M), so e_f stays (to round-off) while the smallest margin rises.
+    plain = sim.run("paper-tilt", relaxation=1.0)
+    staged = sim.run("paper-tilt", relaxation=1.0, null_space="margin")
+    assert plain.null_space is None and staged.null_space == "margin"
+    assert "null_space" not in plain.summary
+    ns = staged.summary["null_space"]
+    assert ns["periods"] > 1000 and ns["raised_periods"] > 0
+    assert ns["mean_margin_after"] > ns["mean_margin_before"]
+    assert ns["min_margin_after"] >= ns["min_margin_before"]
+    assert staged.summary["saturated_periods"] < plain.summary["saturated_periods"]
+    assert abs(staged.summary["max_e_f"] - plain.summary["max_e_f"]) < 1e-6
+    tilted = sim.run_many(
+        [{"scenario": "paper-tilt", "null_space": "inward-tilt=0.1"}]
+    )[0]
+    assert tilted.null_space == "inward-tilt=0.1"
+    # The scenario that ran says so, as a table that loads back.
+    assert 'objective = "inward-tilt"' in tilted.scenario_toml
+    assert sim.run(toml=tilted.scenario_toml).null_space == "inward-tilt=0.1"
+
+
+@pytest.mark.parametrize(
+    "spec, field",
+    [("sideways", "null_space"), ("inward-tilt", "null_space.tilt"), ("inward-tilt=2", "null_space.tilt")],
+)
+def test_null_space_errors_name_the_field(spec, field):
+    with pytest.raises(ValueError, match=field.replace(".", r"\.")):
+        sim.run("paper-tilt", null_space=spec)
+    toml = SHORT + "null_space = { objective = \"margin\", iterations = 0 }\n"
+    with pytest.raises(ValueError, match=r"null_space\.iterations"):
+        sim.run(toml=toml)

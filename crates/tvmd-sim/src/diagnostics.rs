@@ -79,6 +79,24 @@ pub struct AllocationDiagnostics {
     /// are given).
     #[serde(default)]
     pub rotor_speeds: Vec<f64>,
+    /// What the null-space stage changed, when the scenario runs one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub null_space: Option<NullSpaceDiagnostics>,
+}
+
+/// The null-space stage's report of one period (`tvmd_core::NullSpaceReport`, in f64).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct NullSpaceDiagnostics {
+    /// Accepted steps (0: the allocator's forces unchanged).
+    pub iterations: u32,
+    /// The objective before and after.
+    pub objective: [f64; 2],
+    /// The smallest normalized margin to the admissible boundary, before and after.
+    pub margin: [f64; 2],
+    /// Largest change of one agent's force (N).
+    pub largest_force_change: f64,
+    /// `||M f' - M f||`, the wrench the stage moved (round-off).
+    pub wrench_drift: f64,
 }
 
 /// Lyapunov candidates (logged on `/lyapunov`).

@@ -28,6 +28,8 @@
 //!   f64 or in f32 (the flight configuration; scenario field `controller_precision`).
 //! - [`runner`]: runs with the tvmd controller: one ([`runner::run_scenario`]) or a batch on
 //!   one worker pool ([`runner::run_many`], [`runner::relaxation_sweep`]).
+//! - [`allocation_bench`]: the allocation benchmark set (seeded requests per team, attainable
+//!   or certified outside) and the evaluation of every allocator on it and in the closed loop.
 //! - [`plot`]: PNG figures (state profile, Lyapunov candidates, relaxation study) from samples
 //!   or from an MCAP log.
 //!
@@ -37,6 +39,7 @@
 #![warn(missing_docs)]
 
 pub mod actuators;
+pub mod allocation_bench;
 pub mod control;
 pub mod diagnostics;
 mod error;

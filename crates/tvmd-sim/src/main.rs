@@ -3,12 +3,16 @@
 //!
 //! ```text
 //! tvmd-sim run [SCENARIO|FILE.toml] [--out run.mcap | --no-log] [--plots DIR] [--summary FILE]
-//!              [--relaxation S] [--allocator NAME] [--precision f64|f32]
+//!              [--relaxation S] [--allocator NAME] [--null-space margin|inward-tilt=RAD]
+//!              [--precision f64|f32]
 //!              [--pil cortex-m4|cortex-m7]
 //! tvmd-sim sweep [--relaxations 0.25,0.5,0.75,1.0] [--scenario NAME|FILE] [--plots DIR]
 //!                [--allocator NAME] [--precision f64|f32]
 //! tvmd-sim plot RUN.mcap [MORE.mcap ...] --out DIR
 //! tvmd-sim record-cycles [SCENARIO|FILE.toml] --out FILE [--cycles 1000] [--allocator NAME]
+//! tvmd-sim allocation-set [--out benches/data/allocation_set.json] [--seed 16]
+//! tvmd-sim allocation-eval [--set benches/data/allocation_set.json] [--allocators A,B]
+//!                          [--closed-loop] [--json FILE]
 //! tvmd-sim list
 //! tvmd-sim show NAME
 //! ```
@@ -21,6 +25,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
+use tvmd_sim::allocation_bench;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::plot::{self, PlotSeries};
@@ -62,9 +67,14 @@ enum Command {
         #[arg(long)]
         relaxation: Option<f64>,
         /// Override the scenario's allocator (exact-boundary-redistribution, the default;
-        /// redistributed-pseudo-inverse, pseudo-inverse, weighted-pseudo-inverse, clarabel).
+        /// redistributed-pseudo-inverse, pseudo-inverse, weighted-pseudo-inverse, clarabel,
+        /// clarabel-sequential).
         #[arg(long)]
         allocator: Option<String>,
+        /// Run a null-space stage after the allocator: `margin`, or `inward-tilt=<rad>`
+        /// (the scenario's `null_space`; see docs/method.md, "Null-space stage").
+        #[arg(long, value_name = "OBJECTIVE")]
+        null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
@@ -132,6 +142,31 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Write the seeded allocation benchmark set (attainable and certified-outside requests for
+    /// A4-Inc, A6-Inc, A8-Inc, a 16-agent ring and A4-Inc with agent 1 failed).
+    AllocationSet {
+        /// File to write.
+        #[arg(long, default_value = tvmd_sim::allocation_bench::SET_PATH)]
+        out: PathBuf,
+        /// Seed of the generator.
+        #[arg(long, default_value_t = tvmd_sim::allocation_bench::SEED)]
+        seed: u64,
+    },
+    /// Evaluate allocators on the allocation set and print markdown tables.
+    AllocationEval {
+        /// The set file.
+        #[arg(long, default_value = tvmd_sim::allocation_bench::SET_PATH)]
+        set: PathBuf,
+        /// Allocators, comma-separated (default: every allocator of this build).
+        #[arg(long, value_delimiter = ',')]
+        allocators: Vec<String>,
+        /// Also fly paper-tilt at s = 1 with each allocator.
+        #[arg(long)]
+        closed_loop: bool,
+        /// JSON file for the rows.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// List the built-in scenarios.
     List,
     /// Print a built-in scenario as TOML (a starting point for a scenario file).
@@ -186,6 +221,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         } => cmd_run(RunArgs {
@@ -196,6 +232,7 @@ fn main() -> ExitCode {
             summary,
             relaxation,
             allocator,
+            null_space,
             precision,
             pil,
         }),
@@ -230,6 +267,22 @@ fn main() -> ExitCode {
             )
         }),
         Command::Plot { logs, out } => cmd_plot(&logs, &out),
+        Command::AllocationSet { out, seed } => allocation_bench::cli::write_set(&out, seed)
+            .map(|m| println!("{m}"))
+            .map_err(CliError::from),
+        Command::AllocationEval {
+            set,
+            allocators,
+            closed_loop,
+            json,
+        } => allocation_bench::cli::evaluate(
+            &set,
+            &allocation_bench::cli::allocator_names(&allocators),
+            closed_loop,
+            json.as_deref(),
+        )
+        .map(|t| print!("{t}"))
+        .map_err(CliError::from),
         Command::List => {
             for name in BUILTIN_NAMES {
                 // Built-ins always exist.
@@ -280,6 +333,9 @@ struct RunReport<'a> {
     scenario: &'a str,
     relaxation: f64,
     allocator: &'a str,
+    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    null_space: Option<String>,
     /// The controller's float type, `"f64"` or `"f32"`.
     controller_precision: Precision,
     /// Where the controller ran: `"host"` or the emulated target.
@@ -299,6 +355,7 @@ struct RunArgs {
     summary: Option<PathBuf>,
     relaxation: Option<f64>,
     allocator: Option<String>,
+    null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
     precision: Option<String>,
     pil: Option<String>,
 }
@@ -346,6 +403,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         relaxation: a.relaxation,
         allocator: a.allocator,
         precision,
+        null_space: a.null_space,
     })?;
     let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
     let log = if a.no_log {
@@ -365,6 +423,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
+        null_space: scenario.null_space.map(|n| n.to_string()),
         controller_precision: scenario.controller_precision,
         controller_target: &result.summary.controller_target,
         hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
@@ -412,7 +471,7 @@ fn opt_e(v: Option<f64>, unit: &str) -> String {
 fn print_run(r: &RunReport<'_>) {
     let s = r.summary;
     let p = &r.paper;
-    let rows: Vec<(&str, String)> = vec![
+    let mut rows: Vec<(&str, String)> = vec![
         ("scenario", r.scenario.to_string()),
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
@@ -496,6 +555,16 @@ fn print_run(r: &RunReport<'_>) {
             ),
         ),
     ];
+    if let (Some(name), Some(n)) = (&r.null_space, &s.null_space) {
+        rows.push(("null-space stage", name.clone()));
+        rows.push((
+            "margin mean / min",
+            format!(
+                "{:.3} -> {:.3} / {:.3} -> {:.3}",
+                n.mean_margin_before, n.mean_margin_after, n.min_margin_before, n.min_margin_after
+            ),
+        ));
+    }
     for (k, v) in rows {
         println!("{k:<26} {v}");
     }

@@ -142,6 +142,14 @@ impl RunSpec {
                     ),
                 });
             }
+            if scenario.null_space.is_some() {
+                return Err(SimError::InvalidScenario {
+                    field: "null_space".into(),
+                    reason: format!(
+                        "the {target} PIL firmware runs without the null-space stage; drop                          `null_space` or the PIL target"
+                    ),
+                });
+            }
             scenario.controller_precision = Precision::F32;
         }
         Ok(Self { scenario, log, pil })

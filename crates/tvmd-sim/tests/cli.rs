@@ -261,3 +261,39 @@ fn sweep_prints_one_row_per_relaxation() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("relaxation"));
 }
+
+#[test]
+fn null_space_option_reports_its_margins_and_rejects_bad_objectives() {
+    let dir = tmp_dir("null-space");
+    let scenario = short_scenario(&dir);
+    let summary = dir.join("ns.json");
+    let stdout = ok(bin()
+        .arg("run")
+        .arg(&scenario)
+        .args(["--null-space", "margin", "--no-log", "--summary"])
+        .arg(&summary)
+        .output()
+        .unwrap());
+    assert!(
+        stdout.contains("null-space stage           margin"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(json["null_space"], "margin");
+    assert!(json["summary"]["null_space"]["periods"].as_u64().unwrap() > 0);
+    for (spec, needle) in [
+        ("sideways", "unknown null-space objective"),
+        ("inward-tilt", "null_space.tilt"),
+    ] {
+        let out = bin()
+            .arg("run")
+            .arg(&scenario)
+            .args(["--null-space", spec, "--no-log"])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{spec}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(needle), "{spec}: {stderr}");
+    }
+}

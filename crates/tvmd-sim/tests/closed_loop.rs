@@ -252,7 +252,7 @@ fn a6_agent_failure_in_hover_is_survived(precision: Precision) {
 /// their full thrust, nothing in reserve. Measured: position error 4.3 mm over 5-9 s, in f64 and
 /// in f32 (where the thrust of agents 1 and 3 dips to 2.0e-4 below `sigma_Tf`). Pinned to the
 /// redistributed pseudo-inverse, which these numbers describe (the default exact-boundary
-/// redistribution also keeps 4.3 mm over 5-9 s, in f32 too, and tilts more in the descent
+/// redistribution also keeps 4.3 mm over 5-9 s, in f32 too, and tilts less in the descent
 /// from 12 s: `hover_failure.rs`).
 fn a4_agent_failure_leaves_no_margin(precision: Precision) {
     let mut s = Scenario::builtin("agent-failure").unwrap();

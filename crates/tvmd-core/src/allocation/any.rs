@@ -20,6 +20,9 @@ pub const EXACT_BOUNDARY_REDISTRIBUTION: &str = "exact-boundary-redistribution";
 /// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without
 /// the feature can say what is missing).
 pub const CLARABEL: &str = "clarabel";
+/// Name of `SequentialConvexAllocator` (feature `clarabel`, known to every build as
+/// [`CLARABEL`] is).
+pub const CLARABEL_SEQUENTIAL: &str = "clarabel-sequential";
 
 #[cfg(feature = "clarabel")]
 const NAMES: &[&str] = &[
@@ -28,6 +31,7 @@ const NAMES: &[&str] = &[
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
     CLARABEL,
+    CLARABEL_SEQUENTIAL,
 ];
 #[cfg(not(feature = "clarabel"))]
 const NAMES: &[&str] = &[
@@ -42,9 +46,11 @@ const NAMES: &[&str] = &[
 pub struct AllocatorOptions<T: Real, const N: usize> {
     /// Per-agent weights `w_i` of [`WeightedPseudoInverse`] (default: all 1).
     pub agent_weights: Option<[T; N]>,
-    /// Wrench weights `W` of `ClarabelAllocator` (default: identity).
+    /// Wrench weights `W` of `ClarabelAllocator` and `SequentialConvexAllocator` (default:
+    /// identity).
     pub wrench_weights: Option<[T; 6]>,
-    /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`).
+    /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`) and
+    /// `SequentialConvexAllocator` (default `0`).
     pub regularization: Option<T>,
 }
 
@@ -85,10 +91,14 @@ pub enum AnyAllocator<T: Real, const N: usize> {
     /// [`super::ClarabelAllocator`] (feature `clarabel`).
     #[cfg(feature = "clarabel")]
     Clarabel(super::ClarabelAllocator<T, N>),
+    /// [`super::SequentialConvexAllocator`] (feature `clarabel`).
+    #[cfg(feature = "clarabel")]
+    ClarabelSequential(super::SequentialConvexAllocator<T, N>),
 }
 
 impl<T: Real, const N: usize> AnyAllocator<T, N> {
-    /// The names this build knows, the default first; `"clarabel"` only with the feature.
+    /// The names this build knows, the default first; `"clarabel"` and `"clarabel-sequential"`
+    /// only with the feature.
     pub const NAMES: &'static [&'static str] = NAMES;
 
     /// The name of the default allocator.
@@ -97,7 +107,7 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
     /// The allocator named `name` (one of [`Self::NAMES`]) with `options`.
     ///
     /// Errors: [`ConfigError::UnknownAllocator`]; [`ConfigError::AllocatorUnavailable`] for
-    /// `"clarabel"` without the feature; [`ConfigError::UnusedOption`] for an option the
+    /// `"clarabel"` and `"clarabel-sequential"` without the feature; [`ConfigError::UnusedOption`] for an option the
     /// allocator does not take; the allocator's own validation errors.
     pub fn from_name(name: &str, options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
         let refuse = |given: bool, field| {
@@ -139,12 +149,16 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
                     weights,
                 )?))
             }
-            CLARABEL => {
+            CLARABEL | CLARABEL_SEQUENTIAL => {
                 refuse(
                     options.agent_weights.is_some(),
                     ConfigField::AllocatorWeights,
                 )?;
-                Self::clarabel(options)
+                if name == CLARABEL {
+                    Self::clarabel(options)
+                } else {
+                    Self::clarabel_sequential(options)
+                }
             }
             _ => Err(ConfigError::UnknownAllocator),
         }
@@ -164,6 +178,21 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
     #[cfg(not(feature = "clarabel"))]
     fn clarabel(_options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
         Err(ConfigError::AllocatorUnavailable { name: CLARABEL })
+    }
+
+    #[cfg(feature = "clarabel")]
+    fn clarabel_sequential(options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        let lambda = options.regularization.unwrap_or_else(T::zero);
+        Ok(Self::ClarabelSequential(
+            super::SequentialConvexAllocator::new(lambda, options.wrench_weights)?,
+        ))
+    }
+
+    #[cfg(not(feature = "clarabel"))]
+    fn clarabel_sequential(_options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        Err(ConfigError::AllocatorUnavailable {
+            name: CLARABEL_SEQUENTIAL,
+        })
     }
 
     /// The allocator's name, one of [`Self::NAMES`].
@@ -188,6 +217,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::ExactBoundaryRedistribution(a) => a.configure(effectiveness),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.configure(effectiveness),
+            #[cfg(feature = "clarabel")]
+            Self::ClarabelSequential(a) => a.configure(effectiveness),
         }
     }
 
@@ -199,6 +230,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::ExactBoundaryRedistribution(a) => a.reset(),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.reset(),
+            #[cfg(feature = "clarabel")]
+            Self::ClarabelSequential(a) => a.reset(),
         }
     }
 
@@ -210,6 +243,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::ExactBoundaryRedistribution(a) => a.allocate(request),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.allocate(request),
+            #[cfg(feature = "clarabel")]
+            Self::ClarabelSequential(a) => a.allocate(request),
         }
     }
 
@@ -221,6 +256,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::ExactBoundaryRedistribution(a) => a.name(),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.name(),
+            #[cfg(feature = "clarabel")]
+            Self::ClarabelSequential(a) => a.name(),
         }
     }
 }

@@ -38,8 +38,10 @@ AllocatorName = Literal[
     "pseudo-inverse",
     "weighted-pseudo-inverse",
     "clarabel",
+    "clarabel-sequential",
 ]
-"""The allocators (``"clarabel"`` only with the cargo feature, see ``ALLOCATORS``)."""
+"""The allocators (``"clarabel"`` and ``"clarabel-sequential"`` only with the cargo feature, see
+``ALLOCATORS``)."""
 PlannerStatus = Literal["already-feasible", "planned", "zero-force", "unreachable"]
 """How the attitude planner reached its output."""
 Arrangement = Literal["Con", "Inc"]
@@ -754,7 +756,8 @@ class Allocation:
         saturated: (n,) bool, agents saturated onto the boundary of their admissible set.
         fallback: the allocator fell back to the redistributed pseudo-inverse (Clarabel).
         method: the allocator's name.
-        report: Clarabel's solve report (text), None for the other allocators.
+        report: the solve report (text) of "clarabel" and "clarabel-sequential", None for the
+            other allocators.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -784,7 +787,7 @@ class Allocation:
         """The allocator's name."""
     @property
     def report(self) -> Optional[str]:
-        """Clarabel's solve report, None otherwise."""
+        """The solve report of "clarabel" and "clarabel-sequential", None otherwise."""
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
 
@@ -817,6 +820,13 @@ def allocate(
         "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
             ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
             diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).
+        "clarabel-sequential": the same objective over the exact ``E_f`` by sequential convex
+            steps: from the redistributed pseudo-inverse's forces, each step a QP over ``E_f``
+            linearized at the current forces (an inner bound that keeps the gimbal corners the
+            "clarabel" pyramid drops), at most 5 steps, stopping when the wrench is exact
+            (relative 1e-9) or the objective decreases by less than 1e-6 relatively; never worse
+            than "redistributed-pseudo-inverse". Needs the cargo feature ``clarabel``;
+            ``weights`` (6,) is ``W``, ``regularization`` is ``lambda`` (default 0).
 
     Args:
         team: the ``Team``.
@@ -829,13 +839,13 @@ def allocate(
         rate_limits: ``(eta_x_rate, eta_y_rate)`` (rad/s): narrows each gimbal range to
             ``|eta - eta_prev| <= rate dt``.
         dt: the control period (s), required with ``rate_limits``.
-        regularization: ``lambda`` of "clarabel".
+        regularization: ``lambda`` of "clarabel" and "clarabel-sequential".
 
     Returns:
         Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
 
     Raises:
-        ValueError: an unknown method, "clarabel" without the feature, options that do not
+        ValueError: an unknown method, "clarabel" or "clarabel-sequential" without the feature, options that do not
             apply to the method, wrong shapes, NaN/inf input.
         ConfigError: a degraded team that cannot produce every wrench, bad weights or rates.
     """
@@ -858,14 +868,21 @@ class Controller:
         rate_limits: optional ``(eta_x_rate, eta_y_rate)`` gimbal rate limits (rad/s).
         failed: None or failed agent indices.
         weights: allocator weights (see ``tvmd.allocate``).
-        regularization: ``lambda`` of the "clarabel" allocator.
+        regularization: ``lambda`` of the "clarabel" and "clarabel-sequential" allocators.
         planner_tolerance: bisection tolerance (rad); default ``max(1e-10, 8 eps)``.
         planner_max_iterations: bisection iteration cap; default 64.
+        null_space: a null-space stage after the allocator (docs/method.md "Null-space stage"):
+            ``"margin"`` (keep every agent away from its limits) or ``"inward-tilt=<rad>"``
+            (tilt each thrust toward the team's centre); moves the forces inside ``null(M)``, so
+            the wrench is unchanged to round-off, and never outside ``E_f``. None (default): off.
+            ``StepOutput.null_space`` reports what it changed.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
             produce every wrench.
-        ValueError: unknown allocator, "clarabel" without the cargo feature, wrong shapes.
+        ValueError: unknown allocator, "clarabel" or "clarabel-sequential" without the cargo
+            feature, wrong shapes, an unknown null-space objective or a tilt that is missing, not
+            finite or not below ``pi/2``.
     """
 
     def __new__(
@@ -884,6 +901,7 @@ class Controller:
         planner_max_iterations: Optional[int] = None,
         *,
         s: Optional[float] = None,
+        null_space: Optional[str] = None,
     ) -> "Controller": ...
     def set_failures(self, failed: _Failed = None) -> "HoverCapability":
         """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``
@@ -948,6 +966,9 @@ class Controller:
     @property
     def planner_max_iterations(self) -> int:
         """The planner's bisection iteration cap."""
+    @property
+    def null_space(self) -> Optional[str]:
+        """The null-space stage ("margin", "inward-tilt=<rad>"), or None."""
     @property
     def failed(self) -> list[int]:
         """Indices of the failed agents."""
@@ -1014,6 +1035,7 @@ class StepOutput:
             ``saturated``, ``fallback``, ``method``, ``report``).
         commands: (n, 4) columns ``eta_x, eta_y, thrust, omega`` (idle for failed agents).
         command_clamp: the largest clamp the command inversion applied (normalized).
+        null_space: NullSpaceReport of the null-space stage (``ran`` False without one).
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -1038,5 +1060,53 @@ class StepOutput:
     @property
     def command_clamp(self) -> float:
         """Largest clamp of the command inversion (normalized)."""
+    @property
+    def null_space(self) -> "NullSpaceReport":
+        """What the null-space stage changed."""
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict (nested records as dicts)."""
+
+@final
+class NullSpaceReport:
+    """What the null-space stage (``Controller(null_space=...)``, ``tvmd_core::NullSpaceStage``)
+    changed in one period. Margins are the smallest normalized margin of any working agent to
+    its admissible boundary (each gimbal and thrust limit as a fraction of its range: 0 on the
+    boundary, 1 at the opposite end).
+
+    Attributes:
+        ran: the stage ran (configured, and the allocation was finite); False: all zero.
+        iterations: accepted steps (0: the allocator's forces are unchanged).
+        objective_before, objective_after: the objective (soft minimum of the margins for
+            ``"margin"``, mean cos to the tilt target for ``"inward-tilt"``); never lower after.
+        margin_before, margin_after: the smallest normalized margin before and after.
+        largest_force_change: largest change of one agent's force (N).
+        wrench_drift: ``||M f' - M f||``, the wrench the stage moved (round-off).
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+    @property
+    def ran(self) -> bool:
+        """The stage ran on this period's allocation."""
+    @property
+    def iterations(self) -> int:
+        """Accepted steps (0: the allocator's forces unchanged)."""
+    @property
+    def objective_before(self) -> float:
+        """The objective at the allocator's forces."""
+    @property
+    def objective_after(self) -> float:
+        """The objective at the returned forces."""
+    @property
+    def margin_before(self) -> float:
+        """Smallest normalized margin to the admissible boundary at the allocator's forces."""
+    @property
+    def margin_after(self) -> float:
+        """The same at the returned forces."""
+    @property
+    def largest_force_change(self) -> float:
+        """Largest change of one agent's force (N)."""
+    @property
+    def wrench_drift(self) -> float:
+        """``||M f' - M f||``, the wrench the stage moved (round-off)."""
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict."""

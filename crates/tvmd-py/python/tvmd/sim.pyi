@@ -42,7 +42,8 @@ class SimResult:
     not report at a tick (a skipped cycle) are NaN.
 
     Attributes:
-        scenario_name, relaxation (``s``), allocator, precision (``"f64"`` or ``"f32"``, the
+        scenario_name, relaxation (``s``), allocator, null_space (the null-space stage or None),
+        precision (``"f64"`` or ``"f32"``, the
         controller's float type), controller_target (``"host"`` or the PIL target), mcap_path
         (str or None), n_agents,
         mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
@@ -75,6 +76,9 @@ class SimResult:
     @property
     def allocator(self) -> AllocatorName:
         """Allocator of the run."""
+    @property
+    def null_space(self) -> Optional[str]:
+        """The null-space stage of the run ("margin", "inward-tilt=<rad>"), or None."""
     @property
     def precision(self) -> _Precision:
         """The float type the controller flew in, "f64" or "f32"."""
@@ -194,6 +198,7 @@ def run(
     allocator: Optional[AllocatorName] = None,
     precision: Optional[_Precision] = None,
     pil: Optional[_PilTarget] = None,
+    null_space: Optional[str] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -210,7 +215,8 @@ def run(
         relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
         allocator: override the allocator ("exact-boundary-redistribution", the default;
             "redistributed-pseudo-inverse", the paper's; "pseudo-inverse",
-            "weighted-pseudo-inverse", "clarabel" with the cargo feature).
+            "weighted-pseudo-inverse"; "clarabel" and "clarabel-sequential" with the cargo
+            feature).
         precision: override the controller's float type (scenario field
             ``controller_precision``): "f32" flies ``tvmd_core::Controller<f32, ..>``, the type a
             flight controller runs; "f64" (the default). The physics stays f64; the summary's
@@ -221,11 +227,16 @@ def run(
             physics stays here; the precision becomes "f32" (asking for "f64" too is a
             ``ValueError``). The summary's and the result's ``controller_target`` say
             which target flew ("host" otherwise).
+        null_space: run a null-space stage after the allocator (scenario field ``null_space``):
+            ``"margin"`` or ``"inward-tilt=<rad>"`` (docs/method.md "Null-space stage"; the
+            wrench is unchanged to round-off). The summary's ``null_space`` gives its margins
+            before and after; not with ``pil``.
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
             message names the field, e.g. ``physics.dt``), a bad override, both ``scenario`` and
-            ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``.
+            ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``, an unknown
+            ``null_space`` objective or a bad tilt (``null_space.tilt``), ``null_space`` with ``pil``.
         TypeError: an argument of the wrong type.
         OSError: the scenario file cannot be read or the log cannot be written.
         RuntimeError: the run failed while flying (the state diverged, the controller failed,
@@ -241,7 +252,8 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
         runs: a sequence whose items are each a scenario (a built-in name or a TOML file, as
             ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
             ``{"scenario": "a4-con", "relaxation": 1.0}``, ``{"toml": text, "mcap": "x.mcap"}`` or
-            ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` too, as ``run``).
+            ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` and ``"null_space"``
+            too, as ``run``).
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
 
     Every item is loaded and validated before any run starts. If runs fail, the first failure

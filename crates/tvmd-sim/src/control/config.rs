@@ -128,6 +128,11 @@ pub fn controller_settings<T: CoreFloat>(
         gravity: to_core(scenario.physics.gravity),
         period: to_core(scenario.controller_period),
         rate_limits,
+        null_space: scenario
+            .null_space
+            .as_ref()
+            .map(|n| n.stage::<T>())
+            .transpose()?,
     })
 }
 
@@ -143,8 +148,10 @@ pub fn allocator<T: CoreFloat>(name: &str) -> Result<AnyAllocator<T, MAX_AGENTS>
         ),
         ConfigError::AllocatorUnavailable { .. } => invalid(
             "allocator",
-            "allocator `clarabel` needs tvmd-sim built with the `clarabel` feature \
-             (cargo build --features clarabel)",
+            format!(
+                "allocator `{name}` needs tvmd-sim built with the `clarabel` feature \
+                 (cargo build --features clarabel)"
+            ),
         ),
         e => config_error(e),
     })

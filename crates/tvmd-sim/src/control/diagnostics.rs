@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 use super::convert::{array_to_sim, matrix_to_sim, to_sim, vector_to_sim, CoreFloat};
 use super::CoreOutput;
 use crate::diagnostics::{
-    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics, PlannerDiagnostics,
+    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics,
+    NullSpaceDiagnostics, PlannerDiagnostics,
 };
 use crate::math::{planned_roll, to_rows};
 use tvmd_core::PlannerStatus;
@@ -58,6 +59,16 @@ pub(super) fn cycle_diagnostics<T: CoreFloat>(
             fallback: alloc.fallback,
             forces: alloc.forces[..n].iter().map(vector_to_sim).collect(),
             rotor_speeds: out.commands[..n].iter().map(|c| to_sim(c.omega)).collect(),
+            null_space: out.null_space.ran.then(|| {
+                let r = &out.null_space;
+                NullSpaceDiagnostics {
+                    iterations: r.iterations,
+                    objective: [to_sim(r.objective_before), to_sim(r.objective_after)],
+                    margin: [to_sim(r.margin_before), to_sim(r.margin_after)],
+                    largest_force_change: to_sim(r.largest_force_change),
+                    wrench_drift: to_sim(r.wrench_drift),
+                }
+            }),
         }),
         lyapunov: Some(LyapunovDiagnostics {
             v_x: to_sim(law.v_x),

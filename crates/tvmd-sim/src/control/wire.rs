@@ -294,6 +294,7 @@ impl CoreConfig {
             gravity: self.gravity,
             period: self.period,
             rate_limits,
+            null_space: None,
         };
         let alloc = AnyAllocator::from_name(self.allocator_name(), &Default::default())?;
         Controller::new(team, settings, alloc)
@@ -459,6 +460,8 @@ pub fn get_output(r: &mut Reader<'_>, n: usize) -> Option<WireOutput> {
         f_r,
         law,
         allocation,
+        // The target runs without the null-space stage.
+        null_space: tvmd_core::NullSpaceReport::off(),
         commands,
         command_clamp,
     })

@@ -14,6 +14,7 @@
 //! allocator = "exact-boundary-redistribution" # "redistributed-pseudo-inverse", "clarabel", ...
 //! controller_precision = "f64"               # or "f32": the flight configuration
 //! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
+//! # null_space = "margin"                     # null-space stage after the allocator
 //!
 //! [physics]
 //! dt = 0.001
@@ -66,15 +67,20 @@ use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
 
 mod builtin;
+mod null_space;
 mod overrides;
 mod validate;
 
 pub use builtin::BUILTIN_NAMES;
+pub use null_space::{
+    NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
+};
 pub use overrides::Overrides;
 use validate::invalid;
 
 /// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
-/// scenario may also name `"clarabel"`, which needs the `clarabel` feature at run time.
+/// scenario may also name `"clarabel"` or `"clarabel-sequential"`, which need the `clarabel`
+/// feature at run time.
 pub const ALLOCATOR_NAMES: &[&str] = tvmd_core::AnyAllocator::<f64, 1>::NAMES;
 
 /// The float type the controller runs in (the physics is always f64).
@@ -391,14 +397,18 @@ pub struct Scenario {
     pub relaxation: f64,
     /// Allocator name, interpreted by the controller; `"exact-boundary-redistribution"`
     /// (the core's default; also `"redistributed-pseudo-inverse"`, the paper's,
-    /// `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and `"clarabel"` with
-    /// the `clarabel` feature).
+    /// `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and `"clarabel"`,
+    /// `"clarabel-sequential"` with the `clarabel` feature).
     pub allocator: String,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
     /// plant's: give both to model a servo the controller knows about.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controller_rate_limits: Option<[f64; 2]>,
+    /// Optional null-space stage after the allocator (`"margin"`, `"inward-tilt=<rad>"`, or a
+    /// table, see [`NullSpaceConfig`]); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub null_space: Option<NullSpaceConfig>,
     /// The float type the controller runs in, `"f64"` (default) or `"f32"` (the flight
     /// configuration: `tvmd_core::Controller<f32, ..>`). The physics stays f64.
     pub controller_precision: Precision,
@@ -435,6 +445,7 @@ impl Default for Scenario {
             relaxation: 0.5,
             allocator: tvmd_core::AnyAllocator::<f64, 1>::DEFAULT_NAME.into(),
             controller_rate_limits: None,
+            null_space: None,
             controller_precision: Precision::F64,
             physics: PhysicsConfig::default(),
             team: TeamSpec::default(),

@@ -2,7 +2,7 @@
 //! `--precision`, the Python keywords `relaxation=` / `allocator=` / `precision=`), applied
 //! with validation.
 
-use super::{Precision, Scenario};
+use super::{NullSpaceConfig, Precision, Scenario};
 use crate::SimError;
 
 /// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
@@ -14,12 +14,17 @@ pub struct Overrides {
     pub allocator: Option<String>,
     /// The controller's float type (`controller_precision`).
     pub precision: Option<Precision>,
+    /// A null-space stage after the allocator (`null_space`).
+    pub null_space: Option<NullSpaceConfig>,
 }
 
 impl Overrides {
     /// True if nothing is overridden.
     pub fn is_empty(&self) -> bool {
-        self.relaxation.is_none() && self.allocator.is_none() && self.precision.is_none()
+        self.relaxation.is_none()
+            && self.allocator.is_none()
+            && self.precision.is_none()
+            && self.null_space.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -32,6 +37,9 @@ impl Overrides {
         }
         if let Some(p) = self.precision {
             scenario.controller_precision = p;
+        }
+        if let Some(n) = self.null_space {
+            scenario.null_space = Some(n);
         }
         scenario.validate()
     }
@@ -55,12 +63,17 @@ mod tests {
             relaxation: Some(1.0),
             allocator: Some("pseudo-inverse".into()),
             precision: Some(Precision::F32),
+            null_space: Some("margin".parse().unwrap()),
         };
         assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();
         assert_eq!(s.relaxation, 1.0);
         assert_eq!(s.allocator, "pseudo-inverse");
         assert_eq!(s.controller_precision, Precision::F32);
+        assert_eq!(
+            s.null_space.map(|n| n.to_string()).as_deref(),
+            Some("margin")
+        );
         assert_eq!(
             Scenario::default()
                 .with_overrides(&Overrides::default())

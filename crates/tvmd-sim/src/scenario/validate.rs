@@ -84,6 +84,9 @@ impl Scenario {
             check_pos("controller_rate_limits[0]", x)?;
             check_pos("controller_rate_limits[1]", y)?;
         }
+        if let Some(n) = &self.null_space {
+            n.validate()?;
+        }
         check_nonneg("gains.k_x", &self.gains.k_x)?;
         check_nonneg("gains.k_r", &self.gains.k_r)?;
         check_nonneg("gains.k_xi", &self.gains.k_xi)?;

@@ -38,7 +38,7 @@ use crate::SimError;
 
 pub use difference::FlightDifference;
 pub use sample::Sample;
-pub use summary::{PaperMetrics, RunSummary, RunTotals, VxRise};
+pub use summary::{NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, VxRise};
 
 /// Result of a run: the samples and a summary.
 #[derive(Clone, Debug, Serialize)]

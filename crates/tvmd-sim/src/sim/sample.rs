@@ -39,6 +39,8 @@ pub struct Sample {
     pub e_f: Option<f64>,
     /// Number of agents the allocator saturated, if reported.
     pub saturated_agents: Option<usize>,
+    /// The null-space stage's smallest normalized margin before and after, if it ran.
+    pub null_space_margins: Option<[f64; 2]>,
     /// `V_x`, if reported.
     pub v_x: Option<f64>,
     /// `V_R`, if reported.
@@ -98,6 +100,11 @@ impl Sample {
                 .allocation
                 .as_ref()
                 .map(|a| a.saturated.iter().filter(|x| **x).count()),
+            null_space_margins: d
+                .allocation
+                .as_ref()
+                .and_then(|a| a.null_space.as_ref())
+                .map(|n| n.margin),
             v_x: d.lyapunov.map(|l| l.v_x),
             v_r: d.lyapunov.map(|l| l.v_r),
             cycle_error: d.cycle_error.is_some(),

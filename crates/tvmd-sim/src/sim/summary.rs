@@ -207,6 +207,9 @@ pub struct RunSummary {
     pub saturated_periods: usize,
     /// Controller periods the controller skipped (held commands).
     pub cycle_errors: usize,
+    /// The null-space stage's margins, when the scenario runs one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub null_space: Option<NullSpaceSummary>,
     /// The hover classifications, one per accepted change of the failure mask.
     pub hover_classifications: Vec<HoverClassification>,
     /// Number of controller calls.
@@ -217,6 +220,47 @@ pub struct RunSummary {
     pub wall_time: f64,
     /// Real-time factor: simulated time over wall time.
     pub real_time_factor: f64,
+}
+
+/// The null-space stage over a run: its smallest normalized margin to the admissible
+/// boundary (`docs/method.md`, "Null-space stage") before and after it, over the samples where
+/// it ran.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct NullSpaceSummary {
+    /// Samples where the stage ran.
+    pub periods: usize,
+    /// Samples where it raised the smallest margin.
+    pub raised_periods: usize,
+    /// Mean smallest margin at the allocator's forces.
+    pub mean_margin_before: f64,
+    /// Mean smallest margin after the stage.
+    pub mean_margin_after: f64,
+    /// Lowest smallest margin at the allocator's forces.
+    pub min_margin_before: f64,
+    /// Lowest smallest margin after the stage.
+    pub min_margin_after: f64,
+}
+
+impl NullSpaceSummary {
+    /// `None` when the stage never ran.
+    fn of(samples: &[Sample]) -> Option<Self> {
+        let margins: Vec<[f64; 2]> = samples
+            .iter()
+            .filter_map(|x| x.null_space_margins)
+            .collect();
+        if margins.is_empty() {
+            return None;
+        }
+        let n = margins.len() as f64;
+        Some(Self {
+            periods: margins.len(),
+            raised_periods: margins.iter().filter(|[b, a]| a > b).count(),
+            mean_margin_before: margins.iter().map(|m| m[0]).sum::<f64>() / n,
+            mean_margin_after: margins.iter().map(|m| m[1]).sum::<f64>() / n,
+            min_margin_before: margins.iter().map(|m| m[0]).fold(f64::INFINITY, f64::min),
+            min_margin_after: margins.iter().map(|m| m[1]).fold(f64::INFINITY, f64::min),
+        })
+    }
 }
 
 impl RunSummary {
@@ -282,6 +326,7 @@ impl RunSummary {
                 .filter(|x| x.saturated_agents.is_some_and(|n| n > 0))
                 .count(),
             cycle_errors: samples.iter().filter(|x| x.cycle_error).count(),
+            null_space: NullSpaceSummary::of(samples),
             hover_classifications: samples
                 .iter()
                 .filter_map(|x| {
@@ -460,6 +505,7 @@ mod tests {
             theta: None,
             e_f,
             saturated_agents: None,
+            null_space_margins: None,
             v_x: Some(x),
             v_r: None,
             cycle_error: false,

@@ -32,6 +32,13 @@ pub(super) struct Bounds {
     pub(super) x_lo: XBound,
     pub(super) thrust_lo: f64,
     pub(super) thrust_hi: f64,
+    /// Linearized at a force `f0` ([`super::SequentialConvexAllocator`]): the linear `eta_x`
+    /// rows use `axis . (f_x, f_z)` and the minimum-thrust row `lift . f` in place of `f_z`.
+    pub(super) tilted: bool,
+    /// Unit direction in the `x z` plane (`[0, 1]`, that is `f_z`, unless tilted).
+    pub(super) axis: [f64; 2],
+    /// Unit normal of the minimum-thrust row (`[0, 0, 1]` unless tilted).
+    pub(super) lift: [f64; 3],
 }
 
 impl Bounds {
@@ -56,6 +63,9 @@ impl Bounds {
             },
             thrust_lo: to_f64(set.thrust().lo).max(0.0),
             thrust_hi: to_f64(set.thrust().hi),
+            tilted: false,
+            axis: [0.0, 1.0],
+            lift: [0.0, 0.0, 1.0],
         };
         let finite = [
             bounds.tan_y_lo,
@@ -78,26 +88,44 @@ impl Bounds {
         Shape {
             x_hi_cone: self.x_hi.is_cone(),
             x_lo_cone: self.x_lo.is_cone(),
+            tilted: self.tilted,
         }
     }
 
     /// Every constraint's slack at `f` (negative: violated), in the order of the rows.
     pub(super) fn slacks(&self, [fx, fy, fz]: [f64; 3]) -> [f64; 6] {
         let norm = (fx * fx + fy * fy + fz * fz).sqrt();
+        let (along, lifted) = if self.tilted {
+            let ([ax, az], [hx, hy, hz]) = (self.axis, self.lift);
+            (ax * fx + az * fz, hx * fx + hy * fy + hz * fz)
+        } else {
+            (fz, fz)
+        };
         [
             self.tan_y_hi * fz - fx,
             fx - self.tan_y_lo * fz,
             match self.x_hi {
-                XBound::Tan(t) => t * fz + fy,
+                XBound::Tan(t) => t * along + fy,
                 XBound::Cone(s) => s * fy - norm,
             },
             match self.x_lo {
-                XBound::Tan(t) => -fy - t * fz,
+                XBound::Tan(t) => -fy - t * along,
                 XBound::Cone(s) => -s * fy - norm,
             },
-            fz - self.thrust_lo,
+            lifted - self.thrust_lo,
             self.thrust_hi - norm,
         ]
+    }
+
+    /// Whether a constraint is active at `f` within [`ACTIVE_TOL`] (of the pyramid: after
+    /// [`Self::repair`], as the polish has always judged it).
+    pub(super) fn active(&self, f: [f64; 3]) -> bool {
+        if self.tilted {
+            let tol = ACTIVE_TOL * self.thrust_hi.max(f64::MIN_POSITIVE);
+            self.slacks(f).iter().any(|s| *s <= tol)
+        } else {
+            self.repair(f).1
+        }
     }
 
     /// Whether `f` satisfies every constraint up to [`FEASIBLE_TOL`] of the maximum thrust.
@@ -162,6 +190,8 @@ pub(super) fn lerp(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
 pub(super) struct Shape {
     pub(super) x_hi_cone: bool,
     pub(super) x_lo_cone: bool,
+    /// Linearized rows (more nonzeros in `A`, same rows).
+    pub(super) tilted: bool,
 }
 
 impl Shape {

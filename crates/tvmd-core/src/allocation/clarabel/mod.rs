@@ -2,13 +2,18 @@
 //! see [`ClarabelAllocator`]. One file per concept, as Clarabel.rs lays out its solver:
 //! [`settings`] (defaults), [`report`] (what a solve did), [`cones`] (one agent's constraint
 //! geometry), [`qp`] (assembly of `P`, `q`, `A`, `b`), [`polish`] (least squares, shortcut and
-//! active-set polish) and [`cache`] (the solver reused between periods).
+//! active-set polish) and [`cache`] (the solver reused between periods). The sequential convex
+//! allocator on the exact gimbal set ([`SequentialConvexAllocator`]) adds [`linearize`] (the
+//! convexification at a force), [`sequential`] and [`sequential_report`].
 
 mod cache;
 mod cones;
+mod linearize;
 mod polish;
 mod qp;
 mod report;
+mod sequential;
+mod sequential_report;
 mod settings;
 
 use core::fmt;
@@ -28,6 +33,8 @@ use crate::real::{lit, to_f64, Real};
 use cache::Cache;
 use qp::Problem;
 pub use report::{ClarabelStatus, FallbackReason, SolveReport};
+pub use sequential::SequentialConvexAllocator;
+pub use sequential_report::{SequentialReport, StopReason};
 use settings::{default_settings, DEFAULT_LAMBDA};
 
 /// The constrained allocator of `docs/method.md` ("Allocation"): a QP with second-order cones solved by

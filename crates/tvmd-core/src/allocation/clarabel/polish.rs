@@ -66,7 +66,7 @@ impl<const N: usize> Problem<N> {
             .agents
             .iter()
             .zip(start)
-            .map(|(a, f)| a.bounds.feasible(*f) && !a.bounds.repair(*f).1)
+            .map(|(a, f)| a.bounds.feasible(*f) && !a.bounds.active(*f))
             .collect();
         let mut moved = false;
         for _ in 0..self.agents.len() {

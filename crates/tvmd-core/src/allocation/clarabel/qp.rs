@@ -169,18 +169,30 @@ impl<const N: usize> Problem<N> {
             // -f_x + tan(lo_y) f_z <= 0
             out.extend([(x, row, -1.0), (z, row, b.tan_y_lo)]);
             row += 1;
+            // Untilted, `axis . (f_x, f_z)` is `f_z` and `lift . f` is `f_z`.
+            let [ax, az] = b.axis;
             if let XBound::Tan(t) = b.x_hi {
-                // -f_y - tan(hi_x) f_z <= 0
-                out.extend([(y, row, -1.0), (z, row, -t)]);
+                // -f_y - tan(hi_x) axis . (f_x, f_z) <= 0
+                if b.tilted {
+                    out.push((x, row, -t * ax));
+                }
+                out.extend([(y, row, -1.0), (z, row, -t * az)]);
                 row += 1;
             }
             if let XBound::Tan(t) = b.x_lo {
-                // f_y + tan(lo_x) f_z <= 0
-                out.extend([(y, row, 1.0), (z, row, t)]);
+                // f_y + tan(lo_x) axis . (f_x, f_z) <= 0
+                if b.tilted {
+                    out.push((x, row, t * ax));
+                }
+                out.extend([(y, row, 1.0), (z, row, t * az)]);
                 row += 1;
             }
-            // -f_z <= -T_lo
-            out.push((z, row, -1.0));
+            // -lift . f <= -T_lo
+            let [hx, hy, hz] = b.lift;
+            if b.tilted {
+                out.extend([(x, row, -hx), (y, row, -hy)]);
+            }
+            out.push((z, row, -hz));
             row += 1;
         }
         for (k, agent) in self.agents.iter().enumerate() {

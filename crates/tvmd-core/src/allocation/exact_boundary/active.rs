@@ -10,7 +10,7 @@ use crate::real::{lit, Real};
 /// Constraints an agent is held on (bit `k` for constraint `k`), with the orthonormal normals of
 /// their tangent planes at the agent's current force.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct ActiveSet<T: Real> {
+pub(in crate::allocation) struct ActiveSet<T: Real> {
     bits: u8,
     /// Constraints already let go once in this allocation: never again, so no cycling.
     released: u8,
@@ -18,6 +18,9 @@ pub(super) struct ActiveSet<T: Real> {
     basis: [Option<Vector3<T>>; 2],
     fixed: bool,
     curved: bool,
+    /// The held bits and the force of the last [`Self::update`]: the normals are the same while
+    /// both are (a fixed agent, or every agent after a release re-solves).
+    updated: Option<(u8, Vector3<T>)>,
 }
 
 impl<T: Real> Default for ActiveSet<T> {
@@ -28,23 +31,29 @@ impl<T: Real> Default for ActiveSet<T> {
             basis: [None, None],
             fixed: false,
             curved: false,
+            updated: None,
         }
     }
 }
 
 impl<T: Real> ActiveSet<T> {
     /// Whether constraint `k` is held.
-    pub(super) fn holds(&self, k: usize) -> bool {
+    pub(in crate::allocation) fn holds(&self, k: usize) -> bool {
         k < CONSTRAINTS && self.bits & (1 << k) != 0
     }
 
     /// Whether constraint `k` is held and may still be let go.
-    pub(super) fn releasable(&self, k: usize) -> bool {
+    pub(in crate::allocation) fn releasable(&self, k: usize) -> bool {
         self.holds(k) && self.released & (1 << k) == 0
     }
 
+    /// Whether some held constraint may still be let go.
+    pub(super) fn any_releasable(&self) -> bool {
+        self.bits & !self.released != 0
+    }
+
     /// Stops holding constraint `k` (the walk wants to leave it inward), once per allocation.
-    pub(super) fn release(&mut self, k: usize) {
+    pub(in crate::allocation) fn release(&mut self, k: usize) {
         if k < CONSTRAINTS {
             self.bits &= !(1 << k);
             self.released |= 1 << k;
@@ -52,23 +61,27 @@ impl<T: Real> ActiveSet<T> {
     }
 
     /// Whether the held normals span all three directions: the agent cannot move.
-    pub(super) fn fixed(&self) -> bool {
+    pub(in crate::allocation) fn fixed(&self) -> bool {
         self.fixed
     }
 
     /// Holds constraint `k` from now on.
-    pub(super) fn hold(&mut self, k: usize) {
+    pub(in crate::allocation) fn hold(&mut self, k: usize) {
         if k < CONSTRAINTS {
             self.bits |= 1 << k;
         }
     }
 
     /// Recomputes the normals at `force` (they turn with the force on a cone or a sphere).
-    pub(super) fn update(
+    pub(in crate::allocation) fn update(
         &mut self,
         constraints: &[Constraint<T>; CONSTRAINTS],
         force: &Vector3<T>,
     ) {
+        if self.updated == Some((self.bits, *force)) {
+            return;
+        }
+        self.updated = Some((self.bits, *force));
         self.basis = [None, None];
         self.fixed = false;
         self.curved = false;
@@ -100,7 +113,7 @@ impl<T: Real> ActiveSet<T> {
     }
 
     /// `P d`, the part of `d` in every held tangent plane.
-    pub(super) fn project(&self, d: &Vector3<T>) -> Vector3<T> {
+    pub(in crate::allocation) fn project(&self, d: &Vector3<T>) -> Vector3<T> {
         if self.fixed {
             return Vector3::zeros();
         }
@@ -114,7 +127,11 @@ impl<T: Real> ActiveSet<T> {
     /// Turns the agent's term `B B^T` of a Gram matrix into `B P B^T` (`B` its effectiveness
     /// block; `P` symmetric and idempotent, so `B P (B P)^T = B P B^T`): one rank-one downdate per
     /// held normal, or the whole term for a fixed agent.
-    pub(super) fn downdate(&self, block: &Matrix6x3<T>, gram: &mut nalgebra::Matrix6<T>) {
+    pub(in crate::allocation) fn downdate(
+        &self,
+        block: &Matrix6x3<T>,
+        gram: &mut nalgebra::Matrix6<T>,
+    ) {
         if self.fixed {
             *gram -= block * block.transpose();
             return;
@@ -125,8 +142,13 @@ impl<T: Real> ActiveSet<T> {
         }
     }
 
+    /// The orthonormal normals of the held tangent planes (up to two).
+    pub(in crate::allocation) fn normals(&self) -> impl Iterator<Item = &Vector3<T>> {
+        self.basis.iter().flatten()
+    }
+
     /// Whether a held constraint is a cone or a sphere.
-    pub(super) fn curved(&self) -> bool {
+    pub(in crate::allocation) fn curved(&self) -> bool {
         self.curved
     }
 }

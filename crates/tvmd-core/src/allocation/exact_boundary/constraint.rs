@@ -20,24 +20,31 @@ use crate::linalg::{max_abs, norm};
 use crate::real::{eps, lit, Real};
 
 /// Number of constraints of one agent.
-pub(super) const CONSTRAINTS: usize = 6;
+pub(in crate::allocation) const CONSTRAINTS: usize = 6;
 
 /// `g(f) = c . f + s ||f|| + k <= 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Constraint<T: Real> {
+pub(in crate::allocation) struct Constraint<T: Real> {
     c: Vector3<T>,
     s: T,
     k: T,
+    /// `|c| + |s|`, a Lipschitz constant of `g`.
+    lipschitz: T,
 }
 
 impl<T: Real> Constraint<T> {
     /// `g(f)`, overflow-safe (the norm does not square).
-    pub(super) fn value(&self, f: &Vector3<T>) -> T {
+    pub(in crate::allocation) fn value(&self, f: &Vector3<T>) -> T {
         self.c.dot(f) + self.s * norm(f) + self.k
     }
 
+    /// `g(f)` given `||f||`.
+    pub(super) fn value_with_norm(&self, f: &Vector3<T>, norm: T) -> T {
+        self.c.dot(f) + self.s * norm + self.k
+    }
+
     /// `grad g(f) = c + s f / ||f||` (`c` at the origin, where the cones have no normal).
-    pub(super) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
+    pub(in crate::allocation) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
         let n = norm(f);
         if n > T::zero() {
             self.c + f * (self.s / n)
@@ -48,52 +55,60 @@ impl<T: Real> Constraint<T> {
 
     /// Whether `g` is curved (a cone or a sphere): a step along its tangent plane leaves the
     /// boundary to second order, so the agent is retracted onto the set after it.
-    pub(super) fn curved(&self) -> bool {
+    pub(in crate::allocation) fn curved(&self) -> bool {
         self.s != T::zero()
     }
 
     /// The first `tau >= 0` at which `f + tau d` leaves `{g <= 0}`: `Some(0)` when `f` is on
     /// (or, by round-off, just beyond) the boundary and `d` points out; `None` when the ray never
-    /// leaves. `f` and `d` finite.
+    /// leaves. `f` and `d` finite. (The walk scales one ray for all six; the null-space stage
+    /// asks one constraint at a time.)
+    pub(in crate::allocation) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
+        Ray::new(f, d, self.k.abs())
+            .and_then(|ray| self.first_exit_along(&ray, T::max_value().unwrap_or_else(T::one)))
+    }
+
+    /// [`Self::first_exit`] along a ray scaled once for all of an agent's constraints, or
+    /// `None` for an exit that is certainly beyond `2 within`.
     ///
     /// Closed form: squaring `c . x + k = -s ||x||` gives a quadratic in `tau`; a root is kept
     /// when it is a root of `g` itself (`s (c . x + k) <= 0`) and `g` increases through it.
-    /// Everything is scaled by the largest input component first, which leaves `tau`
+    /// The ray is scaled by the largest input component (`k` included), which leaves `tau`
     /// unchanged (`g` is homogeneous of degree one in `(f, d, k)`) and keeps the squares finite.
-    pub(super) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
-        let m = max_abs(f).max(max_abs(d)).max(self.k.abs());
-        if m <= T::zero() || !m.is_finite() {
-            return None;
-        }
-        let (f, d, k) = (f / m, d / m, self.k / m);
-        // Scaled to components of at most one: plain norms cannot overflow (an underflow is
-        // a force at the origin, which it is to this precision).
-        let len = |v: &Vector3<T>| v.dot(v).sqrt();
+    pub(super) fn first_exit_along(&self, ray: &Ray<T>, within: T) -> Option<T> {
+        let (f, d) = (&ray.f, &ray.d);
+        let k = self.k / ray.scale;
         let tol: T = eps::<T>() * lit(64.0);
-        let g0 = self.c.dot(&f) + self.s * len(&f) + k;
-        let slope = |x: &Vector3<T>| {
-            let n = len(x);
-            if n > T::zero() {
-                self.c.dot(&d) + self.s * x.dot(&d) / n
+        let p = self.c.dot(f) + k;
+        let q = self.c.dot(d);
+        let g0 = p + self.s * ray.f_len;
+        // The slope of `g` along `d` at a point `x` with `x . d` and `||x||` given.
+        let slope = |x_dot_d: T, x_len: T| {
+            if x_len > T::zero() {
+                q + self.s * x_dot_d / x_len
             } else {
-                self.c.dot(&d) + self.s * len(&d)
+                q + self.s * ray.d_len
             }
         };
-        let d_scale = len(&d);
-        if g0 > -tol && slope(&f) > tol * d_scale {
+        if g0 > -tol && slope(ray.fd, ray.f_len) > tol * ray.d_len {
             return Some(T::zero());
         }
-        let p = self.c.dot(&f) + k;
-        let q = self.c.dot(&d);
+        // `g` changes by at most `(|c| + |s|) ||d||` per unit of `tau`: no exit before
+        // `-g0 / ((|c| + |s|) ||d||)`. Beyond twice `within` (round-off of the roots allowed for),
+        // the exit cannot be the walk's first and the quadratic is not solved.
+        let slope_bound = self.lipschitz * ray.d_len;
+        if -g0 > within * slope_bound * lit(2.0) {
+            return None;
+        }
         if !self.curved() {
             return (q > T::zero()).then(|| (-p / q).max(T::zero()));
         }
         let s2 = self.s * self.s;
-        let a = q * q - s2 * d.dot(&d);
-        let b = p * q - s2 * f.dot(&d);
-        let c = p * p - s2 * f.dot(&f);
+        let a = q * q - s2 * ray.dd;
+        let b = p * q - s2 * ray.fd;
+        let c = p * p - s2 * ray.ff;
         let mut roots = [None, None];
-        if a.abs() <= tol * (q * q + s2 * d.dot(&d)) {
+        if a.abs() <= tol * (q * q + s2 * ray.dd) {
             if b != T::zero() {
                 roots[0] = Some(-c / (b + b));
             }
@@ -115,12 +130,54 @@ impl<T: Real> Constraint<T> {
             .filter(|t| t.is_finite() && *t >= T::zero())
             .filter(|t| {
                 let x = f + d * *t;
-                self.s * (p + q * *t) <= T::zero() && slope(&x) > T::zero()
+                self.s * (p + q * *t) <= T::zero() && slope(x.dot(d), x.dot(&x).sqrt()) > T::zero()
             })
             .fold(None, |best: Option<T>, t| match best {
                 Some(b) if b <= t => Some(b),
                 _ => Some(t),
             })
+    }
+
+    /// `|k|`, the part of the ray's scale this constraint needs.
+    pub(super) fn offset(&self) -> T {
+        self.k.abs()
+    }
+}
+
+/// A ray `f + tau d` scaled by its largest component (and the largest constraint offset `|k|`),
+/// with the products every constraint's first exit uses, computed once per agent and round.
+pub(super) struct Ray<T: Real> {
+    f: Vector3<T>,
+    d: Vector3<T>,
+    scale: T,
+    ff: T,
+    dd: T,
+    fd: T,
+    f_len: T,
+    d_len: T,
+}
+
+impl<T: Real> Ray<T> {
+    /// `None` when everything is zero or a component is not finite (no exit).
+    pub(super) fn new(f: &Vector3<T>, d: &Vector3<T>, offset: T) -> Option<Self> {
+        let scale = max_abs(f).max(max_abs(d)).max(offset);
+        if scale <= T::zero() || !scale.is_finite() {
+            return None;
+        }
+        let (f, d) = (f / scale, d / scale);
+        // Scaled to components of at most one: plain norms cannot overflow (an underflow is
+        // a force at the origin, which it is to this precision).
+        let (ff, dd) = (f.dot(&f), d.dot(&d));
+        Some(Self {
+            f,
+            d,
+            scale,
+            ff,
+            dd,
+            fd: f.dot(&d),
+            f_len: ff.sqrt(),
+            d_len: dd.sqrt(),
+        })
     }
 }
 
@@ -130,7 +187,7 @@ impl<T: Real> Constraint<T> {
 /// One milliradian short of the axis, every force the walk returns inverts to a command that
 /// reproduces it within `1e3 eps T`, in `f32` and `f64`. (`set` itself if the narrowed ranges
 /// do not make a set.)
-pub(super) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
+pub(in crate::allocation) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
     let cap = T::frac_pi_2() - lit(1e-3);
     let ex = set.eta_x();
     let hi = ex.hi.min(cap);
@@ -143,7 +200,9 @@ pub(super) fn regular<T: Real>(set: &AdmissibleSet<T>) -> AdmissibleSet<T> {
 
 /// The six constraints of `set` (a bound that can never bind, `T >= 0`, is `-T_max <= 0`:
 /// never violated, never crossed, never on the boundary).
-pub(super) fn constraints<T: Real>(set: &AdmissibleSet<T>) -> [Constraint<T>; CONSTRAINTS] {
+pub(in crate::allocation) fn constraints<T: Real>(
+    set: &AdmissibleSet<T>,
+) -> [Constraint<T>; CONSTRAINTS] {
     let zero = T::zero();
     let y = Vector3::new(zero, T::one(), zero);
     let plane = |b: T, sign: T| {
@@ -153,43 +212,21 @@ pub(super) fn constraints<T: Real>(set: &AdmissibleSet<T>) -> [Constraint<T>; CO
     let ex = set.eta_x();
     let ey = set.eta_y();
     let th = set.thrust();
-    let never = Constraint {
-        c: Vector3::zeros(),
-        s: zero,
-        k: -th.hi.max(T::one()),
+    let constraint = |c: Vector3<T>, s: T, k: T| Constraint {
+        c,
+        s,
+        k,
+        lipschitz: norm(&c) + s.abs(),
     };
+    let never = constraint(Vector3::zeros(), zero, -th.hi.max(T::one()));
     [
-        Constraint {
-            c: -y,
-            s: -ex.hi.sin(),
-            k: zero,
-        },
-        Constraint {
-            c: y,
-            s: ex.lo.sin(),
-            k: zero,
-        },
-        Constraint {
-            c: plane(ey.hi, T::one()),
-            s: zero,
-            k: zero,
-        },
-        Constraint {
-            c: plane(ey.lo, -T::one()),
-            s: zero,
-            k: zero,
-        },
-        Constraint {
-            c: Vector3::zeros(),
-            s: T::one(),
-            k: -th.hi,
-        },
+        constraint(-y, -ex.hi.sin(), zero),
+        constraint(y, ex.lo.sin(), zero),
+        constraint(plane(ey.hi, T::one()), zero, zero),
+        constraint(plane(ey.lo, -T::one()), zero, zero),
+        constraint(Vector3::zeros(), T::one(), -th.hi),
         if th.lo > zero {
-            Constraint {
-                c: Vector3::zeros(),
-                s: -T::one(),
-                k: th.lo,
-            }
+            constraint(Vector3::zeros(), -T::one(), th.lo)
         } else {
             never
         },

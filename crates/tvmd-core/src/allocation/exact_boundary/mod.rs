@@ -2,13 +2,13 @@
 //! "Allocation"): walk from admissible forces toward the request and stop each agent on the
 //! exact boundary of its admissible set, found in closed form, instead of clamping.
 
-mod active;
-mod constraint;
+pub(super) mod active;
+pub(super) mod constraint;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
 use self::active::ActiveSet;
-use self::constraint::{constraints, regular, Constraint, CONSTRAINTS};
+use self::constraint::{constraints, regular, Constraint, Ray, CONSTRAINTS};
 use super::{
     outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
 };
@@ -21,7 +21,8 @@ use crate::real::{eps, lit, Real};
 ///
 /// Each period starts from admissible forces `f`: the previous period's forces (saturated into
 /// this period's sets) or the redistributed pseudo-inverse's, whichever leaves the smaller
-/// wrench error. A previous-period start that does not meet the request first moves in
+/// torque-first wrench error (torque weighted by [`Self::TORQUE_PRIORITY`]). A previous-period
+/// start that does not meet the request first moves in
 /// `null(M)` toward the minimum-norm forces of its own wrench, as far as the exact sets allow,
 /// so the internal forces of a saturation bleed off as the request returns inside instead of
 /// jumping away at once later. Then, in rounds:
@@ -35,7 +36,10 @@ use crate::real::{eps, lit, Real};
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
 /// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds. A start that
-/// already meets the request is returned as it is. The walk keeps `|eta_x|` one milliradian
+/// already meets the request is returned as it is. The result is the candidate (the
+/// redistributed pseudo-inverse's forces, the walk's start and each of its points) with the
+/// smallest torque-first error, so it is never worse than the redistributed pseudo-inverse by
+/// that measure. The walk keeps `|eta_x|` one milliradian
 /// inside `pi/2`, where the gimbal inverse is singular (see `constraint::regular`). Every force is
 /// inside its set (the last rounds' forces are saturated if round-off left one outside).
 /// `rounds` counts the start's rounds and the walk's; `saturated` marks agents that end on a boundary.
@@ -72,6 +76,17 @@ impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
 }
 
 impl<T: Real, const N: usize> ExactBoundaryRedistribution<T, N> {
+    /// How much a torque error counts against a force error when the request cannot be met:
+    /// 1 N m as much as `TORQUE_PRIORITY` N.
+    ///
+    /// The walk spreads the whole remaining wrench, so where it stalls the error can sit in the
+    /// torque, and an attitude loop fed a torque it does not get drifts (measured: A4-Inc with one
+    /// agent failed tilted to 0.6 rad in `agent-failure`'s descent when the walk's result was chosen
+    /// by the plain wrench error). Choosing by this error keeps the torque first, as the
+    /// redistributed pseudo-inverse does (it saturates agents, not the torque), and leaves every
+    /// request the walk meets exactly unchanged.
+    pub const TORQUE_PRIORITY: f64 = 100.0;
+
     /// A new allocator with no previous forces.
     pub fn new() -> Self {
         Self::default()
@@ -122,18 +137,23 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             return None;
         }
         let lambda = solve_gram(&gram, r);
-        if release && self.release_one(&lambda) {
-            return self.direction(r, false);
-        }
+        // `M_i^T lambda`, the free increments, once for the release test and the step.
         let mut delta = [Vector3::zeros(); N];
-        for (((d, block), a), w) in delta
+        for ((d, block), w) in delta
             .iter_mut()
             .zip(self.effectiveness.blocks())
-            .zip(&self.active)
             .zip(&self.working)
         {
             if let (Some(block), true) = (block, *w) {
-                *d = a.project(&block.tr_mul(&lambda));
+                *d = block.tr_mul(&lambda);
+            }
+        }
+        if release && self.release_one(&delta) {
+            return self.direction(r, false);
+        }
+        for ((d, a), w) in delta.iter_mut().zip(&self.active).zip(&self.working) {
+            if *w {
+                *d = a.project(d);
             }
         }
         delta
@@ -142,31 +162,29 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .then_some(delta)
     }
 
-    /// Lets go of the held constraint the free increment `M_i^T lambda` leaves most steeply
+    /// Lets go of the held constraint the free increment `free_i = M_i^T lambda` leaves most steeply
     /// inward (an active-set method's multiplier test), if any: holding it would keep the agent
     /// on a boundary the request pulls it away from.
-    fn release_one(&mut self, lambda: &Vector6<T>) -> bool {
+    fn release_one(&mut self, free: &[Vector3<T>; N]) -> bool {
         let mut worst: Option<(usize, usize, T)> = None;
-        for (i, (((block, a), f), (w, b))) in self
-            .effectiveness
-            .blocks()
+        for (i, (((free, a), f), (w, b))) in free
             .iter()
             .zip(&self.active)
             .zip(&self.forces)
             .zip(self.working.iter().zip(&self.bounds))
             .enumerate()
         {
-            let (Some(block), true) = (block, *w) else {
+            if !*w || !a.any_releasable() {
                 continue;
-            };
-            let free = block.tr_mul(lambda);
+            }
+            let free_norm = norm(free);
             for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
                 let g = c.gradient(f);
-                let scale = norm(&g) * norm(&free);
+                let scale = norm(&g) * free_norm;
                 if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                     continue;
                 }
-                let slope = g.dot(&free) / scale;
+                let slope = g.dot(free) / scale;
                 if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
                     worst = Some((i, k, slope));
                 }
@@ -200,11 +218,15 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             if !*w || a.fixed() {
                 continue;
             }
+            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), T::max);
+            let Some(ray) = Ray::new(f, d, offset) else {
+                continue;
+            };
             for (k, c) in b.iter().enumerate() {
                 if a.holds(k) {
                     continue;
                 }
-                if let Some(t) = c.first_exit(f, d) {
+                if let Some(t) = c.first_exit_along(&ray, tau) {
                     if t == T::zero() && now.is_none() {
                         *now = Some(k);
                     }
@@ -229,18 +251,20 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     /// Moves by `tau delta`; agents that left their set by moving along a curved boundary's
     /// tangent (or by round-off) are put back on it.
     fn advance(&mut self, tau: T, delta: &[Vector3<T>; N]) {
-        for (((f, d), (set, w)), a) in self
+        for ((((f, d), (set, w)), a), b) in self
             .forces
             .iter_mut()
             .zip(delta)
             .zip(self.sets.iter().zip(&self.working))
             .zip(&self.active)
+            .zip(&self.bounds)
         {
             if *w {
                 *f += d * tau;
                 // Only a tangent step on a cone or sphere leaves the set by more than round-off
-                // (the final forces are checked anyway).
-                if a.curved() && outside(set, f) {
+                // (the final forces are checked with the gimbal inverse anyway). The set's own
+                // constraints decide without `asin`/`atan2`.
+                if a.curved() && violated(b, f) {
                     *f = set.saturate(f);
                 }
             }
@@ -276,7 +300,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
 
 /// `f` of every set, computed once per run of equal sets (the agents usually share one set, and
 /// the constraints cost trigonometry).
-fn per_set<T: Real, U: Copy, const N: usize>(
+pub(in crate::allocation) fn per_set<T: Real, U: Copy, const N: usize>(
     sets: &[AdmissibleSet<T>; N],
     f: impl Fn(&AdmissibleSet<T>) -> U,
 ) -> [U; N] {
@@ -291,6 +315,17 @@ fn per_set<T: Real, U: Copy, const N: usize>(
     })
 }
 
+/// Whether `f` is outside the set its constraints describe (or not finite): the same test as
+/// [`outside`] up to round-off, with a dot product per constraint and one norm instead of the
+/// gimbal inverse.
+fn violated<T: Real>(bounds: &[Constraint<T>; CONSTRAINTS], f: &Vector3<T>) -> bool {
+    if !f.iter().all(|x| x.is_finite()) {
+        return true;
+    }
+    let n = norm(f);
+    bounds.iter().any(|c| c.value_with_norm(f, n) > T::zero())
+}
+
 /// Whether `f` is on a constraint of its set, within `sqrt(eps)` of the largest thrust.
 fn on_boundary<T: Real>(
     bounds: &[Constraint<T>; CONSTRAINTS],
@@ -299,6 +334,22 @@ fn on_boundary<T: Real>(
 ) -> bool {
     let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
     bounds.iter().any(|c| c.value(f) > -tol)
+}
+
+/// `||[w r_tau; r_f]||`, `w` = [`ExactBoundaryRedistribution::TORQUE_PRIORITY`]
+/// (overflow-safe norm).
+fn torque_first<T: Real>(r: &Vector6<T>) -> T {
+    let w: T = lit(ExactBoundaryRedistribution::<T, 1>::TORQUE_PRIORITY);
+    // Scaled first, so the weight cannot overflow a large but finite residual.
+    let m = max_abs(r);
+    if !(m > T::zero() && m.is_finite()) {
+        return norm(r);
+    }
+    let mut weighted = r / m;
+    for x in weighted.iter_mut().take(3) {
+        *x *= w;
+    }
+    norm(&weighted) * m
 }
 
 impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T, N> {
@@ -331,6 +382,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             self.previous = Some(start.forces);
             return start;
         }
+        // The redistributed pseudo-inverse keeps the torque whenever it can (it saturates agents,
+        // not the torque); it stays a candidate for the result under the torque-first error.
+        let rpi = (torque_first(&(request.wrench - e.wrench(&forces))), forces);
         if let Some(previous) = &self.previous {
             let mut kept = [Vector3::zeros(); N];
             for (((k, p), set), w) in kept.iter_mut().zip(previous).zip(sets).zip(&working) {
@@ -338,7 +392,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
                     *k = if outside(set, p) { set.saturate(p) } else { *p };
                 }
             }
-            if norm(&(request.wrench - e.wrench(&kept))) < start.wrench_error {
+            if torque_first(&(request.wrench - e.wrench(&kept))) < rpi.0 {
                 forces = kept;
             }
         }
@@ -361,10 +415,10 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
         // than its step gained, and the result is never worse than the start.
-        let mut best = (T::max_value().unwrap_or_else(T::one), walk.forces);
+        let mut best = rpi;
         while (rounds as usize) < limit {
             let r = walk.remaining(&request.wrench);
-            let error = norm(&r);
+            let error = torque_first(&r);
             if error < best.0 {
                 best = (error, walk.forces);
             }
@@ -385,8 +439,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             }
         }
         let r = walk.remaining(&request.wrench);
-        if norm(&r) < best.0 {
-            best = (norm(&r), walk.forces);
+        let error = torque_first(&r);
+        if error < best.0 {
+            best = (error, walk.forces);
         }
         let mut forces = best.1;
         let mut saturated = [false; N];

@@ -1,0 +1,443 @@
+//! The null-space stage (`docs/method.md`, "Null-space stage"): after any allocator, move the
+//! forces inside `null(M)`, so the wrench `M f` (eq. 4) stays what the allocator made, toward a
+//! stated objective, never leaving any agent's admissible set `E_f` (eq. 6).
+
+mod objective;
+mod projection;
+mod report;
+
+pub use objective::NullSpaceObjective;
+pub use report::NullSpaceReport;
+
+use nalgebra::Vector3;
+
+use self::objective::Prepared;
+use self::projection::project_null;
+use super::exact_boundary::active::ActiveSet;
+use super::exact_boundary::constraint::{constraints, regular, Constraint, CONSTRAINTS};
+use super::exact_boundary::per_set;
+use super::{outside, working_mask, Allocation, AllocationRequest};
+use crate::effectiveness::Effectiveness;
+use crate::error::{ConfigError, ConfigField};
+use crate::linalg::{max_abs, norm};
+use crate::real::{eps, lit, Real};
+
+/// Largest iteration cap [`NullSpaceStage::new`] accepts.
+pub const MAX_NULL_SPACE_ITERATIONS: u32 = 64;
+
+/// Halvings of a step before the stage gives up on it.
+const HALVINGS: u32 = 8;
+
+/// Gradient ascent of a [`NullSpaceObjective`] inside `null(M)`, at most `iterations` steps.
+///
+/// Each step, from forces `f` (the allocator's at first):
+/// 1. `g` = the objective's gradient, `d = g - M^T (M M^T)^-1 M g` (its part in `null(M)`,
+///    so `M d = 0`; failed agents have no block and do not move), except that an agent near a
+///    limit (normalized margin below `1/32`, or on it) is kept from moving toward it: `d_i`
+///    keeps only the tangential part of the null-space step plus the inward part of `g_i`
+///    along that limit's normal, the other agents absorbing the difference (the held-normal
+///    projection of the exact-boundary allocator, with `M d = 0` still);
+/// 2. `tau_max` = the first exit of `f + tau d` from any agent's exact admissible set (the
+///    closed-form exits of the exact-boundary allocator: gimbal cones and planes, thrust
+///    spheres, with `|eta_x|` one milliradian inside `pi/2`), and the step starts at
+///    `tau = min(tau_max / 2, T_max / (4 max_i ||d_i||))`, so it stops halfway to the boundary
+///    and moves no agent by more than a quarter of the largest thrust;
+/// 3. the step is kept if the objective rises (the smallest margin must not fall either, for
+///    [`NullSpaceObjective::Margin`]), every force is inside its set by the gimbal inverse
+///    (the allocator's own test) and the wrench drift `||M f' - M f||` is at most
+///    [`Self::drift_bound`]; else `tau` is halved, up to 8 times, and the stage stops when no
+///    halving is kept.
+///
+/// It never makes the allocation worse: a non-finite allocation or one with no agent inside its
+/// set is returned as it came (`ran = false`); an agent just outside its set (the round-off of
+/// a saturation) starts from its saturation when that is inside and within `sqrt(eps) T_max`,
+/// else keeps its force; every kept step satisfies all three tests of step 3; and a result whose
+/// objective (or smallest margin) ends below the input's is dropped for the input. No
+/// allocation, no panic path, `f32` and `f64`.
+///
+/// ```
+/// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+/// use tvmd_core::{NullSpaceObjective, NullSpaceStage, RedistributedPseudoInverse};
+/// use tvmd_core::nalgebra::Vector6;
+/// let team = presets::a4_inc::<f64, 4>()?;
+/// let effectiveness = team.effectiveness(&FailureMask::none());
+/// let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+/// let wrench = Vector6::new(0.0, 0.0, 0.0, 8.0, 0.0, 30.0);
+/// let request = AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench };
+/// let allocation = RedistributedPseudoInverse.allocate(&request);
+/// let stage = NullSpaceStage::new(NullSpaceObjective::Margin, 8)?;
+/// let (refined, report) = stage.refine(&request, &allocation);
+/// assert!(report.ran && report.margin_after >= report.margin_before);
+/// assert!((refined.wrench - allocation.wrench).norm() <= report.wrench_drift + 1e-15);
+/// assert!(report.wrench_drift <= NullSpaceStage::drift_bound(&effectiveness, &allocation.forces, &refined.forces));
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NullSpaceStage<T: Real> {
+    objective: NullSpaceObjective<T>,
+    iterations: u32,
+}
+
+impl<T: Real> NullSpaceStage<T> {
+    /// A stage with at most `iterations` steps (`1..=64`). Errors with
+    /// [`ConfigField::NullSpaceIterations`] outside that, and [`ConfigField::NullSpaceTilt`]
+    /// for a tilt that is not finite or not below `pi/2` in magnitude.
+    pub fn new(objective: NullSpaceObjective<T>, iterations: u32) -> Result<Self, ConfigError> {
+        if iterations == 0 || iterations > MAX_NULL_SPACE_ITERATIONS {
+            return Err(ConfigError::Parameter {
+                field: ConfigField::NullSpaceIterations,
+            });
+        }
+        if let NullSpaceObjective::InwardTilt { angle } = objective {
+            if !angle.is_finite() {
+                return Err(ConfigError::NonFinite {
+                    field: ConfigField::NullSpaceTilt,
+                });
+            }
+            if angle.abs() >= T::frac_pi_2() {
+                return Err(ConfigError::Parameter {
+                    field: ConfigField::NullSpaceTilt,
+                });
+            }
+        }
+        Ok(Self {
+            objective,
+            iterations,
+        })
+    }
+
+    /// The objective.
+    pub fn objective(&self) -> NullSpaceObjective<T> {
+        self.objective
+    }
+
+    /// The iteration cap.
+    pub fn iterations(&self) -> u32 {
+        self.iterations
+    }
+
+    /// The wrench drift the stage accepts between forces `before` and `after`:
+    /// `1e3 eps max(1, max |M_ij|) max(sum_i ||f_i||, sum_i ||f_i'||)` over the working agents
+    /// (a bound relative to the forces: `M f` itself is only known to about
+    /// `eps |M| sum ||f_i||`).
+    pub fn drift_bound<const N: usize>(
+        effectiveness: &Effectiveness<T, N>,
+        before: &[Vector3<T>; N],
+        after: &[Vector3<T>; N],
+    ) -> T {
+        projection::drift_bound(effectiveness, before, after)
+    }
+
+    /// Refines `allocation` (the allocator's answer to `request`): the returned allocation has
+    /// the refined forces, their wrench and errors against the request, the allocator's rounds
+    /// and fallback flag, and `saturated` re-judged for the agents that moved (on a boundary
+    /// within `sqrt(eps) T_max`). Unchanged forces return `allocation` itself.
+    pub fn refine<const N: usize>(
+        &self,
+        request: &AllocationRequest<'_, T, N>,
+        allocation: &Allocation<T, N>,
+    ) -> (Allocation<T, N>, NullSpaceReport<T>) {
+        let unchanged = (*allocation, NullSpaceReport::off());
+        let e = request.effectiveness;
+        let working = working_mask(e);
+        let input = allocation.forces;
+        let sets = &per_set(request.sets, regular);
+        // An agent the allocator left just outside a set it walks in (the round-off of a
+        // saturation) starts from its saturation when that is inside and within
+        // `sqrt(eps) T_max` (the drift check below still holds it to the input's wrench); one
+        // further out, or whose saturation is not inside either, keeps its force.
+        let mut frozen = [false; N];
+        let mut begin = input;
+        for ((((z, b), f), (s, r)), w) in frozen
+            .iter_mut()
+            .zip(begin.iter_mut())
+            .zip(&input)
+            .zip(request.sets.iter().zip(sets))
+            .zip(&working)
+        {
+            if !*w || (!outside(s, f) && !outside(r, f)) {
+                continue;
+            }
+            let back = r.saturate(f);
+            let near = norm(&(back - f)) <= eps::<T>().sqrt() * r.thrust().hi.max(T::one());
+            if near && !outside(s, &back) && !outside(r, &back) {
+                *b = back;
+            } else {
+                *z = true;
+            }
+        }
+        let finite = input.iter().all(|f| f.iter().all(|x| x.is_finite()));
+        if !finite || e.working_count() == 0 || frozen == working {
+            return unchanged;
+        }
+        let objective = Prepared::new(self.objective, e, sets, working);
+        let bounds = per_set(sets, |s| constraints(s));
+        let reach = sets
+            .iter()
+            .zip(&working)
+            .filter(|(_, w)| **w)
+            .fold(T::zero(), |m, (s, _)| m.max(s.thrust().hi));
+        let start = e.wrench(&input);
+        let value0 = objective.value(&input);
+        let margin0 = objective.smallest_margin(&input);
+        if !value0.is_finite() || !margin0.is_finite() || !max_abs(&start).is_finite() {
+            return unchanged;
+        }
+        let (mut forces, mut value, mut margin) = (
+            begin,
+            objective.value(&begin),
+            objective.smallest_margin(&begin),
+        );
+        let mut iterations = 0;
+        let margin_objective = matches!(self.objective, NullSpaceObjective::Margin);
+        while iterations < self.iterations {
+            let active = hold_boundaries(&objective, &bounds, sets, &working, &forces);
+            let Some(d) = project_null(e, &active, &frozen, &objective.gradient(&forces)) else {
+                break;
+            };
+            let longest = d.iter().fold(T::zero(), |m, v| m.max(norm(v)));
+            if longest.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                break;
+            }
+            let exit = first_exit(&bounds, &working, &forces, &d);
+            let mut tau = (exit / lit(2.0)).min(reach / (longest * lit(4.0)));
+            let mut kept = None;
+            for _ in 0..HALVINGS {
+                if tau.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                    break;
+                }
+                let mut next = forces;
+                for ((f, di), w) in next.iter_mut().zip(&d).zip(&working) {
+                    if *w {
+                        *f += di * tau;
+                    }
+                }
+                let v = objective.value(&next);
+                let m = objective.smallest_margin(&next);
+                let inside = next
+                    .iter()
+                    .zip(request.sets.iter().zip(sets))
+                    .zip(working.iter().zip(&frozen))
+                    .all(|((f, (s, r)), (w, z))| !*w || *z || (!outside(s, f) && !outside(r, f)));
+                let drift = norm(&(e.wrench(&next) - start));
+                if v > value
+                    && (!margin_objective || m >= margin)
+                    && inside
+                    && drift <= projection::drift_bound(e, &input, &next)
+                {
+                    kept = Some((next, v, m));
+                    break;
+                }
+                tau /= lit(2.0);
+            }
+            let Some((next, v, m)) = kept else {
+                break;
+            };
+            (forces, value, margin) = (next, v, m);
+            iterations += 1;
+        }
+        // Never worse than the input, also after the start's snap onto the sets.
+        // Written so a NaN counts as worse.
+        let at_least = |a: T, b: T| a >= b;
+        let worse = !at_least(value, value0) || (margin_objective && !at_least(margin, margin0));
+        if iterations == 0 || worse {
+            let report = NullSpaceReport {
+                ran: true,
+                objective_before: value0,
+                objective_after: value0,
+                margin_before: margin0,
+                margin_after: margin0,
+                ..NullSpaceReport::off()
+            };
+            return (*allocation, report);
+        }
+        let mut saturated = allocation.saturated;
+        let mut largest = T::zero();
+        for ((((s, f), f0), (b, set)), w) in saturated
+            .iter_mut()
+            .zip(&forces)
+            .zip(&input)
+            .zip(bounds.iter().zip(sets))
+            .zip(&working)
+        {
+            let change = norm(&(f - f0));
+            largest = largest.max(change);
+            if *w && change > T::zero() {
+                let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
+                *s = b.iter().any(|c| c.value(f) > -tol);
+            }
+        }
+        let mut refined = Allocation::from_forces(request, forces, allocation.rounds, saturated);
+        refined.fallback = allocation.fallback;
+        let report = NullSpaceReport {
+            ran: true,
+            iterations,
+            objective_before: value0,
+            objective_after: value,
+            margin_before: margin0,
+            margin_after: margin,
+            largest_force_change: largest,
+            wrench_drift: norm(&(refined.wrench - start)),
+        };
+        (refined, report)
+    }
+}
+
+/// Each working agent's constraints held for one step: those it is near (margin below
+/// `1 / kappa`) and those it sits on (within `sqrt(eps) T_max`, whatever their range).
+fn hold_boundaries<T: Real, const N: usize>(
+    objective: &Prepared<T, N>,
+    bounds: &[[Constraint<T>; CONSTRAINTS]; N],
+    sets: &[crate::admissible::AdmissibleSet<T>; N],
+    working: &[bool; N],
+    forces: &[Vector3<T>; N],
+) -> [ActiveSet<T>; N] {
+    let near = objective.near(forces);
+    let mut active = [ActiveSet::default(); N];
+    for (((((a, b), set), w), f), bits) in active
+        .iter_mut()
+        .zip(bounds)
+        .zip(sets)
+        .zip(working)
+        .zip(forces)
+        .zip(near)
+    {
+        if !*w {
+            continue;
+        }
+        let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
+        for (k, c) in b.iter().enumerate() {
+            if c.value(f) > -tol || bits & (1 << k) != 0 {
+                a.hold(k);
+            }
+        }
+        a.update(b, f);
+    }
+    active
+}
+
+/// The first `tau` at which some working agent's `f_i + tau d_i` leaves its set (`MAX` when
+/// none does).
+fn first_exit<T: Real, const N: usize>(
+    bounds: &[[Constraint<T>; CONSTRAINTS]; N],
+    working: &[bool; N],
+    forces: &[Vector3<T>; N],
+    d: &[Vector3<T>; N],
+) -> T {
+    let mut tau = T::max_value().unwrap_or_else(T::one);
+    for (((b, w), f), di) in bounds.iter().zip(working).zip(forces).zip(d) {
+        if !*w {
+            continue;
+        }
+        for c in b {
+            if let Some(t) = c.first_exit(f, di) {
+                tau = tau.min(t);
+            }
+        }
+    }
+    tau
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use crate::admissible::AdmissibleSet;
+    use crate::allocation::{Allocator, RedistributedPseudoInverse};
+    use crate::limits::Interval;
+    use nalgebra::Vector6;
+
+    fn team() -> (Effectiveness<f64, 4>, [AdmissibleSet<f64>; 4]) {
+        let positions = [
+            Vector3::new(0.25, 0.25, 0.0),
+            Vector3::new(-0.25, 0.25, 0.0),
+            Vector3::new(-0.25, -0.25, 0.0),
+            Vector3::new(0.25, -0.25, 0.0),
+        ];
+        let e = Effectiveness::new(positions.iter().enumerate().map(|(i, p)| (i, p, i as i32)));
+        let set = AdmissibleSet::new(
+            Interval::symmetric(0.5),
+            Interval::symmetric(0.5),
+            Interval { lo: 0.0, hi: 10.0 },
+        )
+        .unwrap();
+        (e, [set; 4])
+    }
+
+    #[test]
+    fn iteration_caps_and_tilts_are_checked() {
+        assert!(NullSpaceStage::<f64>::new(NullSpaceObjective::Margin, 0).is_err());
+        assert!(NullSpaceStage::<f64>::new(NullSpaceObjective::Margin, 65).is_err());
+        let tilt = |angle| NullSpaceStage::<f32>::new(NullSpaceObjective::InwardTilt { angle }, 4);
+        assert_eq!(
+            tilt(f32::NAN),
+            Err(ConfigError::NonFinite {
+                field: ConfigField::NullSpaceTilt
+            })
+        );
+        assert!(tilt(2.0).is_err() && tilt(-0.3).is_ok());
+    }
+
+    #[test]
+    fn a_saturated_allocation_gains_margin_at_the_same_wrench() {
+        let (e, sets) = team();
+        // Thrust and a sideways force that push the pseudo-inverse into the gimbal limits.
+        let wrench = Vector6::new(0.0, 0.0, 0.5, 12.0, 0.0, 22.0);
+        let request = AllocationRequest {
+            effectiveness: &e,
+            sets: &sets,
+            wrench,
+        };
+        let allocation = RedistributedPseudoInverse.allocate(&request);
+        let stage = NullSpaceStage::new(NullSpaceObjective::Margin, 16).unwrap();
+        let (refined, report) = stage.refine(&request, &allocation);
+        assert!(report.ran && report.changed(), "{report:?}");
+        assert!(
+            report.margin_after > report.margin_before + 0.01,
+            "{report:?}"
+        );
+        assert!(report.objective_after > report.objective_before);
+        assert!(report.largest_force_change > 0.0);
+        let drift = (refined.wrench - allocation.wrench).norm();
+        assert!(drift <= NullSpaceStage::drift_bound(&e, &allocation.forces, &refined.forces));
+        for (f, s) in refined.forces.iter().zip(&sets) {
+            assert!(!outside(s, f));
+        }
+    }
+
+    #[test]
+    fn failed_agents_stay_and_bad_input_comes_back_untouched() {
+        let (full, sets) = team();
+        let positions = [
+            Vector3::new(0.25, 0.25, 0.0),
+            Vector3::new(-0.25, 0.25, 0.0),
+            Vector3::new(0.25, -0.25, 0.0),
+        ];
+        // Agent 2 failed.
+        let e: Effectiveness<f64, 4> = Effectiveness::new(
+            [0usize, 1, 3]
+                .iter()
+                .zip(&positions)
+                .map(|(i, p)| (*i, p, *i as i32)),
+        );
+        let request = AllocationRequest {
+            effectiveness: &e,
+            sets: &sets,
+            wrench: Vector6::new(0.0, 0.0, 0.0, 2.0, 1.0, 20.0),
+        };
+        let allocation = RedistributedPseudoInverse.allocate(&request);
+        let stage = NullSpaceStage::new(NullSpaceObjective::InwardTilt { angle: 0.2 }, 8).unwrap();
+        let (refined, report) = stage.refine(&request, &allocation);
+        assert!(report.ran);
+        assert_eq!(refined.forces[2], Vector3::zeros());
+        assert!(report.objective_after >= report.objective_before);
+        let mut bad = RedistributedPseudoInverse.allocate(&AllocationRequest {
+            effectiveness: &full,
+            ..request
+        });
+        bad.forces[1].x = f64::NAN;
+        let (back, report) = stage.refine(&request, &bad);
+        assert!(!report.ran && back.forces[1].x.is_nan());
+        assert_eq!(back.forces[0], bad.forces[0]);
+    }
+}
