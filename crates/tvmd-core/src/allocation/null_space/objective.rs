@@ -233,8 +233,15 @@ fn ranges<T: Real>(set: &AdmissibleSet<T>) -> [T; CONSTRAINTS] {
 /// `cos(angle) z + sin(angle) u_i`, `u_i` the horizontal unit vector from `p_i` toward the origin
 /// (the centre of mass).
 fn tilt_target<T: Real>(block: &nalgebra::Matrix6x3<T>, angle: T) -> Vector3<T> {
-    let rotation = block.fixed_rows::<3>(3).into_owned();
-    let skew = block.fixed_rows::<3>(0).into_owned() * rotation.transpose();
+    // Copied element by element: a view's `into_owned` goes through nalgebra's
+    // `from_iterator`, whose length check the optimizer cannot drop (a panic path on the target).
+    let rows = |first: usize| {
+        nalgebra::Matrix3::from_fn(|i, j| {
+            block.get((first + i, j)).copied().unwrap_or_else(T::zero)
+        })
+    };
+    let rotation = rows(3);
+    let skew = rows(0) * rotation.transpose();
     // `[p]x` holds `p` as (m32, m13, m21).
     let inward = Vector3::new(-skew.m32, -skew.m13, T::zero());
     let length = norm(&inward);
