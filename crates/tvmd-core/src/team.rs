@@ -379,6 +379,6 @@ fn finite_derived<'a, T: Real + 'a>(
     }
 }
 
-/// Team presets: the paper's A4 teams, the authors' grid layouts (A6, A8) and ring layouts for
-/// tests and the simulator.
+/// Team presets: the authors' catalogue ([`presets::Preset`], A3 to A10 and T10), the paper's A4
+/// teams, grid layouts and ring layouts for tests and the simulator.
 pub mod presets;

@@ -17,6 +17,7 @@ use pyo3::types::PyTuple;
 
 mod afs;
 mod allocation;
+mod atlas;
 mod controller;
 mod convert;
 mod errors;
@@ -46,5 +47,6 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     allocation::register(m)?;
     controller::register(m)?;
     sim::register(m)?;
+    atlas::register(m)?;
     Ok(())
 }

@@ -519,7 +519,7 @@ record! {
 }
 
 /// A tvmd-sim record (serde) as Python objects: `json.loads` of its JSON (NaN becomes None).
-fn record_to_py<'py, T: serde::Serialize>(
+pub(crate) fn record_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,
     record: &T,
 ) -> PyResult<Bound<'py, PyAny>> {

@@ -230,6 +230,24 @@ record! {
         Self::wrap(presets::a4_con())
     }
 
+    /// A team of the authors' catalogue by name (`Team.preset_names()`).
+    #[staticmethod]
+    fn preset(name: &str) -> PyResult<Self> {
+        let preset = presets::Preset::from_name(name).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "unknown preset {name:?}; known: {}",
+                Self::preset_names().join(", ")
+            ))
+        })?;
+        Self::wrap(preset.team())
+    }
+
+    /// The catalogue's preset names, Con before Inc, by size.
+    #[staticmethod]
+    fn preset_names() -> Vec<&'static str> {
+        presets::Preset::ALL.iter().map(|p| p.name()).collect()
+    }
+
     /// `n` agents of 0.7 kg on a circle of `radius` (m).
     #[staticmethod]
     #[pyo3(signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY))]

@@ -32,6 +32,8 @@
 //!   or certified outside) and the evaluation of every allocator on it and in the closed loop.
 //! - [`plot`]: PNG figures (state profile, Lyapunov candidates, relaxation study) from samples
 //!   or from an MCAP log.
+//! - [`afs_atlas`]: the exact attainable force set of a team, bracketed, against the elliptic
+//!   cone, and the certified relaxation `s*` (std only; `docs/afs-atlas.md`).
 //!
 //! Conventions: SI units, z up, gravity `g = 9.81 m/s^2` along `-z`; body-frame twist
 //! `xi = [Omega; v]` with `x_dot = R v`.
@@ -39,6 +41,7 @@
 #![warn(missing_docs)]
 
 pub mod actuators;
+pub mod afs_atlas;
 pub mod allocation_bench;
 pub mod control;
 pub mod diagnostics;

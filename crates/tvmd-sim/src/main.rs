@@ -44,6 +44,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// The AFS atlas of a catalogue team: the exact attainable lateral forces (bracketed)
+    /// against the elliptic cone, and the certified relaxation s* (docs/afs-atlas.md).
+    Afs(tvmd_sim::afs_atlas::cli::AfsArgs),
     /// Run one scenario with the tvmd controller; print a summary, write the MCAP log, the
     /// summary JSON and (with --plots) the figures.
     Run {
@@ -213,6 +216,9 @@ impl From<serde_json::Error> for CliError {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Afs(args) => tvmd_sim::afs_atlas::cli::run(&args)
+            .map(|(_, table)| print!("{table}"))
+            .map_err(CliError::Sim),
         Command::Run {
             scenario,
             out,

@@ -109,6 +109,31 @@ impl TeamBody {
         }
     }
 
+    /// A catalogue team (`tvmd_core::team::presets::Preset`) on a grid of `unit` metres with
+    /// agents of `mass` kg, in the preset's agent order. Massless navigator, collider radius
+    /// [`DEFAULT_COLLIDER_RADIUS`]. Errors when the core rejects the layout at that scale.
+    pub fn preset(
+        preset: tvmd_core::team::presets::Preset,
+        unit: f64,
+        mass: f64,
+    ) -> Result<Self, tvmd_core::ConfigError> {
+        let team: tvmd_core::TeamConfig<f64, 16> = preset.team_with(unit, mass)?;
+        Ok(Self {
+            agents: team
+                .agents()
+                .iter()
+                .map(|a| AgentBody {
+                    position: a.position.into(),
+                    mass: a.mass,
+                    quarter_turns: a.quarter_turns,
+                })
+                .collect(),
+            navigator_mass: 0.0,
+            navigator_inertia: [[0.0; 3]; 3],
+            collider_radius: DEFAULT_COLLIDER_RADIUS,
+        })
+    }
+
     /// Half side of the paper's A4 square: `a = 0.5 sqrt(2)/2` m.
     pub fn paper_arm() -> f64 {
         0.5 * std::f64::consts::SQRT_2 / 2.0

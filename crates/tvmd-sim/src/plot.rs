@@ -32,7 +32,7 @@ const FONT: &[u8] = include_bytes!("../assets/TvmdPlotSans.ttf");
 
 static FONT_ONCE: Once = Once::new();
 
-fn register_font() {
+pub(crate) fn register_font() {
     FONT_ONCE.call_once(|| {
         // The embedded font is known to parse; a failure would only lose the labels.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
@@ -233,12 +233,12 @@ impl PlotSeries {
     }
 }
 
-fn plot_err(e: impl std::fmt::Display) -> SimError {
+pub(crate) fn plot_err(e: impl std::fmt::Display) -> SimError {
     SimError::Plot(e.to_string())
 }
 
 /// A line of a panel.
-struct Line {
+pub(crate) struct Line {
     label: String,
     color: RGBColor,
     dashed: bool,
@@ -246,7 +246,7 @@ struct Line {
 }
 
 impl Line {
-    fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+    pub(crate) fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
         Self {
             label: label.into(),
             color,
@@ -255,13 +255,13 @@ impl Line {
         }
     }
 
-    fn dashed(mut self) -> Self {
+    pub(crate) fn dashed(mut self) -> Self {
         self.dashed = true;
         self
     }
 }
 
-const COLORS: [RGBColor; 6] = [
+pub(crate) const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -285,7 +285,7 @@ fn y_range(lines: &[Line]) -> (f64, f64) {
     (lo - 0.08 * span, hi + 0.08 * span)
 }
 
-fn draw_lines<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
+pub(crate) fn draw_lines<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
     lines: &[Line],
 ) -> Result<(), SimError> {
@@ -412,7 +412,7 @@ fn series_of(s: &PlotSeries, f: impl Fn(&PlotPoint) -> Option<f64>) -> Vec<(f64,
         .collect()
 }
 
-fn ensure_parent(path: &Path) -> Result<(), SimError> {
+pub(crate) fn ensure_parent(path: &Path) -> Result<(), SimError> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }

@@ -5,12 +5,15 @@ Approximation and Full-Pose Tracking Control of an Over-Actuated Thrust-Vectorin
 UAV*). Equation numbers refer to the paper.
 
 * :class:`Team` -- the configuration ``Xi`` (positions, quarter turns ``m_i``, masses, limits),
-  presets ``Team.a4_inc()``, ``Team.a4_con()``, ``Team.ring(...)``; ``M(Xi)`` (eq. 4).
+  presets ``Team.a4_inc()``, ``Team.a4_con()``, ``Team.ring(...)``, the authors' catalogue
+  ``Team.preset(name)``; ``M(Xi)`` (eq. 4).
 * :class:`AttainableForceSpace` -- the AFS approximation (eqs. 7-8) and the projection ``K_f``
   (eqs. 12-13); :func:`gimbal_force` / :func:`gimbal_inverse` (eq. 1).
 * :class:`AttitudePlanner` -- the bisection planner (eqs. 9-11).
 * :class:`Gains`, :class:`State`, :class:`Reference`, :class:`Plant`, :func:`force_request`,
   :func:`control_wrench` -- the control law (eq. 12).
+* :func:`afs_atlas` -- the exact attainable force set against the cone, and the certified
+  relaxation ``s*`` (docs/afs-atlas.md).
 * :func:`allocate` -- the allocators (exact-boundary redistribution, the default; redistributed,
   pseudo-inverse, weighted, Clarabel).
 * :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`
@@ -47,6 +50,7 @@ from ._tvmd import (
     StepOutput,
     Team,
     __version__,
+    afs_atlas,
     allocate,
     control_wrench,
     force_request,
@@ -80,6 +84,7 @@ __all__ = [
     "StepOutput",
     "Team",
     "__version__",
+    "afs_atlas",
     "allocate",
     "control_wrench",
     "force_request",

@@ -12,8 +12,9 @@ configuration and input errors become ``ConfigError`` / ``InputError`` (both ``V
 with the core's message. No code path panics.
 """
 
-from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, Union, final, overload
+from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Sequence, Tuple, Union, final, overload
 
+import os
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -153,6 +154,16 @@ class Team:
     @staticmethod
     def a4_con() -> "Team":
         """As ``a4_inc()`` with every agent aligned: the consistent A4 team."""
+    @staticmethod
+    def preset(name: str) -> "Team":
+        """A team of the authors' catalogue (TVMD-Simulations ``team_conf``) with the paper's
+        agents (0.7 kg, ``sigma_x = pi/6``, ``sigma_y = pi/4``, ``sigma_Tf = 2 m_i g``): ``"a3-con"``
+        to ``"a10-inc"``, ``"t10-con"``, ``"t10-inc"``, the authors' diamond ``"a4-diamond-inc"``
+        and the paper's square ``"a4-inc"`` (``_`` may stand for ``-``). Layouts:
+        ``docs/afs-atlas.md``. Raises ``ValueError`` for an unknown name."""
+    @staticmethod
+    def preset_names() -> list[str]:
+        """Every name ``Team.preset`` accepts, Con before Inc, by size."""
     @staticmethod
     def ring(
         n: int,
@@ -790,6 +801,33 @@ class Allocation:
         """The solve report of "clarabel" and "clarabel-sequential", None otherwise."""
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
+
+def afs_atlas(
+    team: str,
+    *,
+    failed: Optional[Sequence[int]] = None,
+    heights: Optional[Sequence[float]] = None,
+    directions: int = 36,
+    relaxation: float = 1.0,
+    certify_heights: int = 9,
+    torque: Optional[Sequence[float]] = None,
+    plots: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> dict[str, Any]:
+    """The AFS atlas of one catalogue team (``Team.preset_names()``) with the agents ``failed``
+    removed: the exact attainable lateral forces, bracketed, against the elliptic cone at
+    relaxation ``relaxation``, and the certified relaxation ``s*`` (as ``tvmd-sim afs``;
+    ``docs/afs-atlas.md``). Every number is an interval ``[lower, upper]``: ``lower`` attained by
+    commands inside every agent's box, ``upper`` a weak-duality bound.
+
+    Keys: ``team``, ``failed``, ``n``, ``weight`` (N), ``ceiling`` (the hover ceiling in
+    ``m_C g``), ``can_hover``, ``heights`` (one dict per height in ``m_C g``: ``ratio`` (cone over
+    attainable radius, smallest and largest over the directions), ``soundness``,
+    ``conservatism``, ``worst_width``), ``certified`` (``s*`` as ``[lower, upper]``),
+    ``certified_range`` (``m_C g``), ``limiting`` (height in ``m_C g`` and angle in degrees where
+    ``s*`` is limited), ``certified_worst_width``, ``note``. With ``plots`` (a directory) the
+    cross-sections are drawn as ``<team>.png``. ``torque`` (N m) is held meanwhile (zero by
+    default). Raises ``ValueError`` for an unknown team, a bad mask or bad settings. Releases the
+    GIL; about 2 s for A4 with the defaults in a release build."""
 
 def allocate(
     team: Team,

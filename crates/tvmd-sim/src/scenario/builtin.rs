@@ -15,6 +15,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "relaxation-0.5",
     "relaxation-0.75",
     "relaxation-1.0",
+    "relaxation-certified",
     "paper-tilt-sigma-y-pi6",
     "a4-con",
     "a4-inc",
@@ -41,6 +42,14 @@ impl Scenario {
                     _ => 1.0,
                 };
                 let d = format!("Relaxation study: paper-tilt with s = {}", s.relaxation);
+                with(s, &d)
+            }
+            "relaxation-certified" => {
+                s.relaxation = s.certified_relaxation()?;
+                let d = format!(
+                    "Relaxation study: paper-tilt with the AFS atlas's certified s* = {}",
+                    s.relaxation
+                );
                 with(s, &d)
             }
             "paper-tilt-sigma-y-pi6" => {

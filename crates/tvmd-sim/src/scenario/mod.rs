@@ -20,7 +20,7 @@
 //! dt = 0.001
 //!
 //! [team]
-//! preset = "a4-inc"          # or: agents = [{ position = [..], mass = 0.7, quarter_turns = 1 }, ..]
+//! preset = "a4-inc"          # any of a3-con .. a10-inc, t10-con, t10-inc; or: agents = [{ position = [..], mass = 0.7, quarter_turns = 1 }, ..]
 //!
 //! [limits]
 //! sigma_x = 0.5235987755982988
@@ -65,8 +65,10 @@ use crate::actuators::{ActuatorModel, FailureKind, SaturationLimits};
 use crate::physics::{AgentBody, PhysicsConfig, TeamBody, DEFAULT_COLLIDER_RADIUS};
 use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
+use tvmd_core::team::presets::Preset;
 
 mod builtin;
+mod certified;
 mod null_space;
 mod overrides;
 mod validate;
@@ -133,7 +135,8 @@ impl std::str::FromStr for Precision {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TeamSpec {
-    /// `"a4-inc"` or `"a4-con"`; used when `agents` is absent (default `"a4-inc"`).
+    /// A catalogue team (`tvmd_core::team::presets::Preset::name`: `"a3-con"` .. `"t10-inc"`,
+    /// `"a4-inc"` the paper's); used when `agents` is absent (default `"a4-inc"`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
     /// Explicit agents (positions relative to the team centre of mass); excludes `preset`.
@@ -141,7 +144,8 @@ pub struct TeamSpec {
     pub agents: Option<Vec<AgentBody>>,
     /// Agent mass for presets (kg); 0.7.
     pub agent_mass: f64,
-    /// Half side `a` of the A4 square for presets (m); default `0.5 sqrt(2)/2`.
+    /// Grid unit of the presets (m): the half side `a` of the A4 square, `0.5 sqrt(2)/2` by
+    /// default (the authors' `GRID_SIZE`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub arm: Option<f64>,
     /// Navigator mass (kg); 0.
@@ -187,18 +191,17 @@ impl TeamSpec {
                 collider_radius: DEFAULT_COLLIDER_RADIUS,
             },
             (preset, None) => {
-                let a = self.arm.unwrap_or_else(TeamBody::paper_arm);
-                let turns = match preset.as_deref().unwrap_or("a4-inc") {
-                    "a4-inc" => [1, 1, 0, 0],
-                    "a4-con" => [0, 0, 0, 0],
-                    other => {
-                        return Err(invalid(
-                            "team.preset",
-                            format!("unknown preset `{other}` (known: a4-inc, a4-con)"),
-                        ))
-                    }
+                let name = preset.as_deref().unwrap_or("a4-inc");
+                let Some(preset) = Preset::from_name(name) else {
+                    let known: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+                    return Err(invalid(
+                        "team.preset",
+                        format!("unknown preset `{name}` (known: {})", known.join(", ")),
+                    ));
                 };
-                TeamBody::a4(a, self.agent_mass, turns)
+                let unit = self.arm.unwrap_or_else(TeamBody::paper_arm);
+                TeamBody::preset(preset, unit, self.agent_mass)
+                    .map_err(|e| invalid("team", e.to_string()))?
             }
         };
         body.navigator_mass = self.navigator_mass;
@@ -393,7 +396,8 @@ pub struct Scenario {
     /// Initial position of the centre of mass (m); `[0.5, -0.5, 0]`, i.e. resting on the
     /// ground (the ground lies at `z = -rest height`, see [`crate::physics`]).
     pub initial_position: [f64; 3],
-    /// Planner relaxation `s` in `(0, 1]`; 0.5.
+    /// Planner relaxation `s` in `(0, 1]`; 0.5. In TOML also `"certified"`: the AFS atlas's
+    /// `s*` of the team ([`Scenario::certified_relaxation`]), resolved when the file is read.
     pub relaxation: f64,
     /// Allocator name, interpreted by the controller; `"exact-boundary-redistribution"`
     /// (the core's default; also `"redistributed-pseudo-inverse"`, the paper's,
@@ -467,6 +471,20 @@ impl Scenario {
             path: None,
             message,
         };
+        // `relaxation = "certified"`: the atlas's s* of the team, resolved once the team is known.
+        let mut certified = false;
+        let rewritten;
+        let text = match text.parse::<toml::Table>() {
+            Ok(mut table)
+                if table.get("relaxation").and_then(toml::Value::as_str) == Some("certified") =>
+            {
+                table.remove("relaxation");
+                certified = true;
+                rewritten = toml::to_string(&table).map_err(|e| parse_error(e.to_string()))?;
+                rewritten.as_str()
+            }
+            _ => text,
+        };
         let de = toml::Deserializer::parse(text).map_err(|e| parse_error(e.to_string()))?;
         // serde_path_to_error adds the dotted key path (e.g. `physics.dt`) to the message;
         // toml's own message shows the offending line.
@@ -479,6 +497,10 @@ impl Scenario {
                 parse_error(format!("field `{path}`: {inner}"))
             }
         })?;
+        let mut s = s;
+        if certified {
+            s.relaxation = s.certified_relaxation()?;
+        }
         s.validate()?;
         Ok(s)
     }

@@ -1,7 +1,15 @@
-//! Team presets: the paper's A4 teams, the authors' grid layouts (A6-Inc, A8-Inc, A8-Con) and
-//! ring layouts for tests and the simulator.
+//! Team presets: the authors' catalogue ([`Preset`]: A3 to A10 and T10, Con and Inc, with the
+//! paper's A4 square), the paper's A4 teams, grid layouts and ring layouts for tests and the
+//! simulator.
 
 use super::*;
+
+mod catalogue;
+mod certified;
+
+/// One row of the certified-relaxation table: `(preset, s* nominal, s* without agent i)`.
+type CertifiedEntry = (Preset, Option<f64>, &'static [Option<f64>]);
+pub use catalogue::{Cell, Preset};
 
 /// Half side of the paper's square: `a = 0.5 sqrt(2)/2` m.
 pub const PAPER_HALF_SIDE: f64 = 0.353_553_390_593_273_8;
@@ -124,26 +132,27 @@ pub fn grid<T: Real, const N: usize>(
             capacity: N,
         });
     }
-    let unit: T = lit(PAPER_HALF_SIDE);
-    let n = count::<T>(cells.len().max(1));
-    let (sx, sy) = cells
-        .iter()
-        .fold((0, 0), |(sx, sy), &(x, y, _)| (sx + x, sy + y));
-    let (cx, cy) = (lit::<T>(f64::from(sx)) / n, lit::<T>(f64::from(sy)) / n);
-    let mut agents = [AgentSpec::placeholder(); N];
-    for (agent, &(x, y, m)) in agents.iter_mut().zip(cells) {
-        let position = Vector3::new(
-            (lit::<T>(f64::from(x)) - cx) * unit,
-            (lit::<T>(f64::from(y)) - cy) * unit,
-            T::zero(),
-        );
-        *agent = AgentSpec::new(position, m, lit(PAPER_AGENT_MASS));
+    let mut layout = [Cell {
+        x: 0,
+        y: 0,
+        z: 0,
+        quarter_turns: 0,
+    }; N];
+    for (slot, &(x, y, m)) in layout.iter_mut().zip(cells) {
+        *slot = Cell {
+            x,
+            y,
+            z: 0,
+            quarter_turns: m,
+        };
     }
-    TeamConfig::new(
-        agents.get(..cells.len()).unwrap_or(&[]),
-        limits,
-        Navigator::default(),
-    )
+    let team: TeamConfig<T, N> = catalogue::layout_team(
+        layout.get(..cells.len()).unwrap_or(&[]),
+        false,
+        lit(PAPER_HALF_SIDE),
+        lit(PAPER_AGENT_MASS),
+    )?;
+    TeamConfig::new(team.agents(), limits, Navigator::default())
 }
 
 /// The authors' six-agent inconsistent team A6-Inc ([`A6_INC_CELLS`] on [`grid`]), the paper's

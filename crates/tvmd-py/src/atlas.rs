@@ -1,0 +1,60 @@
+//! `tvmd.afs_atlas`: the AFS atlas of `tvmd_sim::afs_atlas` (a thin adapter: arguments in, the
+//! row as a dict out).
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use tvmd_sim::afs_atlas::cli::{run, AfsArgs};
+
+use crate::convert::{count, indices};
+use crate::sim::{record_to_py, value_error};
+
+/// The atlas row of one catalogue team and failure mask. See the stub.
+#[pyfunction]
+#[pyo3(signature = (team, *, failed = None, heights = None, directions = 36, relaxation = 1.0, certify_heights = 9, torque = None, plots = None))]
+#[allow(clippy::too_many_arguments)]
+fn afs_atlas<'py>(
+    py: Python<'py>,
+    team: &str,
+    failed: Option<&Bound<'py, PyAny>>,
+    heights: Option<Vec<f64>>,
+    directions: i64,
+    relaxation: f64,
+    certify_heights: i64,
+    torque: Option<[f64; 3]>,
+    plots: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    if team == "all" {
+        return Err(PyValueError::new_err(
+            "afs_atlas takes one team; loop over tvmd.Team.preset_names() for the catalogue",
+        ));
+    }
+    let failed = indices(failed, "failed")?
+        .into_iter()
+        .map(|i| count(i, "failed"))
+        .collect::<PyResult<Vec<usize>>>()?;
+    let args = AfsArgs {
+        team: team.to_string(),
+        failed,
+        each_failure: false,
+        heights: heights.unwrap_or_else(|| vec![0.5, 1.0, 1.5]),
+        directions: count(directions, "directions")?,
+        relaxation,
+        certify_heights: count(certify_heights, "certify_heights")?,
+        torque: torque.unwrap_or_default().to_vec(),
+        plots,
+        json: None,
+    };
+    let (mut rows, _) = py.detach(|| run(&args)).map_err(value_error)?;
+    let row = rows
+        .pop()
+        .ok_or_else(|| PyValueError::new_err("the atlas returned no row"))?;
+    record_to_py(py, &row)
+}
+
+/// Registers `afs_atlas` on the top-level module.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(afs_atlas, m)?)
+}

@@ -1,0 +1,148 @@
+//! `tvmd-sim afs TEAM`: the atlas of one catalogue team (or `all`), as a table, JSON and PNG
+//! cross-sections. The binary only parses these arguments and prints what [`run`] returns.
+
+use std::path::PathBuf;
+
+use tvmd_core::team::presets::Preset;
+use tvmd_core::TeamConfig;
+
+use super::certify::HeightRange;
+use super::plot::cross_sections;
+use super::report::{atlas_entry, markdown_table, AtlasRow, AtlasSettings};
+use crate::SimError;
+
+/// Arguments of `tvmd-sim afs`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct AfsArgs {
+    /// A catalogue team (`a3-con` .. `a10-inc`, `t10-con`, `t10-inc`, `a4-diamond-inc`, ...)
+    /// or `all`.
+    pub team: String,
+    /// Failed agents (0-based), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub failed: Vec<usize>,
+    /// Also every one-agent failure of each team.
+    #[arg(long, conflicts_with = "failed")]
+    pub each_failure: bool,
+    /// Comparison heights in multiples of m_C g, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1.0,1.5")]
+    pub heights: Vec<f64>,
+    /// Directions per cross-section.
+    #[arg(long, default_value_t = 36)]
+    pub directions: usize,
+    /// Relaxation s of the compared cone.
+    #[arg(long, default_value_t = 1.0)]
+    pub relaxation: f64,
+    /// Heights of the s* certification grid (from 0.1 to 0.9 of the hover ceiling).
+    #[arg(long, default_value_t = 9)]
+    pub certify_heights: usize,
+    /// Torque the agents must hold (N m), `x,y,z`.
+    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.0, 0.0, 0.0], allow_negative_numbers = true)]
+    pub torque: Vec<f64>,
+    /// Directory for the PNG cross-sections (`<team>[-failed-<i>].png`).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+    /// Write the rows as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+/// The teams the arguments name.
+pub fn presets(team: &str) -> Result<Vec<Preset>, SimError> {
+    if team == "all" {
+        return Ok(Preset::ALL.to_vec());
+    }
+    Preset::from_name(team).map(|p| vec![p]).ok_or_else(|| {
+        let known: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+        SimError::InvalidScenario {
+            field: "team".into(),
+            reason: format!("unknown team `{team}` (known: all, {})", known.join(", ")),
+        }
+    })
+}
+
+/// Computes every row the arguments ask for, writes the plots and JSON, and returns the rows
+/// and the Markdown table.
+pub fn run(args: &AfsArgs) -> Result<(Vec<AtlasRow>, String), SimError> {
+    let settings = AtlasSettings {
+        heights: args.heights.clone(),
+        directions: args.directions,
+        relaxation: args.relaxation,
+        range: HeightRange {
+            heights: args.certify_heights,
+            ..HeightRange::default()
+        },
+        torque: [
+            args.torque.first().copied().unwrap_or(0.0),
+            args.torque.get(1).copied().unwrap_or(0.0),
+            args.torque.get(2).copied().unwrap_or(0.0),
+        ],
+    };
+    if let Some(dir) = &args.plots {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| SimError::Plot(format!("cannot create `{}`: {e}", dir.display())))?;
+    }
+    let mut jobs = Vec::new();
+    for preset in presets(&args.team)? {
+        let team: TeamConfig<f64, 16> = preset
+            .team()
+            .map_err(|e| SimError::InvalidTeam(e.to_string()))?;
+        jobs.push((preset, team, args.failed.clone(), false));
+        if args.each_failure {
+            jobs.extend((0..team.len()).map(|i| (preset, team, vec![i], true)));
+        }
+    }
+    let job =
+        |(preset, team, failed, optional): &(Preset, TeamConfig<f64, 16>, Vec<usize>, bool)| {
+            let entry = match atlas_entry(preset.name(), team, failed, &settings) {
+                Ok(entry) => entry,
+                // A one-agent failure the team cannot survive is a row of the table, not an error
+                // of the whole run.
+                Err(e) if *optional => {
+                    return Ok(AtlasRow::unavailable(preset.name(), failed, e.to_string()))
+                }
+                Err(e) => return Err(e),
+            };
+            if let Some(dir) = &args.plots {
+                let suffix: String = failed.iter().map(|i| format!("-failed-{i}")).collect();
+                let path = dir.join(format!("{}{suffix}.png", preset.name()));
+                cross_sections(&entry, args.relaxation, &path)?;
+            }
+            Ok(entry.row)
+        };
+    // Rows are independent: spread them over the cores, keeping their order.
+    let workers = std::thread::available_parallelism()
+        .map_or(1, usize::from)
+        .min(jobs.len().max(1));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut slots: Vec<Option<Result<AtlasRow, SimError>>> = Vec::new();
+    slots.resize_with(jobs.len(), || None);
+    let slots = std::sync::Mutex::new(slots);
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(spec) = jobs.get(k) else { break };
+                let result = job(spec);
+                if let Ok(mut slots) = slots.lock() {
+                    if let Some(slot) = slots.get_mut(k) {
+                        *slot = Some(result);
+                    }
+                }
+            });
+        }
+    });
+    let slots = slots
+        .into_inner()
+        .map_err(|_| SimError::Internal("an atlas worker panicked".into()))?;
+    let rows = slots
+        .into_iter()
+        .map(|r| r.unwrap_or_else(|| Err(SimError::Internal("an atlas row is missing".into()))))
+        .collect::<Result<Vec<AtlasRow>, SimError>>()?;
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&rows)?;
+        std::fs::write(path, text)
+            .map_err(|e| SimError::Plot(format!("cannot write `{}`: {e}", path.display())))?;
+    }
+    let table = markdown_table(&rows);
+    Ok((rows, table))
+}
