@@ -19,6 +19,23 @@ use crate::sim::{null_space_arg, value_error};
 use crate::team::{failure_mask, PyTeam};
 use crate::CAPACITY;
 
+/// The controller borrowed for a call; a clear error if another thread holds it (only possible
+/// from code that re-enters the controller while it runs, as the GIL serializes the calls).
+fn borrow<'py>(slf: &Bound<'py, PyController>) -> PyResult<PyRef<'py, PyController>> {
+    slf.try_borrow().map_err(|_| busy())
+}
+
+fn borrow_mut<'py>(slf: &Bound<'py, PyController>) -> PyResult<PyRefMut<'py, PyController>> {
+    slf.try_borrow_mut().map_err(|_| busy())
+}
+
+fn busy() -> PyErr {
+    pyo3::exceptions::PyRuntimeError::new_err(
+        "tvmd.Controller is in use by another call (a controller may be shared between threads; \
+         its calls run one at a time)",
+    )
+}
+
 /// The full-pose controller: one `step` per control period. See the stub for arguments.
 #[pyclass(module = "tvmd", name = "Controller")]
 pub struct PyController {
@@ -81,9 +98,15 @@ impl PyController {
     /// Marks agents failed (None or [] for none); returns the `HoverCapability` of the
     /// working agents. See the stub.
     #[pyo3(signature = (failed = None))]
-    fn set_failures(&mut self, failed: Option<&Bound<'_, PyAny>>) -> PyResult<PyHoverCapability> {
-        let mask = failure_mask(self.inner.team(), failed)?;
-        let inner = self.inner.set_failures(mask).or_raise()?;
+    fn set_failures(
+        slf: &Bound<'_, Self>,
+        failed: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyHoverCapability> {
+        // Convert first (a conversion may run Python code and let another thread in), then
+        // borrow: a shared controller is never found borrowed by a waiting thread.
+        let team = *borrow(slf)?.inner.team();
+        let mask = failure_mask(&team, failed)?;
+        let inner = borrow_mut(slf)?.inner.set_failures(mask).or_raise()?;
         Ok(PyHoverCapability { inner })
     }
 
@@ -102,16 +125,19 @@ impl PyController {
 
     /// One control period. See the stub for arguments.
     fn step(
-        &mut self,
+        slf: &Bound<'_, Self>,
         py: Python<'_>,
         state: &Bound<'_, PyAny>,
         reference: &Bound<'_, PyAny>,
     ) -> PyResult<PyStepOutput> {
+        // Arguments are converted before the controller is borrowed (see `set_failures`).
         let (state, reference) = (state_arg(state)?, reference_arg(reference)?);
-        let n = self.inner.team().len();
-        match self.inner.step(&state, &reference) {
+        let mut this = borrow_mut(slf)?;
+        let this = &mut *this;
+        let n = this.inner.team().len();
+        match this.inner.step(&state, &reference) {
             Ok(out) => {
-                let allocation = AllocationData::new(out.allocation, n, self.inner.allocator());
+                let allocation = AllocationData::new(out.allocation, n, this.inner.allocator());
                 let inner = StepData {
                     out: Box::new(out),
                     n,

@@ -49,7 +49,9 @@ fn numeric<T: Element>(
         })?;
     let dtype = converted.getattr(intern!(py, "dtype"))?;
     let kind: String = dtype.getattr(intern!(py, "kind"))?.extract()?;
-    if !kinds.contains(&kind.as_str()) {
+    // An empty list converts to float64: it is no evidence of the wrong kind of values.
+    let size: usize = converted.getattr(intern!(py, "size"))?.extract()?;
+    if size > 0 && !kinds.contains(&kind.as_str()) {
         return Err(PyTypeError::new_err(format!(
             "`{name}` must contain {what}, got an array of dtype {}",
             dtype.str()?

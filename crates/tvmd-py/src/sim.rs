@@ -4,8 +4,9 @@
 //! this module converts arguments, results and errors. Runs release the GIL.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
@@ -47,10 +48,20 @@ fn sim_error(error: SimError, context: &str, file: Option<(&str, &Path)>) -> PyE
             let what = file.map_or("I/O error", |(what, _)| what);
             (format!("{context}{what}: {io}"), io.raw_os_error())
         }
+        SimError::File { source, path, .. } => {
+            let message = format!("{context}{error}");
+            let path = path.display().to_string();
+            return match source.raw_os_error() {
+                Some(errno) => PyOSError::new_err((errno, message, path)),
+                None => PyOSError::new_err(message),
+            };
+        }
+        SimError::Interrupted => return PyKeyboardInterrupt::new_err(format!("{context}{error}")),
         SimError::Mcap(_) | SimError::LogRead(_) | SimError::LogFinished => {
             (format!("{context}{error}"), None)
         }
-        SimError::InvalidTeam(_)
+        SimError::PathClash(_)
+        | SimError::InvalidTeam(_)
         | SimError::InvalidScenario { .. }
         | SimError::ScenarioParse { .. }
         | SimError::UnknownScenario { .. } => {
@@ -220,7 +231,8 @@ fn run_specs(
                 .ok_or_else(error)
         })
         .transpose()?;
-    let outcomes = py.detach(|| runner::run_many(specs, jobs, None));
+    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    let outcomes = run_interruptibly(py, specs, jobs)?;
     let results = outcomes.into_iter().enumerate();
     results
         .map(|(k, RunOutcome { spec, result })| match result {
@@ -233,6 +245,36 @@ fn run_specs(
             }
         })
         .collect()
+}
+
+/// How often a waiting batch looks for Python signals (Ctrl-C).
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// Runs the batch on tvmd-sim's pool while this thread, GIL released, checks for Python signals
+/// every [`SIGNAL_POLL`]: on `KeyboardInterrupt` (or any signal handler's exception) the
+/// flights stop at their next controller tick (logs finalised), and the exception is raised.
+fn run_interruptibly(
+    py: Python<'_>,
+    specs: Vec<RunSpec>,
+    jobs: Option<usize>,
+) -> PyResult<Vec<RunOutcome>> {
+    let cancel = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let batch = scope.spawn(|| runner::run_many_until(specs, jobs, None, Some(&cancel)));
+        while !batch.is_finished() {
+            py.detach(|| std::thread::sleep(SIGNAL_POLL));
+            if let Err(signal) = py.check_signals() {
+                cancel.store(true, Ordering::Relaxed);
+                // The flights stop within one controller tick; join them so that their logs
+                // are complete when the exception reaches the caller.
+                let _ = py.detach(|| batch.join());
+                return Err(signal);
+            }
+        }
+        batch
+            .join()
+            .map_err(|_| PyRuntimeError::new_err("tvmd-sim: the batch thread panicked"))
+    })
 }
 
 /// The names of the built-in scenarios.

@@ -3,6 +3,20 @@
 /// Boxed error returned by a flight controller.
 pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
+impl SimError {
+    /// A `map_err` adapter: the I/O error of `action` on `path`.
+    pub fn file<'a>(
+        action: &'static str,
+        path: &'a std::path::Path,
+    ) -> impl FnOnce(std::io::Error) -> SimError + 'a {
+        move |source| SimError::File {
+            action,
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
 /// Errors of the simulator.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
@@ -49,17 +63,35 @@ pub enum SimError {
         /// What is wrong with the output.
         reason: String,
     },
-    /// The simulated state became non-finite.
+    /// The simulated state became non-finite or left the physics' valid range
+    /// (`sim::MAX_POSITION`, `sim::MAX_SPEED`, `sim::MAX_BODY_RATE`).
     #[error("simulation diverged at t = {t:.3} s: {what}")]
     Diverged {
         /// Simulation time.
         t: f64,
-        /// Which quantity became non-finite.
+        /// Which quantity, and its value.
         what: String,
     },
-    /// An I/O error (reading a scenario, writing a log).
+    /// An I/O error without a known file.
     #[error("I/O error: {0}")]
     Io(#[from] std::io::Error),
+    /// A file could not be read or written: what was being done, the path and the cause.
+    #[error("cannot {action} `{}`: {source}", path.display())]
+    File {
+        /// What was being done (`"read the scenario file"`, `"write the MCAP log"`, ...).
+        action: &'static str,
+        /// The file.
+        path: std::path::PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Output paths that would overwrite each other or an input.
+    #[error("output path clash: {0}")]
+    PathClash(String),
+    /// A batch was interrupted (SIGINT, SIGTERM, Ctrl-C) before this run started.
+    #[error("interrupted before this run started")]
+    Interrupted,
     /// An MCAP error while writing a log.
     #[error("MCAP error: {0}")]
     Mcap(#[from] mcap::McapError),

@@ -9,8 +9,9 @@
 //!
 //! Modules, in import order (a module uses only modules above it; see
 //! `docs/architecture.md`):
-//! - [`math`] (rotations, row-major conversions, planned roll) and the
-//!   error type [`SimError`].
+//! - [`math`] (rotations, row-major conversions, planned roll), the error type [`SimError`]
+//!   [`paths`] (output file names and the checks made before a run starts) and [`pool`] (a
+//!   scoped worker pool, results in input order).
 //! - [`actuators`]: actuator commands, thrust direction (eq. 1), servo / rotor-lag models and
 //!   failures.
 //! - [`physics`]: team body, rapier world, the plant's state ([`physics::PlantState`]).
@@ -49,8 +50,10 @@ mod error;
 pub mod flight;
 pub mod log;
 pub mod math;
+pub mod paths;
 pub mod physics;
 pub mod plot;
+pub mod pool;
 pub mod reference;
 pub mod rk4;
 pub mod runner;

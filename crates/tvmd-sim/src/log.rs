@@ -396,9 +396,13 @@ pub struct McapLog {
 }
 
 impl McapLog {
-    /// Creates (truncates) `path` and registers every channel with its schema.
+    /// Creates (truncates) `path`, its parent directories first, and registers every channel
+    /// with its schema. I/O errors name the path ([`SimError::File`]).
     pub fn create(path: impl AsRef<Path>) -> Result<Self, SimError> {
-        let file = BufWriter::new(File::create(path)?);
+        let path = path.as_ref();
+        const ACTION: &str = "write the MCAP log";
+        crate::paths::create_parent(path, ACTION)?;
+        let file = BufWriter::new(File::create(path).map_err(SimError::file(ACTION, path))?);
         let mut w = mcap::WriteOptions::new()
             .profile("")
             .library(concat!("tvmd-sim ", env!("CARGO_PKG_VERSION")))

@@ -13,13 +13,19 @@
 //! tvmd-sim allocation-set [--out benches/data/allocation_set.json] [--seed 16]
 //! tvmd-sim allocation-eval [--set benches/data/allocation_set.json] [--allocators A,B]
 //!                          [--closed-loop] [--json FILE]
+//! tvmd-sim afs TEAM|all [--failed I | --each-failure] [--plots DIR] [--json FILE]
 //! tvmd-sim list
 //! tvmd-sim show NAME
 //! ```
+//!
+//! SIGINT or SIGTERM during `run` or `sweep` stops the flights at their next controller tick:
+//! the MCAP logs are finalised and the summary written with what was simulated (marked
+//! `interrupted`), and the exit status is 130. A second signal exits at once.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -28,8 +34,11 @@ use serde::Serialize;
 use tvmd_sim::allocation_bench;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
+use tvmd_sim::paths::{check_outputs, create_parent, file_stem};
 use tvmd_sim::plot::{self, PlotSeries};
-use tvmd_sim::runner::{record_cycles, run_many, run_scenario_on, sweep_specs, RunSpec};
+use tvmd_sim::runner::{
+    check_batch_outputs, record_cycles, run_many_until, run_scenario_until, sweep_specs, RunSpec,
+};
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary};
 use tvmd_sim::SimError;
@@ -179,18 +188,38 @@ enum Command {
     },
 }
 
+/// Set by SIGINT / SIGTERM: runs stop at their next controller tick.
+static INTERRUPT: AtomicBool = AtomicBool::new(false);
+
+/// Exit status after an interrupt (128 + SIGINT).
+const INTERRUPTED_STATUS: u8 = 130;
+
+/// Makes SIGINT / SIGTERM set [`INTERRUPT`] (a second one exits at once), for the commands
+/// that fly: the others keep the default, immediate exit.
+fn catch_interrupts() {
+    // If no handler can be installed, a signal still ends the run, only without its log's
+    // footer.
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPT.swap(true, Ordering::SeqCst) {
+            std::process::exit(i32::from(INTERRUPTED_STATUS));
+        }
+    });
+}
+
 /// Errors of the command line.
 #[derive(Debug)]
 enum CliError {
     Sim(SimError),
     Other(String),
+    /// Stopped by a signal; what was simulated has been written.
+    Interrupted(String),
 }
 
 impl std::fmt::Display for CliError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::Sim(e) => write!(f, "{e}"),
-            Self::Other(m) => write!(f, "{m}"),
+            Self::Other(m) | Self::Interrupted(m) => write!(f, "{m}"),
         }
     }
 }
@@ -306,6 +335,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Interrupted(m)) => {
+            eprintln!("interrupted: {m}");
+            ExitCode::from(INTERRUPTED_STATUS)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
@@ -412,17 +445,47 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         null_space: a.null_space,
     })?;
     let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
+    let stem = file_stem(&scenario.name);
     let log = if a.no_log {
         None
     } else {
         Some(
             a.out
-                .unwrap_or_else(|| PathBuf::from(format!("out/{}.mcap", scenario.name))),
+                .unwrap_or_else(|| PathBuf::from(format!("out/{stem}.mcap"))),
         )
     };
+    let summary_path = a
+        .summary
+        .or_else(|| log.as_ref().map(|l| l.with_extension("summary.json")));
+    // Every output is checked, and its directory made, before the run starts.
+    let mut outputs: Vec<(String, &Path)> = Vec::new();
+    if let Some(l) = &log {
+        outputs.push(("the log (--out)".into(), l));
+    }
+    if let Some(p) = &summary_path {
+        outputs.push(("the summary (--summary)".into(), p));
+        create_parent(p, "write the summary")?;
+    }
+    let input = Path::new(&a.scenario);
+    let inputs: Vec<(String, &Path)> = if input.is_file() {
+        vec![("scenario file".into(), input)]
+    } else {
+        Vec::new()
+    };
+    check_outputs(&outputs, &inputs)?;
+    if let Some(dir) = &a.plots {
+        std::fs::create_dir_all(dir).map_err(SimError::file("create the figure directory", dir))?;
+    }
+    catch_interrupts();
     let bar = progress_bar(ticks_of(&scenario), &scenario.name);
     let mut tick = |_t: f64| bar.inc(1);
-    let result = run_scenario_on(&scenario, pil, log.as_deref(), Some(&mut tick));
+    let result = run_scenario_until(
+        &scenario,
+        pil,
+        log.as_deref(),
+        Some(&mut tick),
+        Some(&INTERRUPT),
+    );
     bar.finish_and_clear();
     let result = result?;
     let report = RunReport {
@@ -438,9 +501,6 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         log: log.as_ref().map(|p| p.display().to_string()),
     };
     print_run(&report);
-    let summary_path = a
-        .summary
-        .or_else(|| log.as_ref().map(|l| l.with_extension("summary.json")));
     if let Some(p) = &summary_path {
         write_json(p, &report)?;
         println!("summary:  {}", p.display());
@@ -448,10 +508,16 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     if let Some(l) = &log {
         println!("log:      {} (open in Foxglove)", l.display());
     }
+    if result.summary.interrupted {
+        return Err(CliError::Interrupted(format!(
+            "stopped at t = {:.3} s of {} s; the log and summary hold what was simulated",
+            result.summary.time, scenario.duration
+        )));
+    }
     if let Some(dir) = &a.plots {
         let series =
             PlotSeries::from_samples(&scenario.name, Some(scenario.relaxation), &result.samples);
-        for p in plot::write_run_figures(&series, dir, &scenario.name)? {
+        for p in plot::write_run_figures(&series, dir, &stem)? {
             println!("figure:   {}", p.display());
         }
     }
@@ -459,10 +525,10 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
 }
 
 fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")?;
+    const ACTION: &str = "write the summary";
+    create_parent(path, ACTION)?;
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+        .map_err(SimError::file(ACTION, path))?;
     Ok(())
 }
 
@@ -608,10 +674,24 @@ fn cmd_sweep(
     if specs.is_empty() {
         return Err(CliError::Other("no relaxation given".into()));
     }
+    let extra: Vec<(String, &Path)> = summary
+        .iter()
+        .map(|p| ("the summary (--summary)".to_string(), p.as_path()))
+        .collect();
+    check_batch_outputs(&specs, &extra)?;
+    if let Some(p) = &summary {
+        create_parent(p, "write the summary")?;
+    }
+    catch_interrupts();
     let total: u64 = specs.iter().map(|s| ticks_of(&s.scenario)).sum();
     let bar = progress_bar(total, &format!("{} runs", specs.len()));
-    let outcomes = run_many(specs, jobs, Some(&|_, _| bar.inc(1)));
+    let outcomes = run_many_until(specs, jobs, Some(&|_, _| bar.inc(1)), Some(&INTERRUPT));
     bar.finish_and_clear();
+    if INTERRUPT.load(Ordering::SeqCst) {
+        return Err(CliError::Interrupted(
+            "the sweep was stopped; every started run's log is finalised".into(),
+        ));
+    }
     let mut rows = Vec::new();
     let mut series = Vec::new();
     for outcome in outcomes {

@@ -6,8 +6,7 @@ use std::any::Any;
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::control::pil::PilTarget;
 use crate::control::recording::{CycleRecording, Recorder};
@@ -84,13 +83,23 @@ pub fn run_scenario_on(
     log: Option<&Path>,
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<RunResult, SimError> {
+    run_scenario_until(scenario, target, log, progress, None)
+}
+
+/// [`run_scenario_on`], stopping at the next controller tick once `cancel` is set (a signal
+/// handler's flag): the log is finalised with what was simulated and the summary says
+/// `interrupted`.
+pub fn run_scenario_until(
+    scenario: &Scenario,
+    target: Option<PilTarget>,
+    log: Option<&Path>,
+    progress: Option<&mut dyn FnMut(f64)>,
+    cancel: Option<&AtomicBool>,
+) -> Result<RunResult, SimError> {
     let mut controller = AnyTvmdController::from_scenario_on(scenario, target)?;
     let mut sim = Simulation::with_options(scenario, SimOptions::default())?;
     let mut mcap = match log {
         Some(path) => {
-            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir)?;
-            }
             let mut l = McapLog::create(path)?;
             write_scenario_metadata(&mut l, scenario)?;
             Some(l)
@@ -98,8 +107,12 @@ pub fn run_scenario_on(
         None => None,
     };
     let result = match progress {
-        Some(p) => sim.run(&mut WithProgress::new(&mut controller, p), mcap.as_mut()),
-        None => sim.run(&mut controller, mcap.as_mut()),
+        Some(p) => sim.run_until(
+            &mut WithProgress::new(&mut controller, p),
+            mcap.as_mut(),
+            cancel,
+        ),
+        None => sim.run_until(&mut controller, mcap.as_mut(), cancel),
     };
     if let Some(l) = mcap.as_mut() {
         l.finish()?;
@@ -171,8 +184,7 @@ pub type Progress<'a> = &'a (dyn Fn(usize, f64) + Sync);
 
 /// Worker threads for `runs` runs: `jobs` or the available cores, at least 1, at most `runs`.
 pub fn worker_count(jobs: Option<usize>, runs: usize) -> usize {
-    jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .clamp(1, runs.max(1))
+    crate::pool::worker_count(jobs, runs)
 }
 
 fn panic_message(payload: &(dyn Any + Send)) -> String {
@@ -188,15 +200,18 @@ fn run_guarded(
     k: usize,
     spec: &RunSpec,
     progress: Option<Progress<'_>>,
+    cancel: Option<&AtomicBool>,
 ) -> Result<RunResult, SimError> {
+    let log = spec.log.as_deref();
     catch_unwind(AssertUnwindSafe(|| match progress {
-        Some(p) => run_scenario_on(
+        Some(p) => run_scenario_until(
             &spec.scenario,
             spec.pil,
-            spec.log.as_deref(),
+            log,
             Some(&mut |t| p(k, t)),
+            cancel,
         ),
-        None => run_scenario_on(&spec.scenario, spec.pil, spec.log.as_deref(), None),
+        None => run_scenario_until(&spec.scenario, spec.pil, log, None, cancel),
     }))
     .unwrap_or_else(|p| Err(SimError::Internal(panic_message(p.as_ref()))))
 }
@@ -209,36 +224,31 @@ pub fn run_many(
     jobs: Option<usize>,
     progress: Option<Progress<'_>>,
 ) -> Vec<RunOutcome> {
-    let jobs = worker_count(jobs, specs.len());
-    let next = AtomicUsize::new(0);
-    let slots: Vec<Mutex<Option<Result<RunResult, SimError>>>> =
-        specs.iter().map(|_| Mutex::new(None)).collect();
-    let work = || loop {
-        let k = next.fetch_add(1, Ordering::Relaxed);
-        let (Some(spec), Some(slot)) = (specs.get(k), slots.get(k)) else {
-            break;
-        };
-        let result = run_guarded(k, spec, progress);
-        if let Ok(mut slot) = slot.lock() {
-            *slot = Some(result);
+    run_many_until(specs, jobs, progress, None)
+}
+
+/// [`run_many`], stopping once `cancel` is set: the running flights stop at their next
+/// controller tick (logs finalised, summaries `interrupted`), the ones not started report
+/// [`SimError::Interrupted`].
+pub fn run_many_until(
+    specs: Vec<RunSpec>,
+    jobs: Option<usize>,
+    progress: Option<Progress<'_>>,
+    cancel: Option<&AtomicBool>,
+) -> Vec<RunOutcome> {
+    let results = crate::pool::map_in_order(&specs, worker_count(jobs, specs.len()), |k, spec| {
+        if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            Err(SimError::Interrupted)
+        } else {
+            run_guarded(k, spec, progress, cancel)
         }
-    };
-    std::thread::scope(|scope| {
-        for _ in 1..jobs {
-            // If a thread cannot be spawned, the others do its share.
-            let _ = std::thread::Builder::new().spawn_scoped(scope, work);
-        }
-        work();
     });
     specs
         .into_iter()
-        .zip(slots)
-        .map(|(spec, slot)| RunOutcome {
+        .zip(results)
+        .map(|(spec, result)| RunOutcome {
             spec,
-            result: slot
-                .into_inner()
-                .ok()
-                .flatten()
+            result: result
                 .unwrap_or_else(|| Err(SimError::Internal("a run did not finish".into()))),
         })
         .collect()
@@ -258,7 +268,8 @@ pub fn sweep_specs(
             scenario.relaxation = s;
             scenario.name = format!("{}-s{s}", base.name);
             scenario.validate()?;
-            let log = log_dir.map(|d| d.join(format!("{}.mcap", scenario.name)));
+            let stem = crate::paths::file_stem(&scenario.name);
+            let log = log_dir.map(|d| d.join(format!("{stem}.mcap")));
             Ok(RunSpec {
                 scenario,
                 log,
@@ -268,8 +279,25 @@ pub fn sweep_specs(
         .collect()
 }
 
-/// The relaxation study: [`sweep_specs`] flown by [`run_many`]. An invalid `s` is an error
-/// before any run starts.
+/// Checks a batch's logs before any run starts ([`crate::paths::check_outputs`]): two runs
+/// writing one file would corrupt it, and `extra` outputs (a summary) must differ from them.
+pub fn check_batch_outputs(specs: &[RunSpec], extra: &[(String, &Path)]) -> Result<(), SimError> {
+    let mut outputs: Vec<(String, &Path)> = specs
+        .iter()
+        .enumerate()
+        .filter_map(|(k, s)| {
+            Some((
+                format!("the log of run {k} ({})", s.scenario.name),
+                s.log.as_deref()?,
+            ))
+        })
+        .collect();
+    outputs.extend(extra.iter().cloned());
+    crate::paths::check_outputs(&outputs, &[])
+}
+
+/// The relaxation study: [`sweep_specs`] flown by [`run_many`]. An invalid `s` or a log path
+/// given twice (the same `s` twice) is an error before any run starts.
 pub fn relaxation_sweep(
     base: &Scenario,
     relaxations: &[f64],
@@ -277,11 +305,9 @@ pub fn relaxation_sweep(
     jobs: Option<usize>,
     progress: Option<Progress<'_>>,
 ) -> Result<Vec<RunOutcome>, SimError> {
-    Ok(run_many(
-        sweep_specs(base, relaxations, log_dir)?,
-        jobs,
-        progress,
-    ))
+    let specs = sweep_specs(base, relaxations, log_dir)?;
+    check_batch_outputs(&specs, &[])?;
+    Ok(run_many(specs, jobs, progress))
 }
 
 /// Flies `scenario` with its f32 controller wrapped in a [`Recorder`] (whatever its `controller_precision`) and records
@@ -315,6 +341,7 @@ pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecordin
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::atomic::AtomicUsize;
 
     fn short(name: &str, relaxation: f64) -> Scenario {
         Scenario {

@@ -895,6 +895,11 @@ class Controller:
     torque part of the law (eq. 12), the allocation and the inversion into gimbal angles and
     rotor speeds inside ``E_f`` (eq. 6).
 
+    Threads: a controller may be shared between threads. Its calls run one at a time (the GIL);
+    arguments are converted before the controller is borrowed, so a conversion that runs
+    Python code (an ``__array__`` method) never finds it busy. The order of two threads' steps is
+    theirs to arrange: each ``step`` advances the one controller state.
+
     Args:
         team: the ``Team``.
         gains: ``Gains``; None for the paper's (``Gains.paper()``).

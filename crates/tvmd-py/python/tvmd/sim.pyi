@@ -11,6 +11,12 @@ is tvmd-sim's, naming the field), wrong argument types ``TypeError``, I/O errors
 errno subclass, e.g. ``FileNotFoundError``, with the file name), a run that fails while flying
 (divergence, controller error) ``RuntimeError``. A panic inside tvmd-sim is raised as
 ``RuntimeError`` too, never as ``PanicException``.
+
+Ctrl-C (or any signal whose handler raises) while a run or batch flies raises that exception
+within about 20 ms: the flights stop at their next controller tick, every log is finalised
+with what was simulated, and the workers stop before the exception reaches the caller.
+Log paths are checked before anything runs: two runs of a batch on one file raise
+``ValueError`` (``output path clash``).
 """
 
 import os
@@ -238,7 +244,9 @@ def run(
             ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``, an unknown
             ``null_space`` objective or a bad tilt (``null_space.tilt``), ``null_space`` with ``pil``.
         TypeError: an argument of the wrong type.
-        OSError: the scenario file cannot be read or the log cannot be written.
+        OSError: the scenario file cannot be read (also: not a regular file, over 1 MiB) or the
+            log cannot be written; the message names the path.
+        KeyboardInterrupt: Ctrl-C while flying; the log holds what was simulated.
         RuntimeError: the run failed while flying (the state diverged, the controller failed,
             the PIL link broke); with ``pil``, also ``qemu-system-arm`` or the PIL firmware not
             found (the message says how to install or build it).
@@ -260,8 +268,8 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
     in input order is raised, its message prefixed with ``runs[k]``.
 
     Raises:
-        ValueError, TypeError, OSError, RuntimeError: as ``run``; ``ValueError`` also for an
-            unknown dict key or ``jobs < 1``.
+        ValueError, TypeError, OSError, KeyboardInterrupt, RuntimeError: as ``run``;
+            ``ValueError`` also for an unknown dict key, ``jobs < 1`` or two runs with one log.
     """
 
 def relaxation_sweep(
@@ -292,8 +300,9 @@ def relaxation_sweep(
         pil: fly every run with the controller on this emulated target, as ``run``.
 
     Raises:
-        ValueError: as ``run``; an ``s`` outside (0, 1] or not finite, ``relaxations`` not 1-D.
-        TypeError, OSError, RuntimeError: as ``run``.
+        ValueError: as ``run``; an ``s`` outside (0, 1] or not finite, ``relaxations`` not 1-D,
+            an ``s`` given twice with ``mcap_dir`` (one log written twice).
+        TypeError, OSError, KeyboardInterrupt, RuntimeError: as ``run``.
     """
 
 

@@ -110,33 +110,10 @@ pub fn run(args: &AfsArgs) -> Result<(Vec<AtlasRow>, String), SimError> {
             Ok(entry.row)
         };
     // Rows are independent: spread them over the cores, keeping their order.
-    let workers = std::thread::available_parallelism()
-        .map_or(1, usize::from)
-        .min(jobs.len().max(1));
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut slots: Vec<Option<Result<AtlasRow, SimError>>> = Vec::new();
-    slots.resize_with(jobs.len(), || None);
-    let slots = std::sync::Mutex::new(slots);
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(spec) = jobs.get(k) else { break };
-                let result = job(spec);
-                if let Ok(mut slots) = slots.lock() {
-                    if let Some(slot) = slots.get_mut(k) {
-                        *slot = Some(result);
-                    }
-                }
-            });
-        }
-    });
-    let slots = slots
-        .into_inner()
-        .map_err(|_| SimError::Internal("an atlas worker panicked".into()))?;
-    let rows = slots
+    let workers = crate::pool::worker_count(None, jobs.len());
+    let rows = crate::pool::map_in_order(&jobs, workers, |_, spec| job(spec))
         .into_iter()
-        .map(|r| r.unwrap_or_else(|| Err(SimError::Internal("an atlas row is missing".into()))))
+        .map(|r| r.unwrap_or_else(|| Err(SimError::Internal("an atlas worker panicked".into()))))
         .collect::<Result<Vec<AtlasRow>, SimError>>()?;
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&rows)?;

@@ -69,6 +69,9 @@ use tvmd_core::team::presets::Preset;
 
 mod builtin;
 mod certified;
+
+/// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 mod null_space;
 mod overrides;
 mod validate;
@@ -471,24 +474,38 @@ impl Scenario {
             path: None,
             message,
         };
-        // `relaxation = "certified"`: the atlas's s* of the team, resolved once the team is known.
+        // Two readings serde's derive cannot express: `relaxation = "certified"` (the atlas's
+        // s* of the team, resolved once the team is known) and a `[reference]` table without
+        // `kind` (the paper's tilt, as every other field defaults).
         let mut certified = false;
         let rewritten;
         let text = match text.parse::<toml::Table>() {
-            Ok(mut table)
-                if table.get("relaxation").and_then(toml::Value::as_str) == Some("certified") =>
-            {
-                table.remove("relaxation");
-                certified = true;
-                rewritten = toml::to_string(&table).map_err(|e| parse_error(e.to_string()))?;
-                rewritten.as_str()
+            Ok(mut table) => {
+                let mut changed = false;
+                if table.get("relaxation").and_then(toml::Value::as_str) == Some("certified") {
+                    table.remove("relaxation");
+                    certified = true;
+                    changed = true;
+                }
+                if let Some(toml::Value::Table(reference)) = table.get_mut("reference") {
+                    if !reference.contains_key("kind") {
+                        reference.insert("kind".into(), "paper-tilt".into());
+                        changed = true;
+                    }
+                }
+                if changed {
+                    rewritten = toml::to_string(&table).map_err(|e| parse_error(e.to_string()))?;
+                    rewritten.as_str()
+                } else {
+                    text
+                }
             }
-            _ => text,
+            Err(_) => text,
         };
         let de = toml::Deserializer::parse(text).map_err(|e| parse_error(e.to_string()))?;
         // serde_path_to_error adds the dotted key path (e.g. `physics.dt`) to the message;
         // toml's own message shows the offending line.
-        let s: Scenario = serde_path_to_error::deserialize(de).map_err(|e| {
+        let mut s: Scenario = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner().to_string();
             if path.is_empty() || path == "." {
@@ -497,7 +514,6 @@ impl Scenario {
                 parse_error(format!("field `{path}`: {inner}"))
             }
         })?;
-        let mut s = s;
         if certified {
             s.relaxation = s.certified_relaxation()?;
         }
@@ -505,10 +521,40 @@ impl Scenario {
         Ok(s)
     }
 
-    /// Reads, parses and validates a scenario file.
+    /// Reads, parses and validates a scenario file: a regular file (after links) of at most
+    /// [`MAX_SCENARIO_BYTES`], so that a device or FIFO is refused before it is opened.
+    /// Errors: [`SimError::File`] naming the path (missing, unreadable, not a regular file, too
+    /// large, not UTF-8), then as [`Scenario::from_toml_str`].
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self, SimError> {
+        use std::io::Read;
+        const ACTION: &str = "read the scenario file";
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)?;
+        let refuse = |reason: String| SimError::File {
+            action: ACTION,
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidInput, reason),
+        };
+        let meta = std::fs::metadata(path).map_err(SimError::file(ACTION, path))?;
+        if !meta.is_file() {
+            return Err(refuse(
+                "not a regular file (a directory, device or FIFO)".into(),
+            ));
+        }
+        if meta.len() > MAX_SCENARIO_BYTES {
+            return Err(refuse(format!(
+                "{} bytes, more than the {MAX_SCENARIO_BYTES} a scenario may have",
+                meta.len()
+            )));
+        }
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_string(&mut text))
+            .map_err(SimError::file(ACTION, path))?;
+        if text.len() as u64 > MAX_SCENARIO_BYTES {
+            return Err(refuse(format!(
+                "grew beyond {MAX_SCENARIO_BYTES} bytes while read"
+            )));
+        }
         Self::from_toml_str(&text).map_err(|e| match e {
             SimError::ScenarioParse { message, .. } => SimError::ScenarioParse {
                 path: Some(path.display().to_string()),
@@ -520,7 +566,7 @@ impl Scenario {
 
     /// The scenario named by a command-line or Python argument: a TOML file if `name_or_path`
     /// ends in `.toml` or names an existing file, else a built-in (see [`BUILTIN_NAMES`]).
-    /// Errors: [`SimError::Io`] for a file that cannot be read, [`SimError::ScenarioParse`] /
+    /// Errors: [`SimError::File`] for a file that cannot be read, [`SimError::ScenarioParse`] /
     /// [`SimError::InvalidScenario`] naming the field, [`SimError::UnknownScenario`].
     pub fn load(name_or_path: &str) -> Result<Self, SimError> {
         let path = Path::new(name_or_path);
@@ -581,135 +627,4 @@ impl Scenario {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn empty_file_is_paper_tilt() {
-        let s = Scenario::from_toml_str("").unwrap();
-        assert_eq!(s, Scenario::default());
-        assert_eq!(s.steps_per_control().unwrap(), 10);
-        assert!((s.max_thrust().unwrap() - 2.0 * 0.7 * 9.81).abs() < 1e-12);
-    }
-
-    #[test]
-    fn wrong_type_names_the_field() {
-        let e = Scenario::from_toml_str("relaxation = \"half\"\n").unwrap_err();
-        let msg = e.to_string();
-        assert!(msg.contains("relaxation"), "{msg}");
-        let e = Scenario::from_toml_str("[gains]\nk_x = [1.0, 2.0]\n").unwrap_err();
-        assert!(e.to_string().contains("k_x"), "{e}");
-        let e =
-            Scenario::from_toml_str("[[failures]]\nagent = 0\ntime = 1.0\nkind = \"explode\"\n")
-                .unwrap_err();
-        assert!(e.to_string().contains("kind"), "{e}");
-    }
-
-    #[test]
-    fn controller_precision_parses_round_trips_and_rejects_others() {
-        let s = Scenario::from_toml_str("controller_precision = \"f32\"\n").unwrap();
-        assert_eq!(s.controller_precision, Precision::F32);
-        let again = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
-        assert_eq!(again, s);
-        assert_eq!(Scenario::default().controller_precision, Precision::F64);
-        let e = Scenario::from_toml_str("controller_precision = \"f16\"\n").unwrap_err();
-        let msg = e.to_string();
-        assert!(
-            msg.contains("controller_precision") && msg.contains("f32"),
-            "{msg}"
-        );
-        for p in Precision::ALL {
-            assert_eq!(p.as_str().parse::<Precision>().unwrap(), p);
-            assert_eq!(p.to_string(), p.as_str());
-        }
-        let e = "double".parse::<Precision>().unwrap_err();
-        assert!(
-            matches!(&e, SimError::InvalidScenario { field, .. } if field == "controller_precision"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn unknown_key_is_rejected_by_name() {
-        let e = Scenario::from_toml_str("relaxaton = 0.5\n").unwrap_err();
-        assert!(e.to_string().contains("relaxaton"), "{e}");
-        let e = Scenario::from_toml_str("[physics]\nstep = 0.001\n").unwrap_err();
-        assert!(e.to_string().contains("step"), "{e}");
-        let e = Scenario::from_toml_str("[physics]\ndt = \"x\"\n").unwrap_err();
-        assert!(e.to_string().contains("physics.dt"), "{e}");
-    }
-
-    #[test]
-    fn full_example_parses() {
-        let text = r#"
-name = "custom"
-duration = 3.0
-controller_period = 0.005
-relaxation = 1.0
-[physics]
-dt = 0.0005
-[team]
-agents = [
-  { position = [0.3, 0.0, 0.0], mass = 0.5, quarter_turns = 0 },
-  { position = [-0.3, 0.0, 0.0], mass = 0.5, quarter_turns = 3 },
-]
-navigator_mass = 0.2
-[limits]
-max_thrust = 12.0
-[reference]
-kind = "hover"
-position = [0.0, 0.0, 1.0]
-[actuators]
-servo = { natural_frequency = 40.0, damping_ratio = 0.8, rate_limit = 6.0 }
-rotor_lag = { time_constant = 0.03 }
-[[failures]]
-agent = 1
-time = 2.0
-kind = "stuck-gimbal"
-controller_informed = false
-[disturbances]
-wind = [0.5, 0.0, 0.0]
-external_wrench = { torque = [0.0, 0.0, 0.1], start = 1.0, end = 2.0 }
-state_noise = { position = 0.01, seed = 7 }
-"#;
-        let s = Scenario::from_toml_str(text).unwrap();
-        assert_eq!(s.steps_per_control().unwrap(), 10);
-        assert_eq!(s.team_body().unwrap().len(), 2);
-        assert_eq!(s.failures[0].kind, FailureKind::StuckGimbal);
-        assert!(!s.failures[0].controller_informed);
-        assert_eq!(s.disturbances.state_noise.unwrap().seed, 7);
-        assert_eq!(s.max_thrust().unwrap(), 12.0);
-        assert!(matches!(s.reference, ReferenceConfig::Hover { .. }));
-    }
-
-    #[test]
-    fn load_takes_a_builtin_name_or_a_file() {
-        assert_eq!(
-            Scenario::load("a4-con").unwrap(),
-            Scenario::builtin("a4-con").unwrap()
-        );
-        assert!(matches!(
-            Scenario::load("nope"),
-            Err(SimError::UnknownScenario { .. })
-        ));
-        assert!(matches!(
-            Scenario::load("missing-file.toml"),
-            Err(SimError::Io(_))
-        ));
-        let dir = std::env::temp_dir().join(format!("tvmd-sim-load-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        // A file without the .toml suffix is still a file.
-        let path = dir.join("scenario");
-        std::fs::write(&path, "name = \"from-file\"\nrelaxation = 1.0\n").unwrap();
-        let s = Scenario::load(path.to_str().unwrap()).unwrap();
-        assert_eq!((s.name.as_str(), s.relaxation), ("from-file", 1.0));
-        std::fs::write(&path, "[physics]\ndt = -1.0\n").unwrap();
-        let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
-        assert!(
-            e.to_string()
-                .contains("invalid scenario field `physics.dt`"),
-            "{e}"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-}
+mod tests;

@@ -14,6 +14,48 @@ pub(super) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Si
     }
 }
 
+/// Longest scenario (s): 1e6 s, about 11.6 days of flight.
+pub const MAX_DURATION: f64 = 1e6;
+/// Most controller ticks of one run: every sample is kept in memory (about 1 KB each), so a
+/// run is bounded to about 2 GB.
+pub const MAX_TICKS: f64 = 2e6;
+/// Most physics steps of one run (about 20 minutes of rapier on the development machine).
+pub const MAX_PHYSICS_STEPS: f64 = 1e9;
+/// Physics step range (s): `[1e-6, 0.01]`.
+pub const PHYSICS_DT: [f64; 2] = [1e-6, 0.01];
+/// Controller period range (s): from one physics step to 1 s.
+pub const MAX_CONTROLLER_PERIOD: f64 = 1.0;
+/// Solver iterations range.
+pub const SOLVER_ITERATIONS: [usize; 2] = [1, 1000];
+/// Largest distance of positions in a scenario (m).
+pub const MAX_DISTANCE: f64 = 1e4;
+/// Largest external force or wind (N) and torque (N m).
+pub const MAX_EXTERNAL: f64 = 1e4;
+
+/// `Err` naming `field` unless `v` is in `[lo, hi]`.
+fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), SimError> {
+    if v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            format!("must be in [{lo:e}, {hi:e}], got {v}"),
+        ))
+    }
+}
+
+/// `Err` naming `field` unless every component of `v` has `|x| <= limit`.
+fn check_magnitude(field: &str, v: &[f64], limit: f64) -> Result<(), SimError> {
+    check_finite(field, v)?;
+    match v.iter().find(|x| x.abs() > limit) {
+        None => Ok(()),
+        Some(x) => Err(invalid(
+            field,
+            format!("must be within +-{limit:e}, got {x}"),
+        )),
+    }
+}
+
 fn check_pos(field: &str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -41,12 +83,70 @@ impl Scenario {
     /// Checks values that parse but make no sense; errors name the field.
     pub fn validate(&self) -> Result<(), SimError> {
         check_pos("duration", self.duration)?;
-        check_pos("physics.dt", self.physics.dt)?;
-        check_pos("controller_period", self.controller_period)?;
+        check_range("duration", self.duration, 0.0, MAX_DURATION)?;
+        check_range("physics.dt", self.physics.dt, PHYSICS_DT[0], PHYSICS_DT[1])?;
+        check_range(
+            "controller_period",
+            self.controller_period,
+            self.physics.dt,
+            MAX_CONTROLLER_PERIOD,
+        )?;
         self.steps_per_control()?;
-        check_nonneg("physics.gravity", &[self.physics.gravity])?;
+        if self.duration < self.controller_period {
+            return Err(invalid(
+                "duration",
+                format!(
+                    "{} s is shorter than one controller period ({} s): the run would record \
+                     no sample",
+                    self.duration, self.controller_period
+                ),
+            ));
+        }
+        let ticks = self.duration / self.controller_period;
+        if ticks > MAX_TICKS {
+            return Err(invalid(
+                "duration",
+                format!(
+                    "{ticks:.3e} controller ticks exceed the {MAX_TICKS:e} a run may keep in \
+                     memory; shorten the run or lengthen controller_period"
+                ),
+            ));
+        }
+        let steps = self.duration / self.physics.dt;
+        if steps > MAX_PHYSICS_STEPS {
+            return Err(invalid(
+                "duration",
+                format!(
+                    "{steps:.3e} physics steps exceed {MAX_PHYSICS_STEPS:e}; shorten the run or \
+                     lengthen physics.dt"
+                ),
+            ));
+        }
+        let [lo, hi] = SOLVER_ITERATIONS;
+        let iterations = self.physics.solver_iterations;
+        if !(lo..=hi).contains(&iterations) {
+            return Err(invalid(
+                "physics.solver_iterations",
+                format!("must be in [{lo}, {hi}], got {iterations}"),
+            ));
+        }
+        check_range("physics.gravity", self.physics.gravity, 0.0, 100.0)?;
         check_nonneg("physics.friction", &[self.physics.friction])?;
-        check_finite("initial_position", &self.initial_position)?;
+        check_magnitude("initial_position", &self.initial_position, MAX_DISTANCE)?;
+        if self.initial_position[2] < 0.0 {
+            return Err(invalid(
+                "initial_position",
+                format!(
+                    "z = {} m is below the ground (z = 0 rests the team on it)",
+                    self.initial_position[2]
+                ),
+            ));
+        }
+        check_range("team.agent_mass", self.team.agent_mass, 1e-3, 1e3)?;
+        check_range("team.navigator_mass", self.team.navigator_mass, 0.0, 1e4)?;
+        if let Some(arm) = self.team.arm {
+            check_range("team.arm", arm, 1e-3, 100.0)?;
+        }
         check_pos(
             "failure_response.landing_acceleration",
             self.failure_response.landing_acceleration,
@@ -93,26 +193,43 @@ impl Scenario {
         let team = self.team_body()?;
         match &self.reference {
             ReferenceConfig::PaperTilt(p) => {
-                check_finite("reference.ascent_height", &[p.ascent_height])?;
-                check_finite("reference.roll_peak", &[p.roll_peak])?;
+                check_magnitude("reference.ascent_height", &[p.ascent_height], MAX_DISTANCE)?;
+                check_magnitude("reference.roll_peak", &[p.roll_peak], PI)?;
                 for (f, w) in [
                     ("reference.ascent", p.ascent),
                     ("reference.tilt", p.tilt),
                     ("reference.descent", p.descent),
                 ] {
-                    check_finite(f, &w)?;
-                    if w[1] < w[0] {
-                        return Err(invalid(f, "end before start"));
+                    check_magnitude(f, &w, MAX_DURATION)?;
+                    if w[1] <= w[0] {
+                        return Err(invalid(
+                            f,
+                            format!("the window [{}, {}] s must end after it starts", w[0], w[1]),
+                        ));
                     }
                 }
             }
             ReferenceConfig::Hover { position, roll } => {
-                check_finite("reference.position", position)?;
-                check_finite("reference.roll", &[*roll])?;
+                check_magnitude("reference.position", position, MAX_DISTANCE)?;
+                check_magnitude("reference.roll", &[*roll], PI)?;
             }
         }
         if let Some(s) = &self.actuators.servo {
             check_pos("actuators.servo.natural_frequency", s.natural_frequency)?;
+            // The servo is integrated at the physics step (semi-implicit Euler): stable while
+            // w_n dt stays well below 2.
+            if s.natural_frequency * self.physics.dt > 1.0 {
+                return Err(invalid(
+                    "actuators.servo.natural_frequency",
+                    format!(
+                        "{} rad/s is too fast for physics.dt = {} s: must be at most 1/dt = {} \
+                         rad/s",
+                        s.natural_frequency,
+                        self.physics.dt,
+                        1.0 / self.physics.dt
+                    ),
+                ));
+            }
             check_nonneg("actuators.servo.damping_ratio", &[s.damping_ratio])?;
             check_pos("actuators.servo.rate_limit", s.rate_limit)?;
         }
@@ -137,13 +254,23 @@ impl Scenario {
             }
             check_nonneg(&format!("failures[{i}].time"), &[f.time])?;
         }
-        check_finite("disturbances.wind", &self.disturbances.wind)?;
+        check_magnitude("disturbances.wind", &self.disturbances.wind, MAX_EXTERNAL)?;
         if let Some(w) = &self.disturbances.external_wrench {
-            check_finite("disturbances.external_wrench.force", &w.force)?;
-            check_finite("disturbances.external_wrench.torque", &w.torque)?;
+            check_magnitude("disturbances.external_wrench.force", &w.force, MAX_EXTERNAL)?;
+            check_magnitude(
+                "disturbances.external_wrench.torque",
+                &w.torque,
+                MAX_EXTERNAL,
+            )?;
             check_finite("disturbances.external_wrench.start", &[w.start])?;
             if let Some(e) = w.end {
                 check_finite("disturbances.external_wrench.end", &[e])?;
+                if e < w.start {
+                    return Err(invalid(
+                        "disturbances.external_wrench.end",
+                        format!("ends at {e} s, before it starts ({} s)", w.start),
+                    ));
+                }
             }
         }
         if let Some(n) = &self.disturbances.state_noise {

@@ -23,6 +23,8 @@ pub mod sample;
 pub mod summary;
 pub mod tick_log;
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -39,6 +41,40 @@ use crate::SimError;
 pub use difference::FlightDifference;
 pub use sample::Sample;
 pub use summary::{NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, VxRise};
+
+/// The valid range of the physics: beyond it a run ends with [`SimError::Diverged`] rather than
+/// run on in a state rapier clamps (its default caps speeds) or cannot represent. A team of the
+/// simulator's scale is far outside its flight envelope well before these.
+pub const MAX_POSITION: f64 = 1e5;
+/// Largest speed of the centre of mass (m/s), below rapier's default velocity cap (400 m/s).
+pub const MAX_SPEED: f64 = 300.0;
+/// Largest body rate (rad/s).
+pub const MAX_BODY_RATE: f64 = 200.0;
+
+/// `Err(Diverged)` when the state at `t` is not finite or outside the valid range.
+fn check_divergence(t: f64, s: &PlantState) -> Result<(), SimError> {
+    let what = if !s.is_finite() {
+        Some("the state is not finite".to_string())
+    } else if s.position.norm() > MAX_POSITION {
+        Some(format!(
+            "|position| = {:.3e} m exceeds {MAX_POSITION:e} m",
+            s.position.norm()
+        ))
+    } else if s.velocity.norm() > MAX_SPEED {
+        Some(format!(
+            "speed {:.3e} m/s exceeds {MAX_SPEED} m/s (rapier caps speeds at 400 m/s)",
+            s.velocity.norm()
+        ))
+    } else if s.omega.norm() > MAX_BODY_RATE {
+        Some(format!(
+            "body rate {:.3e} rad/s exceeds {MAX_BODY_RATE} rad/s",
+            s.omega.norm()
+        ))
+    } else {
+        None
+    };
+    what.map_or(Ok(()), |what| Err(SimError::Diverged { t, what }))
+}
 
 /// Result of a run: the samples and a summary.
 #[derive(Clone, Debug, Serialize)]
@@ -81,6 +117,7 @@ pub struct Simulation {
     step_index: usize,
     controller_calls: usize,
     wall_time: f64,
+    interrupted: bool,
 }
 
 impl Simulation {
@@ -122,6 +159,7 @@ impl Simulation {
             step_index: 0,
             controller_calls: 0,
             wall_time: 0.0,
+            interrupted: false,
         })
     }
 
@@ -211,8 +249,20 @@ impl Simulation {
         controller: &mut dyn FlightController,
         log: Option<&mut McapLog>,
     ) -> Result<RunResult, SimError> {
+        self.run_until(controller, log, None)
+    }
+
+    /// As [`Simulation::run`], stopping at the first controller tick after `cancel` is set
+    /// (a signal handler's or a caller's flag): the result then holds what was simulated, and
+    /// its summary says `interrupted`.
+    pub fn run_until(
+        &mut self,
+        controller: &mut dyn FlightController,
+        log: Option<&mut McapLog>,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<RunResult, SimError> {
         let start = std::time::Instant::now();
-        let result = self.run_loop(controller, log);
+        let result = self.run_loop(controller, log, cancel);
         self.wall_time += start.elapsed().as_secs_f64();
         result?;
         Ok(RunResult {
@@ -225,6 +275,7 @@ impl Simulation {
         &mut self,
         controller: &mut dyn FlightController,
         mut log: Option<&mut McapLog>,
+        cancel: Option<&AtomicBool>,
     ) -> Result<(), SimError> {
         let dt = self.scenario.physics.dt;
         let period = self.scenario.controller_period;
@@ -235,7 +286,12 @@ impl Simulation {
             let t = k as f64 * dt;
             self.apply_failures(t);
             if k % self.steps_per_control == 0 {
+                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                    self.interrupted = true;
+                    break;
+                }
                 let truth = self.world.state();
+                check_divergence(t, &truth)?;
                 let fed = self.noisy(&truth);
                 let reference = self.scenario.reference.at(t);
                 let out = controller
@@ -312,6 +368,7 @@ impl Simulation {
             controller_calls: self.controller_calls,
             physics_steps: self.step_index,
             wall_time: self.wall_time,
+            interrupted: self.interrupted,
         };
         RunSummary::new(&self.scenario, &self.samples, &totals)
     }

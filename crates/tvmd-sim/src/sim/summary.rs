@@ -134,6 +134,8 @@ pub struct RunTotals {
     pub physics_steps: usize,
     /// Wall-clock time spent in the loop (s), logging included.
     pub wall_time: f64,
+    /// Whether the run was stopped before the scenario's end (a signal or the caller's flag).
+    pub interrupted: bool,
 }
 
 /// One hover classification of a run: when the controller accepted a new failure mask.
@@ -161,6 +163,9 @@ pub struct RunSummary {
     pub controller_target: String,
     /// Simulated time reached (s).
     pub time: f64,
+    /// Whether the run was stopped before the scenario's end (SIGINT, SIGTERM, Ctrl-C in
+    /// Python): the summary then covers `time` seconds only.
+    pub interrupted: bool,
     /// Final position (m).
     pub final_position: [f64; 3],
     /// Final world velocity (m/s).
@@ -290,6 +295,7 @@ impl RunSummary {
             controller_precision: scenario.controller_precision,
             controller_target: crate::flight::HOST_TARGET.to_string(),
             time,
+            interrupted: totals.interrupted,
             final_position: arr(&s.position),
             final_velocity: arr(&s.velocity),
             final_omega: arr(&s.omega),
@@ -548,6 +554,7 @@ mod tests {
             controller_calls: 4,
             physics_steps: 16,
             wall_time: 0.0,
+            interrupted: false,
         };
         let summary = RunSummary::new(&scenario, &samples, &totals);
         let paper = PaperMetrics::new(&scenario, &samples);
