@@ -30,7 +30,7 @@ HORIZONTAL_ERROR_AT_12S = 0.11
 SHORT = "duration = 1.0\n"
 
 RUN_SUMMARY_FIELDS = {
-    "scenario", "controller_precision", "controller_target", "time", "interrupted", "final_position", "final_velocity", "final_omega",
+    "scenario", "controller_precision", "controller_target", "time", "interrupted", "error", "final_position", "final_velocity", "final_omega",
     "final_roll_pitch_yaw", "max_position_error", "max_position_error_after_4s",
     "final_position_error", "horizontal_error_at_4s", "horizontal_error_at_12s", "max_tilt",
     "max_roll", "max_planned_roll", "max_e_f", "max_e_f_time", "max_e_f_over_weight",

@@ -37,7 +37,7 @@ use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::paths::{check_outputs, create_parent, file_stem};
 use tvmd_sim::plot::{self, PlotSeries};
 use tvmd_sim::runner::{
-    check_batch_outputs, record_cycles, run_many_until, run_scenario_until, sweep_specs, RunSpec,
+    check_batch_outputs, fly, record_cycles, run_many_until, sweep_specs, Flight, RunSpec,
 };
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary};
@@ -479,7 +479,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     catch_interrupts();
     let bar = progress_bar(ticks_of(&scenario), &scenario.name);
     let mut tick = |_t: f64| bar.inc(1);
-    let result = run_scenario_until(
+    let flight = fly(
         &scenario,
         pil,
         log.as_deref(),
@@ -487,7 +487,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         Some(&INTERRUPT),
     );
     bar.finish_and_clear();
-    let result = result?;
+    let Flight { result, error } = flight?;
     let report = RunReport {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
@@ -507,6 +507,10 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     }
     if let Some(l) = &log {
         println!("log:      {} (open in Foxglove)", l.display());
+    }
+    // A failed flight still leaves its log and a summary of what was simulated.
+    if let Some(error) = error {
+        return Err(CliError::Sim(error));
     }
     if result.summary.interrupted {
         return Err(CliError::Interrupted(format!(

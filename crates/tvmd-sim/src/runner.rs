@@ -96,6 +96,31 @@ pub fn run_scenario_until(
     progress: Option<&mut dyn FnMut(f64)>,
     cancel: Option<&AtomicBool>,
 ) -> Result<RunResult, SimError> {
+    let flight = fly(scenario, target, log, progress, cancel)?;
+    match flight.error {
+        Some(error) => Err(error),
+        None => Ok(flight.result),
+    }
+}
+
+/// A flight that started: what was simulated, and the error that ended it early, if any.
+#[derive(Debug)]
+pub struct Flight {
+    /// The samples and summary up to the end or the failure (the summary's `error` names it).
+    pub result: RunResult,
+    /// The failure while flying (divergence, controller error, log write), if any.
+    pub error: Option<SimError>,
+}
+
+/// [`run_scenario_until`] that keeps a failed flight's partial result: `Err` only when the
+/// flight could not start (scenario, controller or log creation).
+pub fn fly(
+    scenario: &Scenario,
+    target: Option<PilTarget>,
+    log: Option<&Path>,
+    progress: Option<&mut dyn FnMut(f64)>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Flight, SimError> {
     let mut controller = AnyTvmdController::from_scenario_on(scenario, target)?;
     let mut sim = Simulation::with_options(scenario, SimOptions::default())?;
     let mut mcap = match log {
@@ -106,7 +131,7 @@ pub fn run_scenario_until(
         }
         None => None,
     };
-    let result = match progress {
+    let run = match progress {
         Some(p) => sim.run_until(
             &mut WithProgress::new(&mut controller, p),
             mcap.as_mut(),
@@ -114,12 +139,22 @@ pub fn run_scenario_until(
         ),
         None => sim.run_until(&mut controller, mcap.as_mut(), cancel),
     };
-    if let Some(l) = mcap.as_mut() {
-        l.finish()?;
-    }
-    let mut result = result?;
+    let finished = mcap.as_mut().map_or(Ok(()), McapLog::finish);
+    let (mut result, error) = match (run, finished) {
+        (Ok(result), Ok(())) => (result, None),
+        (Err(e), _) | (Ok(_), Err(e)) => (result_of(&sim), Some(e)),
+    };
     result.summary.controller_target = controller.target_label();
-    Ok(result)
+    result.summary.error = error.as_ref().map(ToString::to_string);
+    Ok(Flight { result, error })
+}
+
+/// What `sim` has simulated so far.
+fn result_of(sim: &Simulation) -> RunResult {
+    RunResult {
+        samples: sim.samples().to_vec(),
+        summary: sim.summary(),
+    }
 }
 
 /// One run of a batch: a validated scenario and the MCAP log to write, if any.

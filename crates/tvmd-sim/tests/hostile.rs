@@ -285,6 +285,40 @@ fn divergence_ends_the_run_with_an_error() {
     assert!(m.contains("speed") && m.contains("300"), "{m}");
 }
 
+/// A flight that fails while flying still leaves its log and a summary of what was simulated,
+/// naming the error.
+#[test]
+fn a_failed_run_writes_its_summary() {
+    let dir = tmp_dir("failed");
+    let scenario = dir.join("windy.toml");
+    std::fs::write(
+        &scenario,
+        "name = \"windy\"\nduration = 3.0\n[disturbances]\nwind = [9000.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let log = dir.join("windy.mcap");
+    let out = bin()
+        .args([
+            "run",
+            scenario.to_str().unwrap(),
+            "--out",
+            log.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let e = failure(&out);
+    assert!(e.contains("diverged"), "{e}");
+    let bytes = std::fs::read(&log).unwrap();
+    assert!(mcap::Summary::read(&bytes).unwrap().is_some());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("windy.summary.json")).unwrap())
+            .unwrap();
+    let error = json["summary"]["error"].as_str().unwrap_or_default();
+    assert!(error.contains("diverged"), "{json}");
+    assert!(json["summary"]["time"].as_f64().unwrap() < 3.0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Every field of `[reference]` has a default, `kind` included.
 #[test]
 fn a_reference_table_without_kind_is_the_paper_tilt() {

@@ -166,6 +166,9 @@ pub struct RunSummary {
     /// Whether the run was stopped before the scenario's end (SIGINT, SIGTERM, Ctrl-C in
     /// Python): the summary then covers `time` seconds only.
     pub interrupted: bool,
+    /// The error that ended the flight early (then the summary covers `time` seconds only), or
+    /// `None`.
+    pub error: Option<String>,
     /// Final position (m).
     pub final_position: [f64; 3],
     /// Final world velocity (m/s).
@@ -296,6 +299,7 @@ impl RunSummary {
             controller_target: crate::flight::HOST_TARGET.to_string(),
             time,
             interrupted: totals.interrupted,
+            error: None,
             final_position: arr(&s.position),
             final_velocity: arr(&s.velocity),
             final_omega: arr(&s.omega),
