@@ -61,6 +61,7 @@ fn sim_error(error: SimError, context: &str, file: Option<(&str, &Path)>) -> PyE
             (format!("{context}{error}"), None)
         }
         SimError::PathClash(_)
+        | SimError::InvalidArgument { .. }
         | SimError::InvalidTeam(_)
         | SimError::InvalidScenario { .. }
         | SimError::ScenarioParse { .. }

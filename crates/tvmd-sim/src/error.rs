@@ -86,6 +86,14 @@ pub enum SimError {
         #[source]
         source: std::io::Error,
     },
+    /// An argument of an analysis (the AFS atlas) outside its range.
+    #[error("invalid argument `{name}`: {reason}")]
+    InvalidArgument {
+        /// The argument.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// Output paths that would overwrite each other or an input.
     #[error("output path clash: {0}")]
     PathClash(String),

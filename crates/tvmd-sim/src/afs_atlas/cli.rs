@@ -36,7 +36,7 @@ pub struct AfsArgs {
     #[arg(long, default_value_t = 9)]
     pub certify_heights: usize,
     /// Torque the agents must hold (N m), `x,y,z`.
-    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.0, 0.0, 0.0], allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.0, 0.0], allow_negative_numbers = true)]
     pub torque: Vec<f64>,
     /// Directory for the PNG cross-sections (`<team>[-failed-<i>].png`).
     #[arg(long)]
@@ -53,8 +53,8 @@ pub fn presets(team: &str) -> Result<Vec<Preset>, SimError> {
     }
     Preset::from_name(team).map(|p| vec![p]).ok_or_else(|| {
         let known: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
-        SimError::InvalidScenario {
-            field: "team".into(),
+        SimError::InvalidArgument {
+            name: "team".into(),
             reason: format!("unknown team `{team}` (known: all, {})", known.join(", ")),
         }
     })
@@ -71,11 +71,12 @@ pub fn run(args: &AfsArgs) -> Result<(Vec<AtlasRow>, String), SimError> {
             heights: args.certify_heights,
             ..HeightRange::default()
         },
-        torque: [
-            args.torque.first().copied().unwrap_or(0.0),
-            args.torque.get(1).copied().unwrap_or(0.0),
-            args.torque.get(2).copied().unwrap_or(0.0),
-        ],
+        torque: <[f64; 3]>::try_from(args.torque.as_slice()).map_err(|_| {
+            SimError::InvalidArgument {
+                name: "torque".into(),
+                reason: format!("needs three values x,y,z, got {:?}", args.torque),
+            }
+        })?,
     };
     if let Some(dir) = &args.plots {
         std::fs::create_dir_all(dir)

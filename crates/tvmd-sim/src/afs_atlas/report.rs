@@ -132,8 +132,8 @@ pub fn atlas_entry<const N: usize>(
     failed: &[usize],
     settings: &AtlasSettings,
 ) -> Result<AtlasEntry, SimError> {
-    let bad = |field: &str, reason: String| SimError::InvalidScenario {
-        field: field.into(),
+    let bad = |name: &str, reason: String| SimError::InvalidArgument {
+        name: name.into(),
         reason,
     };
     let s = Relaxation::new(settings.relaxation).map_err(|e| bad("relaxation", e.to_string()))?;

@@ -325,3 +325,34 @@ fn hover_ceiling_agrees_with_the_core_hover_certificate() {
         }
     }
 }
+
+/// The command's arguments: a torque as `x,y,z`, refused with its name when not three values;
+/// an unknown team or an out-of-range setting names the argument.
+#[test]
+fn command_arguments_parse_and_fail_by_name() {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Wrap {
+        #[command(flatten)]
+        args: cli::AfsArgs,
+    }
+    let w = Wrap::try_parse_from(["afs", "a4-inc", "--torque", "0,-0.1,0.5"]).unwrap();
+    assert_eq!(w.args.torque, vec![0.0, -0.1, 0.5]);
+    assert_eq!(w.args.heights, vec![0.5, 1.0, 1.5]);
+    let mut two = Wrap::try_parse_from(["afs", "a4-inc", "--torque", "0,1"])
+        .unwrap()
+        .args;
+    let e = cli::run(&two).unwrap_err().to_string();
+    assert!(e.contains("`torque`") && e.contains("three"), "{e}");
+    two.torque = vec![0.0; 3];
+    two.team = "a42".into();
+    let e = cli::run(&two).unwrap_err().to_string();
+    assert!(
+        e.contains("invalid argument `team`") && e.contains("a10-inc"),
+        "{e}"
+    );
+    two.team = "a4-inc".into();
+    two.directions = 2;
+    let e = cli::run(&two).unwrap_err().to_string();
+    assert!(e.contains("invalid argument `directions`"), "{e}");
+}
