@@ -142,18 +142,19 @@ pub fn fly(
     let finished = mcap.as_mut().map_or(Ok(()), McapLog::finish);
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
-        (Err(e), _) | (Ok(_), Err(e)) => (result_of(&sim), Some(e)),
+        (Err(e), _) | (Ok(_), Err(e)) => (result_of(&mut sim), Some(e)),
     };
     result.summary.controller_target = controller.target_label();
     result.summary.error = error.as_ref().map(ToString::to_string);
     Ok(Flight { result, error })
 }
 
-/// What `sim` has simulated so far.
-fn result_of(sim: &Simulation) -> RunResult {
+/// What `sim` has simulated so far, its samples moved out (not copied).
+fn result_of(sim: &mut Simulation) -> RunResult {
+    let summary = sim.summary();
     RunResult {
-        samples: sim.samples().to_vec(),
-        summary: sim.summary(),
+        samples: sim.take_samples(),
+        summary,
     }
 }
 

@@ -92,7 +92,8 @@ pub fn certified_relaxation(
     let heights: Vec<f64> = (0..k)
         .map(|i| top * (range.from + (range.to - range.from) * i as f64 / (k - 1) as f64))
         .collect();
-    let mut lower = (1.0, (f64::NAN, f64::NAN));
+    // The smallest per-point s and where it is (the first such point).
+    let mut lower = (f64::INFINITY, (f64::NAN, f64::NAN));
     let mut upper = 1.0_f64;
     let mut sections = Vec::with_capacity(k);
     for &height in &heights {
@@ -113,8 +114,8 @@ pub fn certified_relaxation(
                 .lower
                 .map_or(0.0, |r| r + CERTIFY_TOLERANCE * model.scale());
             let s_in = largest_relaxation_within(model, height, p.angle, inner);
-            if s_in < lower.0 || lower.1 .0.is_nan() {
-                lower = (s_in.min(lower.0), (height, p.angle));
+            if s_in < lower.0 {
+                lower = (s_in, (height, p.angle));
             }
             upper = upper.min(largest_relaxation_within(
                 model,
@@ -125,6 +126,7 @@ pub fn certified_relaxation(
         }
         sections.push(section);
     }
+    let lower = (lower.0.min(1.0), lower.1);
     Some(CertifiedRelaxation {
         lower: lower.0,
         upper: upper.max(lower.0),

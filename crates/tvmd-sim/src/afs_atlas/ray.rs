@@ -51,11 +51,6 @@ impl Bracket {
     pub fn width(&self) -> f64 {
         self.lower.map_or(f64::INFINITY, |l| self.upper - l)
     }
-
-    /// The midpoint, or `None` without a lower bound.
-    pub fn mid(&self) -> Option<f64> {
-        self.lower.map(|l| 0.5 * (l + self.upper.max(l)))
-    }
 }
 
 /// A ray's bracket with its certificates.

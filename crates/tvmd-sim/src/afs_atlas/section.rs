@@ -40,11 +40,6 @@ pub struct CrossSection {
 }
 
 impl CrossSection {
-    /// Whether the section's centre (no lateral force) was attained.
-    pub fn attained(&self) -> bool {
-        self.points.iter().all(|p| p.radius.lower.is_some())
-    }
-
     /// The widest bracket relative to its upper bound (`inf` when a direction was not attained).
     pub fn worst_relative_width(&self) -> f64 {
         self.points

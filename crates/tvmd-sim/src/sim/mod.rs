@@ -183,6 +183,12 @@ impl Simulation {
         &self.samples
     }
 
+    /// Moves the samples recorded so far out (the simulation keeps none), e.g. to report a
+    /// failed run without copying them.
+    pub fn take_samples(&mut self) -> Vec<Sample> {
+        std::mem::take(&mut self.samples)
+    }
+
     fn noisy(&mut self, s: &PlantState) -> PlantState {
         let Some((n, rng)) = self.noise.as_mut() else {
             return *s;
