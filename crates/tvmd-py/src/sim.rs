@@ -15,7 +15,7 @@ use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::scenario::{NullSpaceConfig, Overrides, Precision, Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
+use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample, SampleRetention};
 use tvmd_sim::SimError;
 
 use crate::convert::{scalars, shape_error, shaped};
@@ -34,6 +34,7 @@ const RUN_KEYS: &[&str] = &[
     "precision",
     "pil",
     "null_space",
+    "max_samples",
 ];
 
 /// What was done with the file an I/O error names.
@@ -114,6 +115,18 @@ struct RunArgs<'a, 'py> {
     null_space: Option<String>,
     precision: Option<String>,
     pil: Option<String>,
+    max_samples: Option<i64>,
+}
+
+/// A `max_samples` argument: `None` keeps every tick, `n >= 0` at most `n` evenly spaced.
+fn retention_arg(max_samples: Option<i64>) -> PyResult<SampleRetention> {
+    let Some(n) = max_samples else {
+        return Ok(SampleRetention::All);
+    };
+    let n = usize::try_from(n).map_err(|_| {
+        PyValueError::new_err(format!("`max_samples` must be >= 0 or None, got {n}"))
+    })?;
+    Ok(SampleRetention::AtMost(n))
 }
 
 /// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
@@ -154,7 +167,11 @@ impl RunArgs<'_, '_> {
             null_space: null_space_arg(self.null_space.as_deref())?,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
-        RunSpec::on_target(scenario, self.mcap, pil, precision).map_err(value_error)
+        let samples = retention_arg(self.max_samples)?;
+        let spec = RunSpec::on_target(scenario, self.mcap, pil, precision);
+        let mut spec = spec.map_err(value_error)?;
+        spec.samples = samples;
+        Ok(spec)
     }
 }
 
@@ -211,6 +228,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         null_space: opt(dict, &name, "null_space")?,
         precision: opt(dict, &name, "precision")?,
         pil: opt(dict, &name, "pil")?,
+        max_samples: opt(dict, &name, "max_samples")?,
     }
     .spec(&format!("{name}['scenario']"))
 }
@@ -295,7 +313,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -307,6 +325,7 @@ fn run(
     precision: Option<String>,
     pil: Option<String>,
     null_space: Option<String>,
+    max_samples: Option<i64>,
 ) -> PyResult<PySimResult> {
     let spec = RunArgs {
         scenario,
@@ -317,6 +336,7 @@ fn run(
         null_space,
         precision,
         pil,
+        max_samples,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?
@@ -350,7 +370,7 @@ fn run_many(
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
 #[pyfunction]
-#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None, pil = None))]
+#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None, pil = None, max_samples = None))]
 #[allow(clippy::too_many_arguments)]
 fn relaxation_sweep(
     py: Python<'_>,
@@ -362,6 +382,7 @@ fn relaxation_sweep(
     mcap_dir: Option<PathBuf>,
     jobs: Option<i64>,
     pil: Option<String>,
+    max_samples: Option<i64>,
 ) -> PyResult<Vec<PySimResult>> {
     let values = match relaxations.filter(|r| !r.is_none()) {
         Some(r) => match scalars(r, "relaxations")? {
@@ -376,6 +397,7 @@ fn relaxation_sweep(
         allocator,
         precision,
         pil,
+        max_samples,
         ..RunArgs::default()
     };
     let base = args.spec("scenario")?;
@@ -383,6 +405,7 @@ fn relaxation_sweep(
         sweep_specs(&base.scenario, &values, mcap_dir.as_deref()).map_err(value_error)?;
     for spec in &mut specs {
         spec.pil = base.pil;
+        spec.samples = base.samples;
     }
     run_specs(py, specs, jobs, |_, s| {
         format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
@@ -394,6 +417,7 @@ pub(crate) struct SimData {
     scenario: Scenario,
     mcap: Option<PathBuf>,
     samples: Vec<Sample>,
+    sample_stride: usize,
     summary: RunSummary,
     paper: PaperMetrics,
     hover_roll_limit: Option<f64>,
@@ -408,11 +432,12 @@ impl SimData {
         let n = result.samples.first().map(|s| s.commands.len());
         Self {
             mass: team.as_ref().map(|t| t.mass()),
-            paper: PaperMetrics::new(&scenario, &result.samples),
+            paper: result.paper,
             hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
             n: n.or_else(|| team.as_ref().map(|t| t.len())).unwrap_or(0),
             mcap: spec.log,
             samples: result.samples,
+            sample_stride: result.sample_stride,
             summary: result.summary,
             scenario,
         }
@@ -509,6 +534,8 @@ record! {
         gravity => o.scenario.physics.gravity,
         /// `atan(c_y(1, s))` (rad), the planned roll at which the planner saturates in hover.
         hover_roll_limit => o.hover_roll_limit,
+        /// Controller ticks between the kept samples (1: every tick; see `max_samples`).
+        sample_stride => o.sample_stride,
         /// (K,) time (s).
         t => o.scalar(py, |x| Some(x.t))?,
         /// (K, 3) `x` (m).

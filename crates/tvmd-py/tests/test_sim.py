@@ -295,6 +295,31 @@ def test_run_many_items_and_order(tmp_path):
     assert sim.relaxation_sweep([]) == []
 
 
+def test_max_samples_bounds_memory_not_the_summary():
+    full = sim.run(toml=SHORT)
+    kept = sim.run(toml=SHORT, max_samples=7)
+    none = sim.run(toml=SHORT, max_samples=0)
+    assert full.sample_stride == 1 and len(full) == 100
+    stride = kept.sample_stride
+    assert len(kept) <= 7 and stride > 1 and stride & (stride - 1) == 0
+    np.testing.assert_array_equal(kept.t, full.t[::stride][: len(kept)])
+    np.testing.assert_array_equal(kept.position, full.position[::stride][: len(kept)])
+    assert len(none) == 0
+    timing = {"wall_time", "real_time_factor"}
+    for other in (kept, none):
+        for key, value in full.summary.items():
+            if key not in timing:
+                assert other.summary[key] == value, key
+    many = sim.run_many([{"toml": SHORT, "max_samples": 7}, {"toml": SHORT}])
+    assert len(many[0]) == len(kept) and len(many[1]) == 100
+    swept = sim.relaxation_sweep([0.5], toml=SHORT, max_samples=0)
+    assert len(swept[0]) == 0 and swept[0].summary["controller_calls"] == 100
+    with pytest.raises(ValueError, match="max_samples"):
+        sim.run(toml=SHORT, max_samples=-1)
+    with pytest.raises(ValueError, match="max_samples"):
+        sim.run_many([{"toml": SHORT, "max_samples": -3}])
+
+
 def test_runs_release_the_gil():
     """A run does not hold the GIL: the main thread keeps running during it."""
     started = threading.Event()

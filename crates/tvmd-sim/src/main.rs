@@ -40,7 +40,7 @@ use tvmd_sim::runner::{
     check_batch_outputs, fly, record_cycles, run_many_until, sweep_specs, Flight, RunSpec,
 };
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
-use tvmd_sim::sim::{PaperMetrics, RunSummary};
+use tvmd_sim::sim::{PaperMetrics, RunSummary, SampleRetention};
 use tvmd_sim::SimError;
 
 /// Simulator of thrust-vectoring modular team UAVs with the tvmd controller in the loop.
@@ -444,8 +444,8 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         precision,
         null_space: a.null_space,
     })?;
-    let scenario = RunSpec::on_target(scenario, None, pil, precision)?.scenario;
-    let stem = file_stem(&scenario.name);
+    let mut spec = RunSpec::on_target(scenario, None, pil, precision)?;
+    let stem = file_stem(&spec.scenario.name);
     let log = if a.no_log {
         None
     } else {
@@ -476,16 +476,15 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     if let Some(dir) = &a.plots {
         std::fs::create_dir_all(dir).map_err(SimError::file("create the figure directory", dir))?;
     }
+    // Memory stays flat: the summary folds every tick, the log streams it, and only the
+    // figures need samples (a bounded, evenly spaced set).
+    spec.log.clone_from(&log);
+    spec.samples = plot_retention(a.plots.is_some());
+    let scenario = &spec.scenario;
     catch_interrupts();
-    let bar = progress_bar(ticks_of(&scenario), &scenario.name);
+    let bar = progress_bar(ticks_of(scenario), &scenario.name);
     let mut tick = |_t: f64| bar.inc(1);
-    let flight = fly(
-        &scenario,
-        pil,
-        log.as_deref(),
-        Some(&mut tick),
-        Some(&INTERRUPT),
-    );
+    let flight = fly(&spec, Some(&mut tick), Some(&INTERRUPT));
     bar.finish_and_clear();
     let Flight { result, error } = flight?;
     let report = RunReport {
@@ -495,9 +494,9 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         null_space: scenario.null_space.map(|n| n.to_string()),
         controller_precision: scenario.controller_precision,
         controller_target: &result.summary.controller_target,
-        hover_roll_limit: hover_roll_limit(&scenario, scenario.relaxation).ok(),
+        hover_roll_limit: hover_roll_limit(scenario, scenario.relaxation).ok(),
         summary: &result.summary,
-        paper: PaperMetrics::new(&scenario, &result.samples),
+        paper: result.paper.clone(),
         log: log.as_ref().map(|p| p.display().to_string()),
     };
     print_run(&report);
@@ -524,8 +523,28 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         for p in plot::write_run_figures(&series, dir, &stem)? {
             println!("figure:   {}", p.display());
         }
+        print_stride(result.sample_stride);
     }
     Ok(())
+}
+
+/// The samples a command-line run keeps: a bounded set for figures, else none.
+fn plot_retention(plots: bool) -> SampleRetention {
+    if plots {
+        SampleRetention::AtMost(plot::PLOT_SAMPLES)
+    } else {
+        SampleRetention::None
+    }
+}
+
+/// Says when the figures show every `stride`-th controller tick only.
+fn print_stride(stride: usize) {
+    if stride > 1 {
+        println!(
+            "figures:  every {stride}th controller tick (at most {} samples per run)",
+            plot::PLOT_SAMPLES
+        );
+    }
 }
 
 fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> {
@@ -674,7 +693,10 @@ fn cmd_sweep(
     jobs: Option<usize>,
 ) -> Result<(), CliError> {
     let base = Scenario::load(scenario_arg)?.with_overrides(&overrides)?;
-    let specs = sweep_specs(&base, relaxations, logs.as_deref())?;
+    let mut specs = sweep_specs(&base, relaxations, logs.as_deref())?;
+    for spec in &mut specs {
+        spec.samples = plot_retention(plots.is_some());
+    }
     if specs.is_empty() {
         return Err(CliError::Other("no relaxation given".into()));
     }
@@ -698,13 +720,14 @@ fn cmd_sweep(
     }
     let mut rows = Vec::new();
     let mut series = Vec::new();
+    let mut stride = 1;
     for outcome in outcomes {
         let sc = &outcome.spec.scenario;
         let r = outcome
             .result
             .map_err(|e| CliError::Other(format!("run {}: {e}", sc.name)))?;
         let s = &r.summary;
-        let paper = PaperMetrics::new(sc, &r.samples);
+        let paper = &r.paper;
         rows.push(SweepRow {
             relaxation: sc.relaxation,
             controller_precision: sc.controller_precision,
@@ -725,6 +748,7 @@ fn cmd_sweep(
             Some(sc.relaxation),
             &r.samples,
         ));
+        stride = stride.max(r.sample_stride);
     }
     println!(
         "controller precision: {}, allocator: {}",
@@ -772,6 +796,7 @@ fn cmd_sweep(
         let path = dir.join("relaxation.png");
         plot::relaxation_study(&series, &path)?;
         println!("figure:   {}", path.display());
+        print_stride(stride);
     }
     if let Some(dir) = &logs {
         println!("logs:     {}", dir.display());

@@ -27,6 +27,10 @@ use crate::log::METADATA_SCENARIO;
 use crate::sim::Sample;
 use crate::SimError;
 
+/// The most samples a run's figures are drawn from: a run keeps this many evenly spaced
+/// controller ticks for its figures (a 1500 px wide figure shows no more), whatever its length.
+pub const PLOT_SAMPLES: usize = 20_000;
+
 /// The embedded font (a renamed subset of DejaVu Sans).
 const FONT: &[u8] = include_bytes!("../assets/TvmdPlotSans.ttf");
 

@@ -18,7 +18,7 @@ use crate::log::{McapLog, METADATA_SCENARIO};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
 use crate::scenario::{Precision, Scenario};
-use crate::sim::{RunResult, SimOptions, Simulation};
+use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
 use crate::SimError;
 
 /// A controller that reports the time of every call to a callback (for progress bars).
@@ -96,7 +96,13 @@ pub fn run_scenario_until(
     progress: Option<&mut dyn FnMut(f64)>,
     cancel: Option<&AtomicBool>,
 ) -> Result<RunResult, SimError> {
-    let flight = fly(scenario, target, log, progress, cancel)?;
+    let spec = RunSpec {
+        scenario: scenario.clone(),
+        log: log.map(Path::to_path_buf),
+        pil: target,
+        samples: SampleRetention::All,
+    };
+    let flight = fly(&spec, progress, cancel)?;
     match flight.error {
         Some(error) => Err(error),
         None => Ok(flight.result),
@@ -112,18 +118,22 @@ pub struct Flight {
     pub error: Option<SimError>,
 }
 
-/// [`run_scenario_until`] that keeps a failed flight's partial result: `Err` only when the
+/// Flies `spec` (its scenario, log, target and sample retention) like
+/// [`run_scenario_until`], keeping a failed flight's partial result: `Err` only when the
 /// flight could not start (scenario, controller or log creation).
 pub fn fly(
-    scenario: &Scenario,
-    target: Option<PilTarget>,
-    log: Option<&Path>,
+    spec: &RunSpec,
     progress: Option<&mut dyn FnMut(f64)>,
     cancel: Option<&AtomicBool>,
 ) -> Result<Flight, SimError> {
-    let mut controller = AnyTvmdController::from_scenario_on(scenario, target)?;
-    let mut sim = Simulation::with_options(scenario, SimOptions::default())?;
-    let mut mcap = match log {
+    let scenario = &spec.scenario;
+    let mut controller = AnyTvmdController::from_scenario_on(scenario, spec.pil)?;
+    let options = SimOptions {
+        samples: spec.samples,
+        ..SimOptions::default()
+    };
+    let mut sim = Simulation::with_options(scenario, options)?;
+    let mut mcap = match spec.log.as_deref() {
         Some(path) => {
             let mut l = McapLog::create(path)?;
             write_scenario_metadata(&mut l, scenario)?;
@@ -142,20 +152,11 @@ pub fn fly(
     let finished = mcap.as_mut().map_or(Ok(()), McapLog::finish);
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
-        (Err(e), _) | (Ok(_), Err(e)) => (result_of(&mut sim), Some(e)),
+        (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),
     };
     result.summary.controller_target = controller.target_label();
     result.summary.error = error.as_ref().map(ToString::to_string);
     Ok(Flight { result, error })
-}
-
-/// What `sim` has simulated so far, its samples moved out (not copied).
-fn result_of(sim: &mut Simulation) -> RunResult {
-    let summary = sim.summary();
-    RunResult {
-        samples: sim.take_samples(),
-        summary,
-    }
 }
 
 /// One run of a batch: a validated scenario and the MCAP log to write, if any.
@@ -168,6 +169,8 @@ pub struct RunSpec {
     /// The emulated target the controller runs on (processor in the loop), or `None` for the
     /// host.
     pub pil: Option<PilTarget>,
+    /// Which samples the result keeps (the summary covers every tick either way).
+    pub samples: SampleRetention,
 }
 
 impl RunSpec {
@@ -201,7 +204,12 @@ impl RunSpec {
             }
             scenario.controller_precision = Precision::F32;
         }
-        Ok(Self { scenario, log, pil })
+        Ok(Self {
+            scenario,
+            log,
+            pil,
+            samples: SampleRetention::All,
+        })
     }
 }
 
@@ -238,18 +246,15 @@ fn run_guarded(
     progress: Option<Progress<'_>>,
     cancel: Option<&AtomicBool>,
 ) -> Result<RunResult, SimError> {
-    let log = spec.log.as_deref();
-    catch_unwind(AssertUnwindSafe(|| match progress {
-        Some(p) => run_scenario_until(
-            &spec.scenario,
-            spec.pil,
-            log,
-            Some(&mut |t| p(k, t)),
-            cancel,
-        ),
-        None => run_scenario_until(&spec.scenario, spec.pil, log, None, cancel),
-    }))
-    .unwrap_or_else(|p| Err(SimError::Internal(panic_message(p.as_ref()))))
+    let flown = catch_unwind(AssertUnwindSafe(|| match progress {
+        Some(p) => fly(spec, Some(&mut |t| p(k, t)), cancel),
+        None => fly(spec, None, cancel),
+    }));
+    match flown {
+        Ok(Ok(Flight { error: Some(e), .. })) | Ok(Err(e)) => Err(e),
+        Ok(Ok(Flight { result, .. })) => Ok(result),
+        Err(p) => Err(SimError::Internal(panic_message(p.as_ref()))),
+    }
 }
 
 /// Runs every spec with [`run_scenario`] on [`worker_count`]`(jobs, len)` threads (the calling
@@ -310,6 +315,7 @@ pub fn sweep_specs(
                 scenario,
                 log,
                 pil: None,
+                samples: SampleRetention::All,
             })
         })
         .collect()
@@ -404,6 +410,7 @@ mod tests {
                 scenario: short(n, s),
                 log: None,
                 pil: None,
+                samples: SampleRetention::All,
             })
             .collect();
         let ticks = AtomicUsize::new(0);

@@ -44,7 +44,8 @@ class SimResult:
     copy, so bind it to a name before indexing in a loop).
 
     ``K`` samples, one per controller tick (``t_k = k controller_period``, true state before the
-    tick's commands act); ``n`` agents. SI units, z up, angles in rad. Values a controller did
+    tick's commands act), or one per ``sample_stride`` ticks when ``run(max_samples=...)`` bounds
+    them (``summary`` and ``paper_metrics`` cover every tick either way); ``n`` agents. SI units, z up, angles in rad. Values a controller did
     not report at a tick (a skipped cycle) are NaN.
 
     Attributes:
@@ -109,6 +110,10 @@ class SimResult:
         """``atan(c_y(1, s))`` (rad): the planned roll at which the planner saturates in hover for
         this team, limits and ``s``.
         """
+    @property
+    def sample_stride(self) -> int:
+        """Controller ticks between the kept samples: 1 keeps every tick; ``k`` keeps ticks
+        0, k, 2k, ... (a power of two, from ``max_samples``)."""
     @property
     def t(self) -> _F64:
         """(K,) time (s)."""
@@ -205,6 +210,7 @@ def run(
     precision: Optional[_Precision] = None,
     pil: Optional[_PilTarget] = None,
     null_space: Optional[str] = None,
+    max_samples: Optional[int] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -237,12 +243,18 @@ def run(
             ``"margin"`` or ``"inward-tilt=<rad>"`` (docs/method.md "Null-space stage"; the
             wrench is unchanged to round-off). The summary's ``null_space`` gives its margins
             before and after; not with ``pil``.
+        max_samples: keep at most this many samples, evenly spaced (every ``sample_stride``-th
+            tick, the smallest power of two that fits; ``0`` keeps none), so a long run's memory
+            stays flat; ``summary`` and ``paper_metrics`` still cover every tick. Default None:
+            every tick, which a run longer than 2,000,000 controller ticks (about 2 GB) refuses
+            with a ``ValueError`` naming ``duration``.
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
             message names the field, e.g. ``physics.dt``), a bad override, both ``scenario`` and
             ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``, an unknown
-            ``null_space`` objective or a bad tilt (``null_space.tilt``), ``null_space`` with ``pil``.
+            ``null_space`` objective or a bad tilt (``null_space.tilt``), ``null_space`` with ``pil``,
+            ``max_samples < 0``, a run that would keep more than 2,000,000 samples.
         TypeError: an argument of the wrong type.
         OSError: the scenario file cannot be read (also: not a regular file, over 1 MiB) or the
             log cannot be written; the message names the path.
@@ -261,7 +273,7 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
             ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
             ``{"scenario": "a4-con", "relaxation": 1.0}``, ``{"toml": text, "mcap": "x.mcap"}`` or
             ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` and ``"null_space"``
-            too, as ``run``).
+            too, as ``run``; ``"max_samples"`` bounds that run's samples).
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
 
     Every item is loaded and validated before any run starts. If runs fail, the first failure
@@ -282,6 +294,7 @@ def relaxation_sweep(
     mcap_dir: Optional[_PathArg] = None,
     jobs: Optional[int] = None,
     pil: Optional[_PilTarget] = None,
+    max_samples: Optional[int] = None,
 ) -> list[SimResult]:
     """The paper's relaxation study: one scenario flown once per relaxation ``s`` (in parallel
     threads, GIL released), results in the order of ``relaxations``. The planner's roll limit in
@@ -298,6 +311,7 @@ def relaxation_sweep(
         mcap_dir: write one MCAP log per run there, ``<name>-s<s>.mcap``.
         jobs: worker threads (default: the available cores).
         pil: fly every run with the controller on this emulated target, as ``run``.
+        max_samples: bound every run's samples, as ``run``.
 
     Raises:
         ValueError: as ``run``; an ``s`` outside (0, 1] or not finite, ``relaxations`` not 1-D,

@@ -9,7 +9,6 @@ use tvmd_core::{AdmissibleSet, AllocationRequest, Allocator, AnyAllocator, Gimba
 use super::{failure_mask, team, team_size, AllocationSet, SetRequest, TeamRequests};
 use crate::runner::run_scenario;
 use crate::scenario::{Overrides, Scenario};
-use crate::sim::PaperMetrics;
 use crate::SimError;
 
 /// A request is allocated exactly when `e_f / ||u_fd|| <=` this (issue 16).
@@ -284,7 +283,6 @@ pub fn closed_loop_rows(names: &[&str]) -> Result<Vec<ClosedLoopRow>, SimError> 
                 ..Overrides::default()
             })?;
             let result = run_scenario(&scenario, None, None)?;
-            let paper = PaperMetrics::new(&scenario, &result.samples);
             let s = result.summary;
             Ok(ClosedLoopRow {
                 allocator: (*name).to_string(),
@@ -292,7 +290,7 @@ pub fn closed_loop_rows(names: &[&str]) -> Result<Vec<ClosedLoopRow>, SimError> 
                 max_e_f_over_weight: s.max_e_f_over_weight,
                 max_position_error: s.max_position_error,
                 max_position_error_after_4s: s.max_position_error_after_4s,
-                max_position_error_6_to_12s: paper.max_position_error_6_to_12s,
+                max_position_error_6_to_12s: result.paper.max_position_error_6_to_12s,
                 horizontal_error_at_12s: s.horizontal_error_at_12s,
                 final_position_error: s.final_position_error,
                 saturated_periods: s.saturated_periods,

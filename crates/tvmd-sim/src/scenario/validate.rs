@@ -16,9 +16,6 @@ pub(super) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Si
 
 /// Longest scenario (s): 1e6 s, about 11.6 days of flight.
 pub const MAX_DURATION: f64 = 1e6;
-/// Most controller ticks of one run: every sample is kept in memory (about 1 KB each), so a
-/// run is bounded to about 2 GB.
-pub const MAX_TICKS: f64 = 2e6;
 /// Most physics steps of one run (about 20 minutes of rapier on the development machine).
 pub const MAX_PHYSICS_STEPS: f64 = 1e9;
 /// Physics step range (s): `[1e-6, 0.01]`.
@@ -99,16 +96,6 @@ impl Scenario {
                     "{} s is shorter than one controller period ({} s): the run would record \
                      no sample",
                     self.duration, self.controller_period
-                ),
-            ));
-        }
-        let ticks = self.duration / self.controller_period;
-        if ticks > MAX_TICKS {
-            return Err(invalid(
-                "duration",
-                format!(
-                    "{ticks:.3e} controller ticks exceed the {MAX_TICKS:e} a run may keep in \
-                     memory; shorten the run or lengthen controller_period"
                 ),
             ));
         }

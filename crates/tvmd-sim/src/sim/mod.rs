@@ -14,11 +14,13 @@
 //!
 //! Then `steps_per_control` physics steps follow, each one: failures whose time has come are
 //! applied, the actuators move towards the held commands, and the agents' body-frame forces
-//! (plus wind and external wrench) are applied for one step. The summary of a run is computed
-//! from its samples ([`summary`]); two flights of one scenario are compared sample by sample
-//! with [`difference`].
+//! (plus wind and external wrench) are applied for one step. The summary of a run is folded
+//! over every tick's sample ([`summary`]); the run keeps all, a bounded subset or none of the
+//! samples ([`retention`]), so memory can stay flat however long the run. Two flights of one
+//! scenario are compared sample by sample with [`difference`].
 
 pub mod difference;
+pub mod retention;
 pub mod sample;
 pub mod summary;
 pub mod tick_log;
@@ -39,8 +41,9 @@ use crate::scenario::{Failure, Scenario, StateNoise};
 use crate::SimError;
 
 pub use difference::FlightDifference;
+pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
-pub use summary::{NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, VxRise};
+pub use summary::{NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, SummaryFold, VxRise};
 
 /// The valid range of the physics: beyond it a run ends with [`SimError::Diverged`] rather than
 /// run on in a state rapier clamps (its default caps speeds) or cannot represent. A team of the
@@ -76,13 +79,18 @@ fn check_divergence(t: f64, s: &PlantState) -> Result<(), SimError> {
     what.map_or(Ok(()), |what| Err(SimError::Diverged { t, what }))
 }
 
-/// Result of a run: the samples and a summary.
+/// Result of a run: the kept samples, the summary and the paper's metrics (both of every
+/// tick, whichever samples were kept).
 #[derive(Clone, Debug, Serialize)]
 pub struct RunResult {
-    /// Samples at the controller rate.
+    /// The samples kept ([`SimOptions::samples`]): every `sample_stride`-th controller tick.
     pub samples: Vec<Sample>,
+    /// Controller ticks between kept samples (1: every tick).
+    pub sample_stride: usize,
     /// Summary.
     pub summary: RunSummary,
+    /// The paper's reproduction metrics.
+    pub paper: PaperMetrics,
 }
 
 /// Options that are not part of the scenario.
@@ -90,11 +98,16 @@ pub struct RunResult {
 pub struct SimOptions {
     /// Period of `/scene` messages (s); rounded to a multiple of the controller period.
     pub scene_period: f64,
+    /// Which samples the result keeps (default: all).
+    pub samples: SampleRetention,
 }
 
 impl Default for SimOptions {
     fn default() -> Self {
-        Self { scene_period: 0.05 }
+        Self {
+            scene_period: 0.05,
+            samples: SampleRetention::All,
+        }
     }
 }
 
@@ -113,7 +126,8 @@ pub struct Simulation {
     noise: Option<(StateNoise, ChaCha8Rng)>,
     max_thrust: f64,
     options: SimOptions,
-    samples: Vec<Sample>,
+    samples: SampleStore,
+    fold: SummaryFold,
     step_index: usize,
     controller_calls: usize,
     wall_time: f64,
@@ -138,6 +152,9 @@ impl Simulation {
         failures.sort_by(|a, b| a.time.total_cmp(&b.time));
         let steps_per_control = scenario.steps_per_control()?;
         let total_steps = (scenario.duration / scenario.physics.dt).round() as usize;
+        options
+            .samples
+            .check(total_steps.div_ceil(steps_per_control))?;
         Ok(Self {
             actuators: ActuatorBank::new(scenario.actuators, n),
             applied: vec![false; failures.len()],
@@ -155,7 +172,8 @@ impl Simulation {
             steps_per_control,
             total_steps,
             options,
-            samples: Vec::new(),
+            samples: SampleStore::new(options.samples),
+            fold: SummaryFold::new(scenario),
             step_index: 0,
             controller_calls: 0,
             wall_time: 0.0,
@@ -178,15 +196,26 @@ impl Simulation {
         &self.scenario
     }
 
-    /// Samples recorded so far (also available after a failed run).
+    /// Samples kept so far (also available after a failed run).
     pub fn samples(&self) -> &[Sample] {
-        &self.samples
+        self.samples.samples()
     }
 
-    /// Moves the samples recorded so far out (the simulation keeps none), e.g. to report a
+    /// Moves the samples kept so far out (the simulation keeps none), e.g. to report a
     /// failed run without copying them.
     pub fn take_samples(&mut self) -> Vec<Sample> {
-        std::mem::take(&mut self.samples)
+        self.samples.take()
+    }
+
+    /// What has been simulated so far: the kept samples (moved out), the summary and the
+    /// paper's metrics.
+    pub fn take_result(&mut self) -> RunResult {
+        RunResult {
+            summary: self.summary(),
+            paper: self.paper_metrics(),
+            sample_stride: self.samples.stride(),
+            samples: self.take_samples(),
+        }
     }
 
     fn noisy(&mut self, s: &PlantState) -> PlantState {
@@ -271,10 +300,7 @@ impl Simulation {
         let result = self.run_loop(controller, log, cancel);
         self.wall_time += start.elapsed().as_secs_f64();
         result?;
-        Ok(RunResult {
-            samples: self.samples.clone(),
-            summary: self.summary(),
-        })
+        Ok(self.take_result())
     }
 
     fn run_loop(
@@ -323,14 +349,16 @@ impl Simulation {
                 let tick = self.controller_calls;
                 self.controller_calls += 1;
                 let actual = self.actuators.actual();
-                self.samples.push(Sample::record(
+                let sample = Sample::record(
                     t,
                     &truth,
                     &reference,
                     &out,
                     actual.clone(),
                     self.failed_true.clone(),
-                ));
+                );
+                self.fold.push(&sample);
+                self.samples.push(tick, || sample);
                 if let Some(log) = log.as_deref_mut() {
                     let tick_log = tick_log::Tick {
                         t,
@@ -365,7 +393,12 @@ impl Simulation {
         Ok(())
     }
 
-    /// Summary of the run so far (final state from the physics, extremes from the samples).
+    /// The paper's metrics of the run so far (every tick, kept or not).
+    pub fn paper_metrics(&self) -> PaperMetrics {
+        self.fold.paper()
+    }
+
+    /// Summary of the run so far (final state from the physics, extremes over every tick).
     pub fn summary(&self) -> RunSummary {
         let totals = RunTotals {
             time: self.world.time(),
@@ -376,6 +409,6 @@ impl Simulation {
             wall_time: self.wall_time,
             interrupted: self.interrupted,
         };
-        RunSummary::new(&self.scenario, &self.samples, &totals)
+        self.fold.summary(&self.scenario, &totals)
     }
 }
