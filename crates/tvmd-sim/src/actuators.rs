@@ -219,21 +219,23 @@ impl ActuatorBank {
     }
 
     /// Advances all agents by `dt`; `commands.len()` must equal the number of agents
-    /// (extra commands are ignored, missing ones count as zero).
-    pub fn step(&mut self, commands: &[ActuatorCommand], dt: f64) -> Vec<ActuatorCommand> {
-        self.agents
-            .iter_mut()
-            .enumerate()
-            .map(|(i, a)| {
-                let c = commands.get(i).copied().unwrap_or_default();
-                a.step(&c, &self.model, dt)
-            })
-            .collect()
+    /// (extra commands are ignored, missing ones count as zero). Read the outputs with
+    /// [`ActuatorBank::outputs`]; nothing is allocated, as this runs every physics step.
+    pub fn step(&mut self, commands: &[ActuatorCommand], dt: f64) {
+        for (i, a) in self.agents.iter_mut().enumerate() {
+            let c = commands.get(i).copied().unwrap_or_default();
+            a.step(&c, &self.model, dt);
+        }
     }
 
-    /// Actual outputs of all agents.
+    /// Actual outputs of the agents, in agent order.
+    pub fn outputs(&self) -> impl Iterator<Item = &ActuatorCommand> + '_ {
+        self.agents.iter().map(|a| &a.actual)
+    }
+
+    /// Actual outputs of all agents, collected.
     pub fn actual(&self) -> Vec<ActuatorCommand> {
-        self.agents.iter().map(|a| a.actual).collect()
+        self.outputs().copied().collect()
     }
 
     /// Applies a failure to agent `i` (ignored if out of range).
@@ -335,7 +337,7 @@ mod tests {
         bank.step(&cmd, 1e-3);
         bank.fail(0, FailureKind::NoThrust);
         bank.fail(1, FailureKind::StuckGimbal);
-        let out = bank.step(
+        bank.step(
             &[ActuatorCommand {
                 eta_x: -0.3,
                 eta_y: 0.0,
@@ -343,6 +345,7 @@ mod tests {
             }; 2],
             1e-3,
         );
+        let out = bank.actual();
         assert_eq!(
             out[0],
             ActuatorCommand {

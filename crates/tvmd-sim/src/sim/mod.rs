@@ -54,6 +54,21 @@ pub const MAX_SPEED: f64 = 300.0;
 /// Largest body rate (rad/s).
 pub const MAX_BODY_RATE: f64 = 200.0;
 
+/// The agents' body-frame forces for their actuator outputs, written over `out`.
+fn body_forces<'a>(
+    outputs: impl IntoIterator<Item = &'a ActuatorCommand>,
+    team: &TeamBody,
+    out: &mut Vec<Vector3<f64>>,
+) {
+    out.clear();
+    out.extend(
+        outputs
+            .into_iter()
+            .zip(&team.agents)
+            .map(|(c, a)| agent_force_body(c, a.quarter_turns)),
+    );
+}
+
 /// `Err(Diverged)` when the state at `t` is not finite or outside the valid range.
 fn check_divergence(t: f64, s: &PlantState) -> Result<(), SimError> {
     let what = if !s.is_finite() {
@@ -268,11 +283,9 @@ impl Simulation {
     }
 
     fn forces(&self, actual: &[ActuatorCommand]) -> Vec<Vector3<f64>> {
-        actual
-            .iter()
-            .zip(&self.team.agents)
-            .map(|(c, a)| agent_force_body(c, a.quarter_turns))
-            .collect()
+        let mut out = Vec::with_capacity(actual.len());
+        body_forces(actual, &self.team, &mut out);
+        out
     }
 
     /// Runs the scenario to its end with `controller`, logging to `log` if given.
@@ -313,6 +326,8 @@ impl Simulation {
         let period = self.scenario.controller_period;
         let scene_every = ((self.options.scene_period / period).round() as usize).max(1);
         let mut held = vec![ActuatorCommand::default(); self.team.len()];
+        // Reused every physics step: the step allocates nothing of its own.
+        let mut forces = Vec::with_capacity(self.team.len());
         while self.step_index < self.total_steps {
             let k = self.step_index;
             let t = k as f64 * dt;
@@ -384,8 +399,8 @@ impl Simulation {
                     }
                 }
             }
-            let actual = self.actuators.step(&held, dt);
-            let forces = self.forces(&actual);
+            self.actuators.step(&held, dt);
+            body_forces(self.actuators.outputs(), &self.team, &mut forces);
             let extra = self.extra_wrench(t);
             self.world.step(&forces, &extra)?;
             self.step_index += 1;
