@@ -357,11 +357,42 @@ def _check_mcap(path):
     assert data.startswith(MCAP_MAGIC) and data.endswith(MCAP_MAGIC)
 
 
+def _decode_all(path):
+    """Every message of the log, decoded with the protobuf schemas stored in the file."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
+    by_topic = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for schema, channel, message, decoded in reader.iter_decoded_messages():
+            assert channel.message_encoding == "protobuf" and schema.encoding == "protobuf"
+            by_topic.setdefault(channel.topic, []).append((message.log_time, decoded))
+    return by_topic
+
+
 def test_mcap_log(tmp_path):
     path = tmp_path / "logs" / "run.mcap"  # the parent directory is created
     r = sim.run(toml=SHORT, mcap=path)
     assert r.mcap_path == str(path)
     _check_mcap(path)
+    by_topic = _decode_all(path)
+    ticks = len(r.t)
+    for topic in ("/state", "/reference", "/planner", "/control", "/allocation", "/actuators",
+                  "/lyapunov", "/tf"):
+        assert len(by_topic[topic]) == ticks, topic
+    assert 0 < len(by_topic["/scene"]) < ticks
+    # The decoded values are the run's: positions and e_f match the NumPy arrays.
+    log_time, state = by_topic["/state"][-1]
+    assert log_time == round(state.t * 1e9)
+    np.testing.assert_allclose(list(state.position), r.position[-1], rtol=0, atol=1e-12)
+    e_f = np.array([a.e_f for _, a in by_topic["/allocation"]])
+    np.testing.assert_allclose(e_f, r.e_f, rtol=0, atol=1e-12)
+    _, tf = by_topic["/tf"][0]
+    assert (tf.parent_frame_id, tf.child_frame_id) == ("world", "team")
+    _, scene = by_topic["/scene"][0]
+    assert [e.id for e in scene.entities][-1] == "navigator"
+    assert len(scene.entities) == 5
     r = sim.run(toml=SHORT, mcap=str(tmp_path / "b.mcap"))
     _check_mcap(r.mcap_path)
 

@@ -15,6 +15,12 @@ impl SimError {
             source,
         }
     }
+
+    /// A `map_err` adapter for the Foxglove SDK's errors (kept as text: the SDK's error type
+    /// is not part of this crate's API).
+    pub fn foxglove(e: foxglove::FoxgloveError) -> SimError {
+        SimError::Foxglove(e.to_string())
+    }
 }
 
 /// Errors of the simulator.
@@ -103,6 +109,9 @@ pub enum SimError {
     /// An MCAP error while writing a log.
     #[error("MCAP error: {0}")]
     Mcap(#[from] mcap::McapError),
+    /// An error of the Foxglove SDK while writing a log (its MCAP sink or live server).
+    #[error("Foxglove SDK error: {0}")]
+    Foxglove(String),
     /// A JSON serialization error while writing a log.
     #[error("JSON error: {0}")]
     Json(#[from] serde_json::Error),

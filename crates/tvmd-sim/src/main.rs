@@ -34,10 +34,12 @@ use serde::Serialize;
 use tvmd_sim::allocation_bench;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
+use tvmd_sim::log::LiveOptions;
 use tvmd_sim::paths::{check_outputs, create_parent, file_stem};
 use tvmd_sim::plot::{self, PlotSeries};
 use tvmd_sim::runner::{
-    check_batch_outputs, fly, record_cycles, run_many_until, sweep_specs, Flight, RunSpec,
+    check_batch_outputs, fly_live, record_cycles, run_many_until, sweep_specs, Flight, LiveView,
+    RunSpec,
 };
 use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary, SampleRetention};
@@ -97,6 +99,22 @@ enum Command {
         /// TVMD_PIL_FIRMWARE=ELF).
         #[arg(long, value_parser = ["cortex-m4", "cortex-m7"])]
         pil: Option<String>,
+        /// Serve the run live over Foxglove's WebSocket protocol (Foxglove app: Open
+        /// connection -> Foxglove WebSocket -> ws://127.0.0.1:8765) at real-time pace.
+        #[arg(long)]
+        live: bool,
+        /// Address the live server binds (127.0.0.1: this machine only).
+        #[arg(long, default_value = "127.0.0.1", requires = "live")]
+        live_host: String,
+        /// Port of the live server (0: any free port, printed at start).
+        #[arg(long, default_value_t = 8765, requires = "live")]
+        live_port: u16,
+        /// Simulated seconds per wall second of the live run.
+        #[arg(long, default_value_t = 1.0, requires = "live")]
+        live_speed: f64,
+        /// Seconds to wait for a Foxglove client before flying (0: fly at once).
+        #[arg(long, default_value_t = 60.0, requires = "live")]
+        live_wait: f64,
     },
     /// Record the first control cycles of a scenario's f32 flight (the core's exact inputs and
     /// the host's outputs) for the target tests; the committed recording is
@@ -259,6 +277,11 @@ fn main() -> ExitCode {
             null_space,
             precision,
             pil,
+            live,
+            live_host,
+            live_port,
+            live_speed,
+            live_wait,
         } => cmd_run(RunArgs {
             scenario,
             out,
@@ -270,6 +293,12 @@ fn main() -> ExitCode {
             null_space,
             precision,
             pil,
+            live: live.then_some(LiveOptions {
+                host: live_host,
+                port: live_port,
+                speed: live_speed,
+                wait_for_client: live_wait,
+            }),
         }),
         Command::RecordCycles {
             scenario,
@@ -397,6 +426,7 @@ struct RunArgs {
     null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
     precision: Option<String>,
     pil: Option<String>,
+    live: Option<LiveOptions>,
 }
 
 /// The `--precision` argument (clap has checked the spelling; the parse names the field).
@@ -484,7 +514,16 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     catch_interrupts();
     let bar = progress_bar(ticks_of(scenario), &scenario.name);
     let mut tick = |_t: f64| bar.inc(1);
-    let flight = fly(&spec, Some(&mut tick), Some(&INTERRUPT));
+    let mut on_listen = |address: std::net::SocketAddr| {
+        bar.suspend(|| {
+            println!("live:     ws://{address} (Foxglove: Open connection -> Foxglove WebSocket)");
+        });
+    };
+    let live = a.live.map(|options| LiveView {
+        options,
+        on_listen: &mut on_listen,
+    });
+    let flight = fly_live(&spec, live, Some(&mut tick), Some(&INTERRUPT));
     bar.finish_and_clear();
     let Flight { result, error } = flight?;
     let report = RunReport {

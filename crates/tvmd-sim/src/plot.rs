@@ -21,9 +21,9 @@ use std::sync::Once;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde_json::Value;
+use prost::Message;
 
-use crate::log::METADATA_SCENARIO;
+use crate::log::{proto, METADATA_SCENARIO};
 use crate::sim::Sample;
 use crate::SimError;
 
@@ -86,31 +86,13 @@ pub struct PlotSeries {
     pub points: Vec<PlotPoint>,
 }
 
-fn rpy_of_rows(rows: &[[f64; 3]; 3]) -> [f64; 3] {
-    crate::math::roll_pitch_yaw(&crate::math::from_rows(rows))
-}
-
 fn read_err(what: impl Into<String>) -> SimError {
     SimError::LogRead(what.into())
 }
 
-fn arr3(v: &Value, key: &str, topic: &str) -> Result<[f64; 3], SimError> {
-    let a = v
-        .get(key)
-        .and_then(Value::as_array)
-        .filter(|a| a.len() == 3)
-        .ok_or_else(|| read_err(format!("`{topic}` message without a 3-vector `{key}`")))?;
-    let mut out = [0.0; 3];
-    for (o, x) in out.iter_mut().zip(a) {
-        *o = x
-            .as_f64()
-            .ok_or_else(|| read_err(format!("`{topic}.{key}` is not numeric")))?;
-    }
-    Ok(out)
-}
-
-fn num(v: &Value, key: &str) -> Option<f64> {
-    v.get(key).and_then(Value::as_f64)
+fn arr3(v: &[f64], field: &str) -> Result<[f64; 3], SimError> {
+    <[f64; 3]>::try_from(v)
+        .map_err(|_| read_err(format!("`{field}` has {} entries, not 3", v.len())))
 }
 
 impl PlotSeries {
@@ -153,35 +135,39 @@ impl PlotSeries {
             ) {
                 continue;
             }
-            let v: Value = serde_json::from_slice(&m.data)
-                .map_err(|e| read_err(format!("`{topic}` message is not JSON: {e}")))?;
             let row = rows.entry(m.log_time).or_default();
-            row.t = num(&v, "t").unwrap_or(m.log_time as f64 * 1e-9);
+            row.t = m.log_time as f64 * 1e-9;
+            let bad = |e: prost::DecodeError| {
+                read_err(format!(
+                    "`{topic}` message is not a tvmd protobuf message: {e}"
+                ))
+            };
             match topic {
                 "/state" => {
                     seen_state = true;
-                    row.position = arr3(&v, "position", topic)?;
-                    row.roll_pitch_yaw = arr3(&v, "roll_pitch_yaw", topic)?;
+                    let s = proto::State::decode(&*m.data).map_err(bad)?;
+                    row.t = s.t;
+                    row.position = arr3(&s.position, "/state.position")?;
+                    row.roll_pitch_yaw = arr3(&s.roll_pitch_yaw, "/state.roll_pitch_yaw")?;
                 }
                 "/reference" => {
                     seen_reference = true;
-                    row.reference_position = arr3(&v, "position", topic)?;
-                    let rows3: [[f64; 3]; 3] =
-                        serde_json::from_value(v.get("rotation").cloned().unwrap_or(Value::Null))
-                            .map_err(|e| read_err(format!("`/reference.rotation`: {e}")))?;
-                    row.reference_roll_pitch_yaw = rpy_of_rows(&rows3);
+                    let r = proto::Reference::decode(&*m.data).map_err(bad)?;
+                    row.reference_position = arr3(&r.position, "/reference.position")?;
+                    row.reference_roll_pitch_yaw =
+                        arr3(&r.roll_pitch_yaw, "/reference.roll_pitch_yaw")?;
                 }
                 "/planner" => {
-                    row.planned_roll = num(&v, "planned_roll").or_else(|| {
-                        v.get("planned_roll_pitch_yaw")
-                            .and_then(|a| a.get(0))
-                            .and_then(Value::as_f64)
-                    });
+                    row.planned_roll =
+                        Some(proto::Planner::decode(&*m.data).map_err(bad)?.planned_roll);
                 }
-                "/allocation" => row.e_f = num(&v, "e_f"),
+                "/allocation" => {
+                    row.e_f = Some(proto::Allocation::decode(&*m.data).map_err(bad)?.e_f);
+                }
                 _ => {
-                    row.v_x = num(&v, "v_x");
-                    row.v_r = num(&v, "v_r");
+                    let l = proto::Lyapunov::decode(&*m.data).map_err(bad)?;
+                    row.v_x = Some(l.v_x);
+                    row.v_r = Some(l.v_r);
                 }
             }
         }

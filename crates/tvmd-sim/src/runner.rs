@@ -14,7 +14,7 @@ use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
-use crate::log::{McapLog, METADATA_SCENARIO};
+use crate::log::{LiveOptions, RunLog, METADATA_SCENARIO};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
 use crate::scenario::{Precision, Scenario};
@@ -48,7 +48,7 @@ impl FlightController for WithProgress<'_> {
 }
 
 /// Writes the scenario into the log's metadata record [`METADATA_SCENARIO`].
-pub fn write_scenario_metadata(log: &mut McapLog, scenario: &Scenario) -> Result<(), SimError> {
+pub fn write_scenario_metadata(log: &mut RunLog, scenario: &Scenario) -> Result<(), SimError> {
     let mut meta = BTreeMap::new();
     meta.insert("name".to_string(), scenario.name.clone());
     meta.insert("relaxation".to_string(), scenario.relaxation.to_string());
@@ -126,21 +126,50 @@ pub fn fly(
     progress: Option<&mut dyn FnMut(f64)>,
     cancel: Option<&AtomicBool>,
 ) -> Result<Flight, SimError> {
+    fly_live(spec, None, progress, cancel)
+}
+
+/// A live view of one flight: where to serve it, and a callback told the server's address
+/// once it listens (before it waits for a client, so a caller can print it).
+pub struct LiveView<'a> {
+    /// Server options.
+    pub options: LiveOptions,
+    /// Called with the address the server listens on.
+    pub on_listen: &'a mut dyn FnMut(std::net::SocketAddr),
+}
+
+/// As [`fly`], also serving the flight live over Foxglove's WebSocket protocol when `live` is
+/// given (the run then goes at the server's pace, real time by default).
+pub fn fly_live(
+    spec: &RunSpec,
+    live: Option<LiveView<'_>>,
+    progress: Option<&mut dyn FnMut(f64)>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Flight, SimError> {
     let scenario = &spec.scenario;
     let mut controller = AnyTvmdController::from_scenario_on(scenario, spec.pil)?;
     let options = SimOptions {
         samples: spec.samples,
-        ..SimOptions::default()
     };
     let mut sim = Simulation::with_options(scenario, options)?;
-    let mut mcap = match spec.log.as_deref() {
-        Some(path) => {
-            let mut l = McapLog::create(path)?;
-            write_scenario_metadata(&mut l, scenario)?;
+    let mut mcap = match (spec.log.as_deref(), &live) {
+        (None, None) => None,
+        (path, _) => {
+            let mut l = RunLog::new();
+            if let Some(path) = path {
+                l.add_mcap(path)?;
+                write_scenario_metadata(&mut l, scenario)?;
+            }
             Some(l)
         }
-        None => None,
     };
+    if let (Some(view), Some(log)) = (live, mcap.as_mut()) {
+        let address = log.serve(&view.options)?;
+        (view.on_listen)(address);
+        if let Some(server) = log.live() {
+            server.wait_for_client(cancel);
+        }
+    }
     let run = match progress {
         Some(p) => sim.run_until(
             &mut WithProgress::new(&mut controller, p),
@@ -149,7 +178,7 @@ pub fn fly(
         ),
         None => sim.run_until(&mut controller, mcap.as_mut(), cancel),
     };
-    let finished = mcap.as_mut().map_or(Ok(()), McapLog::finish);
+    let finished = mcap.as_mut().map_or(Ok(()), RunLog::finish);
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
         (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),

@@ -5,8 +5,10 @@ use std::collections::BTreeMap;
 
 use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Rotation3, Vector3};
+use prost::Message;
 use tvmd_sim::control::{core_reference, core_state, TvmdController};
 use tvmd_sim::flight::FlightController;
+use tvmd_sim::log::proto;
 use tvmd_sim::log::METADATA_SCENARIO;
 use tvmd_sim::physics::PlantState;
 use tvmd_sim::plot::{self, PlotSeries};
@@ -50,36 +52,41 @@ fn short_run_log_has_every_channel_and_replots() {
         .map(|c| c.topic.as_str())
         .collect();
     topics.sort_unstable();
+    // Channels appear in the file with their first message: /hover, written only when a
+    // failure mask changes, is absent.
     let mut want = TOPICS.to_vec();
-    // The hover classification's channel, written only when a failure mask changes.
-    want.push("/hover");
     want.sort_unstable();
     assert_eq!(topics, want);
 
-    let mut by_topic: BTreeMap<String, Vec<serde_json::Value>> = BTreeMap::new();
+    let mut by_topic: BTreeMap<String, Vec<Vec<u8>>> = BTreeMap::new();
     for m in MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
-        let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-        by_topic.entry(m.channel.topic.clone()).or_default().push(v);
+        assert_eq!(m.channel.message_encoding, "protobuf");
+        by_topic
+            .entry(m.channel.topic.clone())
+            .or_default()
+            .push(m.data.to_vec());
     }
     for t in TOPICS {
         let n = by_topic.get(t).map_or(0, Vec::len);
         let want = if t == "/scene" { 10 } else { 50 };
         assert_eq!(n, want, "{t}");
     }
-    assert!(!by_topic.contains_key("/hover"));
     // The controller's diagnostics are in the messages.
-    let p = &by_topic["/planner"][10];
-    assert_eq!(p["status"], "already-feasible");
-    assert!(p["planned_roll"].as_f64().unwrap().abs() < 1e-12);
-    let a = &by_topic["/allocation"][10];
-    assert!(a["e_f"].as_f64().unwrap() < 1e-9);
-    assert_eq!(a["forces"].as_array().unwrap().len(), 4);
-    assert_eq!(a["rounds"], 1);
-    let c = &by_topic["/control"][10];
-    assert_eq!(c["t_tf"], 1.0);
-    assert!(c["u_d"][5].as_f64().unwrap() > 27.0);
-    assert!(by_topic["/lyapunov"][0]["v_x"].as_f64().unwrap() > 0.09);
+    let p = proto::Planner::decode(&*by_topic["/planner"][10]).unwrap();
+    assert_eq!(p.status, "already-feasible");
+    assert!(p.planned_roll.abs() < 1e-12);
+    let a = proto::Allocation::decode(&*by_topic["/allocation"][10]).unwrap();
+    assert!(a.e_f < 1e-9);
+    assert_eq!(a.forces.len(), 4);
+    assert_eq!(a.rounds, 1);
+    let c = proto::Control::decode(&*by_topic["/control"][10]).unwrap();
+    assert_eq!(c.t_tf, 1.0);
+    assert!(c.u_d[5] > 27.0);
+    let extra: serde_json::Value = serde_json::from_str(&c.extra_json).unwrap();
+    assert_eq!(extra["f_r"].as_array().unwrap().len(), 3);
+    let l = proto::Lyapunov::decode(&*by_topic["/lyapunov"][0]).unwrap();
+    assert!(l.v_x > 0.09);
 
     // The scenario is stored as metadata and parses back.
     let idx = summary

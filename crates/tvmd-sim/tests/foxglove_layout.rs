@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 
 use mcap::MessageStream;
+use prost_reflect::{DescriptorPool, DynamicMessage, SerializeOptions};
 use serde_json::Value;
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::scenario::Scenario;
@@ -33,13 +34,22 @@ fn the_layout_names_what_the_log_has() {
     let scenario = Scenario::from_toml_str("duration = 5.0\n").unwrap();
     run_scenario(&scenario, Some(&log), None).unwrap();
     let bytes = std::fs::read(&log).unwrap();
-    // The last message of each topic, as JSON.
+    // The last message of each topic, decoded with the schema in the file alone, as JSON.
     let mut last: BTreeMap<String, Value> = BTreeMap::new();
     for message in MessageStream::new(&bytes).unwrap() {
         let message = message.unwrap();
-        if let Ok(v) = serde_json::from_slice::<Value>(&message.data) {
-            last.insert(message.channel.topic.clone(), v);
-        }
+        let schema = message.channel.schema.as_ref().expect("a schema");
+        assert_eq!(schema.encoding, "protobuf");
+        let pool = DescriptorPool::decode(&*schema.data).unwrap();
+        let descriptor = pool.get_message_by_name(&schema.name).unwrap();
+        let decoded = DynamicMessage::decode(descriptor, &*message.data).unwrap();
+        let options = SerializeOptions::new()
+            .use_proto_field_name(true)
+            .skip_default_fields(false);
+        let v = decoded
+            .serialize_with_options(serde_json::value::Serializer, &options)
+            .unwrap();
+        last.insert(message.channel.topic.clone(), v);
     }
     let panels = layout["configById"].as_object().expect("configById");
     let mut plotted = 0;

@@ -154,20 +154,17 @@ fn the_classification_is_logged_on_the_hover_channel() {
     let path = std::env::temp_dir().join(format!("tvmd-hover-{}.mcap", std::process::id()));
     run_scenario(&s, Some(&path), None).unwrap();
     let bytes = std::fs::read(&path).unwrap();
-    let hover: Vec<serde_json::Value> = MessageStream::new(&bytes)
+    let hover: Vec<tvmd_sim::log::proto::Hover> = MessageStream::new(&bytes)
         .unwrap()
         .map(|m| m.unwrap())
         .filter(|m| m.channel.topic == "/hover")
-        .map(|m| serde_json::from_slice(&m.data).unwrap())
+        .map(|m| prost::Message::decode(&*m.data).unwrap())
         .collect();
     assert_eq!(hover.len(), 1, "{hover:?}");
-    assert_eq!(hover[0]["capable"], false);
-    assert!((hover[0]["t"].as_f64().unwrap() - 5.0).abs() < 1e-9);
-    assert!(hover[0]["margin"].as_f64().unwrap().abs() < 1e-6);
-    assert_eq!(
-        hover[0]["limiting_agent"].as_u64().map(|a| a != 0),
-        Some(true)
-    );
+    assert!(!hover[0].capable);
+    assert!((hover[0].t - 5.0).abs() < 1e-9);
+    assert!(hover[0].margin.abs() < 1e-6);
+    assert_eq!(hover[0].limiting_agent.map(|a| a != 0), Some(true));
     let _ = std::fs::remove_file(&path);
 }
 

@@ -1,15 +1,19 @@
-//! MCAP logs: channels, schemas, message counts, and finalisation on drop / error.
+//! MCAP logs: protobuf channels with their schemas in the file, message counts, decimation,
+//! and finalisation on drop / error.
 
 mod common;
 
 use std::collections::BTreeMap;
 
 use common::PdHover;
+use foxglove::messages::{FrameTransform, SceneUpdate};
 use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Vector3};
+use prost::Message;
+use prost_types::FileDescriptorSet;
 use tvmd_sim::actuators::ActuatorCommand;
 use tvmd_sim::flight::FlightOutput;
-use tvmd_sim::log::{LogKind, McapLog};
+use tvmd_sim::log::{proto, LogKind, LogSettings, RunLog};
 use tvmd_sim::math::rot_x;
 use tvmd_sim::physics::{PlantState, TeamBody};
 use tvmd_sim::reference::{ReferenceConfig, ReferenceSample};
@@ -24,27 +28,63 @@ fn tmp(name: &str) -> std::path::PathBuf {
     dir.join(name)
 }
 
+/// Decodes `data` as the message type of `topic`; panics on a decode error.
+fn decode(topic: &str, data: &[u8]) {
+    let ok = match topic {
+        "/state" => proto::State::decode(data).is_ok(),
+        "/reference" => proto::Reference::decode(data).is_ok(),
+        "/planner" => proto::Planner::decode(data).is_ok(),
+        "/control" => proto::Control::decode(data).is_ok(),
+        "/allocation" => proto::Allocation::decode(data).is_ok(),
+        "/actuators" => proto::Actuators::decode(data).is_ok(),
+        "/lyapunov" => proto::Lyapunov::decode(data).is_ok(),
+        "/hover" => proto::Hover::decode(data).is_ok(),
+        "/tf" => FrameTransform::decode(data).is_ok(),
+        "/scene" => SceneUpdate::decode(data).is_ok(),
+        other => panic!("unexpected topic {other}"),
+    };
+    assert!(ok, "{topic}: not its protobuf message");
+}
+
+/// Messages per topic; every message decodes, and every channel is protobuf with a schema
+/// (a `FileDescriptorSet` that defines the schema's message).
 fn counts(bytes: &[u8]) -> BTreeMap<String, usize> {
     let mut by_topic = BTreeMap::new();
     for m in MessageStream::new(bytes).unwrap() {
         let m = m.unwrap();
-        // Every message is valid JSON.
-        let _: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+        assert_eq!(m.channel.message_encoding, "protobuf");
+        let schema = m.channel.schema.as_ref().expect("a schema");
+        assert_eq!(schema.encoding, "protobuf");
+        let set = FileDescriptorSet::decode(&*schema.data).unwrap();
+        let (package, name) = schema.name.rsplit_once('.').unwrap();
+        assert!(
+            set.file
+                .iter()
+                .any(|f| f.package() == package && f.message_type.iter().any(|d| d.name() == name)),
+            "{} is not defined by its schema",
+            schema.name
+        );
+        let kind = LogKind::ALL
+            .into_iter()
+            .find(|k| k.topic() == m.channel.topic)
+            .unwrap();
+        assert_eq!(schema.name, kind.schema_name());
+        decode(&m.channel.topic, &m.data);
         *by_topic.entry(m.channel.topic.clone()).or_insert(0) += 1;
     }
     by_topic
 }
 
-fn write_small(log: &mut McapLog) {
+fn write_small(log: &mut RunLog) {
     let team = TeamBody::a4_inc();
     for k in 0..3 {
         let t = k as f64 * 0.01;
-        log.write(
-            LogKind::Lyapunov,
+        let msg = proto::Lyapunov {
             t,
-            &serde_json::json!({"v_x": 1.0, "v_r": 2.0}),
-        )
-        .unwrap();
+            v_x: 1.0,
+            v_r: 2.0,
+        };
+        log.write(t, &msg).unwrap();
         log.write_frame_transform(t, &Vector3::new(0.0, 0.0, t), &rot_x(0.1))
             .unwrap();
         let f = vec![Vector3::new(0.0, 1.0, 7.0); 4];
@@ -56,48 +96,40 @@ fn write_small(log: &mut McapLog) {
 #[test]
 fn small_log_reads_back() {
     let path = tmp("small.mcap");
-    let mut log = McapLog::create(&path).unwrap();
+    let mut log = RunLog::create(&path).unwrap();
     write_small(&mut log);
     assert_eq!(log.message_count(), 9);
     log.finish().unwrap();
-    assert!(log.write(LogKind::State, 1.0, &1.0).is_err());
+    assert!(log.write(1.0, &proto::State::default()).is_err());
     let bytes = std::fs::read(&path).unwrap();
     let summary = Summary::read(&bytes).unwrap().expect("summary present");
-    // LogKind::ALL (8, /hover included), /tf and /scene.
-    assert_eq!(summary.channels.len(), 10);
+    // The channels that carried messages: /lyapunov, /tf and /scene.
+    assert_eq!(summary.channels.len(), 3);
     assert_eq!(summary.stats.as_ref().unwrap().message_count, 9);
-    let mut schema_names: Vec<_> = summary
-        .schemas
-        .values()
-        .map(|s| (s.name.clone(), s.encoding.clone()))
-        .collect();
-    schema_names.sort();
-    assert!(schema_names.contains(&("foxglove.FrameTransform".into(), "jsonschema".into())));
-    assert!(schema_names.contains(&("foxglove.SceneUpdate".into(), "jsonschema".into())));
-    for c in summary.channels.values() {
-        assert_eq!(c.message_encoding, "json");
-    }
     let by_topic = counts(&bytes);
     assert_eq!(by_topic["/lyapunov"], 3);
     assert_eq!(by_topic["/tf"], 3);
     assert_eq!(by_topic["/scene"], 3);
-    // The Foxglove transform has the expected shape.
+    // The Foxglove transform has the expected content, and the log time is the sim time.
     let tf = MessageStream::new(&bytes)
         .unwrap()
         .map(|m| m.unwrap())
-        .find(|m| m.channel.topic == "/tf")
+        .filter(|m| m.channel.topic == "/tf")
+        .nth(1)
         .unwrap();
-    let v: serde_json::Value = serde_json::from_slice(&tf.data).unwrap();
-    assert_eq!(v["parent_frame_id"], "world");
-    assert_eq!(v["child_frame_id"], "team");
-    assert!(v["rotation"]["w"].as_f64().unwrap() > 0.99);
+    assert_eq!(tf.log_time, 10_000_000);
+    let v = FrameTransform::decode(&*tf.data).unwrap();
+    assert_eq!(v.parent_frame_id, "world");
+    assert_eq!(v.child_frame_id, "team");
+    assert!(v.rotation.unwrap().w > 0.99);
+    assert!((v.translation.unwrap().z - 0.01).abs() < 1e-15);
 }
 
 #[test]
 fn dropped_log_is_still_valid() {
     let path = tmp("dropped.mcap");
     {
-        let mut log = McapLog::create(&path).unwrap();
+        let mut log = RunLog::create(&path).unwrap();
         write_small(&mut log);
         // No finish(): Drop finalises.
     }
@@ -120,7 +152,7 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
     };
     // Successful run with the PD controller (it reports only the Lyapunov diagnostics).
     let path = tmp("run.mcap");
-    let mut log = McapLog::create(&path).unwrap();
+    let mut log = RunLog::create(&path).unwrap();
     let mut sim = Simulation::new(&s).unwrap();
     let mut ctl = PdHover::new(sim.team());
     sim.run(&mut ctl, Some(&mut log)).unwrap();
@@ -135,7 +167,7 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
     // A run whose controller fails at t = 0.25 s: the caller drops the log on the error path.
     let path = tmp("failed.mcap");
     let result = {
-        let mut log = McapLog::create(&path).unwrap();
+        let mut log = RunLog::create(&path).unwrap();
         let mut sim = Simulation::new(&s).unwrap();
         let mut ctl = |t: f64,
                        _: &PlantState,
@@ -167,4 +199,44 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
     let by_topic = counts(&bytes);
     assert_eq!(by_topic["/state"], 26);
     assert_eq!(by_topic["/planner"], 26);
+}
+
+#[test]
+fn decimation_thins_the_heavy_topics_only() {
+    let base = Scenario {
+        duration: 0.5,
+        ..Scenario::default()
+    };
+    let count = |log_settings: LogSettings, name: &str| {
+        let s = Scenario {
+            log: log_settings,
+            ..base.clone()
+        };
+        let path = tmp(name);
+        let spec = tvmd_sim::runner::RunSpec {
+            scenario: s,
+            log: Some(path.clone()),
+            pil: None,
+            samples: tvmd_sim::sim::SampleRetention::None,
+        };
+        let flight = tvmd_sim::runner::fly(&spec, None, None).unwrap();
+        assert!(flight.error.is_none());
+        counts(&std::fs::read(&path).unwrap())
+    };
+    let all = count(LogSettings::default(), "all.mcap");
+    let thin = count(
+        LogSettings {
+            decimation: 5,
+            scene_period: 0.1,
+        },
+        "thin.mcap",
+    );
+    for topic in ["/planner", "/control", "/allocation", "/actuators"] {
+        assert_eq!(all[topic], 50, "{topic}");
+        assert_eq!(thin[topic], 10, "{topic}");
+    }
+    for topic in ["/state", "/reference", "/lyapunov", "/tf"] {
+        assert_eq!(thin[topic], all[topic], "{topic}");
+    }
+    assert_eq!((all["/scene"], thin["/scene"]), (10, 5));
 }

@@ -61,10 +61,7 @@ fn only_kept_samples_bound_a_run_length() {
         duration: (MAX_KEPT_SAMPLES as f64 + 10.0) * 0.01,
         ..Scenario::builtin("paper-tilt").unwrap()
     };
-    let options = |samples| SimOptions {
-        samples,
-        ..SimOptions::default()
-    };
+    let options = |samples| SimOptions { samples };
     let Err(e) = Simulation::with_options(&s, options(SampleRetention::All)) else {
         panic!("a run that keeps every one of its ticks is bounded");
     };

@@ -62,6 +62,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::actuators::{ActuatorModel, FailureKind, SaturationLimits};
+use crate::log::LogSettings;
 use crate::physics::{AgentBody, PhysicsConfig, TeamBody, DEFAULT_COLLIDER_RADIUS};
 use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
@@ -437,6 +438,8 @@ pub struct Scenario {
     pub failure_response: FailureResponse,
     /// Disturbances.
     pub disturbances: Disturbances,
+    /// What the run's log keeps (`[log]`: `decimation`, `scene_period`).
+    pub log: LogSettings,
 }
 
 impl Default for Scenario {
@@ -463,6 +466,7 @@ impl Default for Scenario {
             failures: Vec::new(),
             failure_response: FailureResponse::default(),
             disturbances: Disturbances::default(),
+            log: LogSettings::default(),
         }
     }
 }

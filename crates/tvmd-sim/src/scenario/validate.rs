@@ -118,6 +118,14 @@ impl Scenario {
             ));
         }
         check_range("physics.gravity", self.physics.gravity, 0.0, 100.0)?;
+        let decimation = self.log.decimation;
+        if !(1..=1_000_000).contains(&decimation) {
+            return Err(invalid(
+                "log.decimation",
+                format!("must be in [1, 1000000] controller ticks, got {decimation}"),
+            ));
+        }
+        check_range("log.scene_period", self.log.scene_period, 1e-6, 1e6)?;
         check_nonneg("physics.friction", &[self.physics.friction])?;
         check_magnitude("initial_position", &self.initial_position, MAX_DISTANCE)?;
         if self.initial_position[2] < 0.0 {

@@ -35,7 +35,7 @@ use serde::Serialize;
 
 use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
-use crate::log::McapLog;
+use crate::log::RunLog;
 use crate::physics::{ExtraWrench, PhysicsWorld, PlantState, TeamBody};
 use crate::scenario::{Failure, Scenario, StateNoise};
 use crate::SimError;
@@ -111,8 +111,6 @@ pub struct RunResult {
 /// Options that are not part of the scenario.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimOptions {
-    /// Period of `/scene` messages (s); rounded to a multiple of the controller period.
-    pub scene_period: f64,
     /// Which samples the result keeps (default: all).
     pub samples: SampleRetention,
 }
@@ -120,7 +118,6 @@ pub struct SimOptions {
 impl Default for SimOptions {
     fn default() -> Self {
         Self {
-            scene_period: 0.05,
             samples: SampleRetention::All,
         }
     }
@@ -140,7 +137,6 @@ pub struct Simulation {
     failed_told: Vec<bool>,
     noise: Option<(StateNoise, ChaCha8Rng)>,
     max_thrust: f64,
-    options: SimOptions,
     samples: SampleStore,
     fold: SummaryFold,
     step_index: usize,
@@ -186,7 +182,6 @@ impl Simulation {
             world,
             steps_per_control,
             total_steps,
-            options,
             samples: SampleStore::new(options.samples),
             fold: SummaryFold::new(scenario),
             step_index: 0,
@@ -295,7 +290,7 @@ impl Simulation {
     pub fn run(
         &mut self,
         controller: &mut dyn FlightController,
-        log: Option<&mut McapLog>,
+        log: Option<&mut RunLog>,
     ) -> Result<RunResult, SimError> {
         self.run_until(controller, log, None)
     }
@@ -306,7 +301,7 @@ impl Simulation {
     pub fn run_until(
         &mut self,
         controller: &mut dyn FlightController,
-        log: Option<&mut McapLog>,
+        log: Option<&mut RunLog>,
         cancel: Option<&AtomicBool>,
     ) -> Result<RunResult, SimError> {
         let start = std::time::Instant::now();
@@ -319,12 +314,14 @@ impl Simulation {
     fn run_loop(
         &mut self,
         controller: &mut dyn FlightController,
-        mut log: Option<&mut McapLog>,
+        mut log: Option<&mut RunLog>,
         cancel: Option<&AtomicBool>,
     ) -> Result<(), SimError> {
         let dt = self.scenario.physics.dt;
         let period = self.scenario.controller_period;
-        let scene_every = ((self.options.scene_period / period).round() as usize).max(1);
+        let settings = self.scenario.log;
+        let scene_every = ((settings.scene_period / period).round() as usize).max(1);
+        let heavy_every = settings.decimation.max(1);
         let mut held = vec![ActuatorCommand::default(); self.team.len()];
         // Reused every physics step: the step allocates nothing of its own.
         let mut forces = Vec::with_capacity(self.team.len());
@@ -375,16 +372,17 @@ impl Simulation {
                 self.fold.push(&sample);
                 self.samples.push(tick, || sample);
                 if let Some(log) = log.as_deref_mut() {
+                    let forces_body = self.forces(&actual);
                     let tick_log = tick_log::Tick {
                         t,
                         state: &truth,
                         reference: &reference,
                         output: &out,
-                        forces_body: self.forces(&actual),
-                        actual,
+                        actual: &actual,
+                        forces_body: &forces_body,
                         failed: &self.failed_true,
                     };
-                    tick_log.write(log)?;
+                    tick_log.write(log, tick % heavy_every == 0)?;
                     if tick % scene_every == 0 {
                         // Show the commanded forces: at a tick the actual ones still lag by one
                         // period.
@@ -397,6 +395,7 @@ impl Simulation {
                             self.max_thrust,
                         )?;
                     }
+                    log.pace(t);
                 }
             }
             self.actuators.step(&held, dt);

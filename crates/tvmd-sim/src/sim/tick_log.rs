@@ -1,17 +1,19 @@
-//! What the loop logs at each controller tick: the MCAP messages of one tick (`/state`,
-//! `/reference`, the diagnostics channels, `/actuators`, `/tf`), built from the loop's values.
+//! What the loop logs at each controller tick: the messages of one tick (`/state`,
+//! `/reference`, the diagnostics channels, `/actuators`, `/tf`), built from the loop's values
+//! as the protobuf messages of [`crate::log::proto`].
 
-use nalgebra::Vector3;
-use serde::Serialize;
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use crate::actuators::ActuatorCommand;
-use crate::diagnostics::PlannerDiagnostics;
+use crate::diagnostics::{
+    AllocationDiagnostics, ControlDiagnostics, HoverDiagnostics, PlannerDiagnostics,
+};
 use crate::flight::FlightOutput;
-use crate::log::{ActuatorsMsg, LogKind, McapLog, Quat, ReferenceMsg, StateMsg};
-use crate::math::{from_rows, roll_pitch_yaw, to_rows};
+use crate::log::proto::{self, Vec3};
+use crate::log::RunLog;
+use crate::math::{from_rows, roll_pitch_yaw};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
-use crate::sim::sample::arr;
 use crate::SimError;
 
 /// The values of one tick to log.
@@ -25,97 +27,215 @@ pub struct Tick<'a> {
     /// The controller's output.
     pub output: &'a FlightOutput,
     /// Actual actuator outputs.
-    pub actual: Vec<ActuatorCommand>,
+    pub actual: &'a [ActuatorCommand],
     /// Body-frame forces of the actual outputs.
-    pub forces_body: Vec<Vector3<f64>>,
+    pub forces_body: &'a [Vector3<f64>],
     /// True failure flags.
     pub failed: &'a [bool],
 }
 
-/// `/planner`: the diagnostics and the roll, pitch, yaw of `R_d`.
-#[derive(Serialize)]
-struct PlannerMsg<'a> {
-    #[serde(flatten)]
-    p: &'a PlannerDiagnostics,
-    planned_roll_pitch_yaw: [f64; 3],
+fn v(x: &Vector3<f64>) -> Vec<f64> {
+    vec![x.x, x.y, x.z]
+}
+
+/// Row-major entries of a 3x3 matrix.
+fn rows(m: &Matrix3<f64>) -> Vec<f64> {
+    m.transpose().iter().copied().collect()
+}
+
+fn command(c: &ActuatorCommand) -> proto::AgentCommand {
+    proto::AgentCommand {
+        eta_x: c.eta_x,
+        eta_y: c.eta_y,
+        thrust: c.thrust,
+    }
+}
+
+fn planner(t: f64, p: &PlannerDiagnostics) -> proto::Planner {
+    let r_d = from_rows(&p.r_d);
+    proto::Planner {
+        t,
+        r_d: rows(&r_d),
+        planned_roll_pitch_yaw: roll_pitch_yaw(&r_d).to_vec(),
+        theta: p.theta,
+        t_tf: p.t_tf,
+        t_eta: p.t_eta,
+        reference_feasible: p.reference_feasible,
+        planned_roll: p.planned_roll,
+        status: p.status.clone(),
+        iterations: p.iterations,
+    }
+}
+
+fn control(t: f64, c: &ControlDiagnostics) -> proto::Control {
+    proto::Control {
+        t,
+        u_r: c.u_r.to_vec(),
+        u_d: c.u_d.to_vec(),
+        e_x: c.e_x.to_vec(),
+        e_v: c.e_v.to_vec(),
+        e_r: c.e_r.to_vec(),
+        e_omega: c.e_omega.to_vec(),
+        t_tf: c.t_tf,
+        t_eta: c.t_eta,
+        extra_json: if c.extra.is_null() {
+            String::new()
+        } else {
+            c.extra.to_string()
+        },
+        ..Default::default()
+    }
+}
+
+fn allocation(t: f64, a: &AllocationDiagnostics) -> proto::Allocation {
+    proto::Allocation {
+        t,
+        wrench: a.wrench.to_vec(),
+        e_f: a.e_f,
+        saturated: a.saturated.clone(),
+        wrench_error: a.wrench_error,
+        rounds: a.rounds,
+        fallback: a.fallback,
+        forces: a
+            .forces
+            .iter()
+            .map(|f| Vec3::of(&Vector3::from(*f)))
+            .collect(),
+        rotor_speeds: a.rotor_speeds.clone(),
+        null_space: a.null_space.map(|n| proto::NullSpace {
+            iterations: n.iterations,
+            objective: n.objective.to_vec(),
+            margin: n.margin.to_vec(),
+            largest_force_change: n.largest_force_change,
+            wrench_drift: n.wrench_drift,
+        }),
+    }
+}
+
+fn hover(t: f64, h: &HoverDiagnostics) -> proto::Hover {
+    proto::Hover {
+        t,
+        capable: h.capable,
+        margin: h.margin,
+        limiting_agent: h.limiting_agent.and_then(|i| u32::try_from(i).ok()),
+        limit: h.limit.clone(),
+        landing: h.landing,
+    }
 }
 
 impl Tick<'_> {
-    /// Writes the tick's messages (everything but `/scene`).
-    pub fn write(self, log: &mut McapLog) -> Result<(), SimError> {
+    /// Writes the tick's messages (everything but `/scene`); the heavy topics
+    /// ([`crate::log::LogKind::is_heavy`]) only when `heavy`.
+    pub fn write(self, log: &mut RunLog, heavy: bool) -> Result<(), SimError> {
         let (t, s, r) = (self.t, self.state, self.reference);
+        let q = UnitQuaternion::from_matrix(&s.rotation);
         log.write(
-            LogKind::State,
             t,
-            &StateMsg {
+            &proto::State {
                 t,
-                position: arr(&s.position),
-                velocity: arr(&s.velocity),
-                velocity_body: arr(&s.velocity_body()),
-                orientation: Quat::from_matrix(&s.rotation),
-                rotation: to_rows(&s.rotation),
-                roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
-                omega: arr(&s.omega),
+                position: v(&s.position),
+                velocity: v(&s.velocity),
+                velocity_body: v(&s.velocity_body()),
+                orientation: Some(proto::Quat {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                }),
+                rotation: rows(&s.rotation),
+                roll_pitch_yaw: roll_pitch_yaw(&s.rotation).to_vec(),
+                omega: v(&s.omega),
             },
         )?;
         log.write(
-            LogKind::Reference,
             t,
-            &ReferenceMsg {
+            &proto::Reference {
                 t,
-                position: arr(&r.position),
-                velocity: arr(&r.velocity),
-                acceleration: arr(&r.acceleration),
-                rotation: to_rows(&r.rotation),
-                omega: arr(&r.omega),
+                position: v(&r.position),
+                velocity: v(&r.velocity),
+                acceleration: v(&r.acceleration),
+                rotation: rows(&r.rotation),
+                omega: v(&r.omega),
                 roll: r.roll,
                 roll_rate: r.roll_rate,
+                roll_pitch_yaw: roll_pitch_yaw(&r.rotation).to_vec(),
             },
         )?;
         let d = &self.output.diagnostics;
-        if let Some(p) = &d.planner {
-            let planned_roll_pitch_yaw = roll_pitch_yaw(&from_rows(&p.r_d));
+        if heavy {
+            if let Some(p) = &d.planner {
+                log.write(t, &planner(t, p))?;
+            }
+            if let Some(c) = &d.control {
+                log.write(t, &control(t, c))?;
+            }
+            if let Some(a) = &d.allocation {
+                log.write(t, &allocation(t, a))?;
+            }
             log.write(
-                LogKind::Planner,
                 t,
-                &PlannerMsg {
-                    p,
-                    planned_roll_pitch_yaw,
+                &proto::Actuators {
+                    t,
+                    commanded: self.output.commands.iter().map(command).collect(),
+                    actual: self.actual.iter().map(command).collect(),
+                    failed: self.failed.to_vec(),
+                    forces_body: self.forces_body.iter().map(Vec3::of).collect(),
                 },
             )?;
         }
-        if let Some(c) = &d.control {
-            log.write(LogKind::Control, t, c)?;
-        }
         if d.cycle_error.is_some() || d.failure_note.is_some() {
-            // A skipped cycle has no law output: log why on the control channel.
+            // A skipped cycle has no law output: say why on the control channel, every time.
             log.write(
-                LogKind::Control,
                 t,
-                &serde_json::json!({"extra": {
-                    "cycle_error": d.cycle_error, "failure_note": d.failure_note}}),
+                &proto::Control {
+                    t,
+                    cycle_error: d.cycle_error.clone().unwrap_or_default(),
+                    failure_note: d.failure_note.clone().unwrap_or_default(),
+                    ..Default::default()
+                },
             )?;
         }
-        if let Some(a) = &d.allocation {
-            log.write(LogKind::Allocation, t, a)?;
-        }
         if let Some(l) = &d.lyapunov {
-            log.write(LogKind::Lyapunov, t, l)?;
+            log.write(
+                t,
+                &proto::Lyapunov {
+                    t,
+                    v_x: l.v_x,
+                    v_r: l.v_r,
+                },
+            )?;
         }
         if let Some(h) = &d.hover {
-            log.write(LogKind::Hover, t, h)?;
+            log.write(t, &hover(t, h))?;
         }
-        log.write(
-            LogKind::Actuators,
-            t,
-            &ActuatorsMsg {
-                t,
-                commanded: self.output.commands.clone(),
-                actual: self.actual,
-                failed: self.failed.to_vec(),
-                forces_body: self.forces_body.iter().map(arr).collect(),
-            },
-        )?;
         log.write_frame_transform(t, &s.position, &s.rotation)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matrices_are_logged_row_major() {
+        let m = Matrix3::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0);
+        assert_eq!(rows(&m), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    }
+
+    #[test]
+    fn a_missing_limiting_agent_stays_absent() {
+        let h = HoverDiagnostics {
+            capable: false,
+            margin: -1.0,
+            limiting_agent: None,
+            limit: "thrust".into(),
+            landing: true,
+        };
+        assert_eq!(hover(0.0, &h).limiting_agent, None);
+        let h = HoverDiagnostics {
+            limiting_agent: Some(2),
+            ..h
+        };
+        assert_eq!(hover(0.0, &h).limiting_agent, Some(2));
     }
 }

@@ -1,0 +1,449 @@
+//! Run logs through the official Foxglove SDK (`foxglove`): every channel protobuf-encoded with
+//! its schema in the file, written to an MCAP file, served live over Foxglove's WebSocket
+//! protocol, or both.
+//!
+//! | topic | schema | content |
+//! |---|---|---|
+//! | `/state` | `tvmd.State` | true state of the team |
+//! | `/reference` | `tvmd.Reference` | reference trajectory |
+//! | `/planner` | `tvmd.Planner` | attitude planner diagnostics |
+//! | `/control` | `tvmd.Control` | control-law diagnostics, or why a cycle was skipped |
+//! | `/allocation` | `tvmd.Allocation` | allocation diagnostics (`e_f`) |
+//! | `/actuators` | `tvmd.Actuators` | commanded and actual agent commands, failures |
+//! | `/lyapunov` | `tvmd.Lyapunov` | `V_x`, `V_R` |
+//! | `/hover` | `tvmd.Hover` | hover classification when the failure mask changes |
+//! | `/tf` | `foxglove.FrameTransform` | pose of frame `team` in frame `world` |
+//! | `/scene` | `foxglove.SceneUpdate` | one entity per agent (cube at `p_i`, thrust arrow) |
+//!
+//! The `tvmd.*` messages are declared in [`proto`]; the `foxglove.*` ones are the SDK's.
+//! [`LogSettings`] (the scenario's `[log]` table) thins the heavy topics. A metadata record
+//! [`METADATA_SCENARIO`] may hold the scenario of the run.
+//!
+//! Every message carries the simulation time `t` (s) as its MCAP log and publish time (ns).
+//! Each [`RunLog`] logs through its own `foxglove::Context`, so runs in parallel never share a
+//! sink. The file is finalised by [`RunLog::finish`] and, if that was not called (an error or
+//! a panic unwound the caller), by `Drop`, so it is never left truncated.
+
+pub mod live;
+pub mod proto;
+pub mod scene;
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+use std::sync::Arc;
+
+use foxglove::messages::{FrameTransform, Quaternion, SceneUpdate, Vector3 as FgVector3};
+use foxglove::{Channel, Context, Encode, McapWriterHandle};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::SimError;
+
+pub use live::{LiveOptions, LiveServer};
+
+/// Name of the metadata record holding the scenario of a run: keys `name`, `relaxation`,
+/// `allocator`, `controller_precision` and `toml` (the whole scenario as TOML).
+pub const METADATA_SCENARIO: &str = "tvmd.scenario";
+
+/// The scenario's `[log]` table: how much of a run its log keeps.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LogSettings {
+    /// Write the heavy diagnostics topics (`/planner`, `/control`, `/allocation`,
+    /// `/actuators`) at every `decimation`-th controller tick; 1 (every tick). `/state`,
+    /// `/reference`, `/lyapunov` and `/tf` are written every tick, `/hover` whenever it
+    /// changes, so the paper's plots keep their resolution.
+    pub decimation: usize,
+    /// Period of `/scene` messages (s), rounded to a multiple of the controller period; 0.05.
+    pub scene_period: f64,
+}
+
+impl Default for LogSettings {
+    fn default() -> Self {
+        Self {
+            decimation: 1,
+            scene_period: 0.05,
+        }
+    }
+}
+
+/// The message kinds of a simulation log (one channel each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LogKind {
+    /// True state ([`proto::State`]).
+    State,
+    /// Reference ([`proto::Reference`]).
+    Reference,
+    /// Planner diagnostics ([`proto::Planner`]).
+    Planner,
+    /// Control-law diagnostics ([`proto::Control`]).
+    Control,
+    /// Allocation diagnostics ([`proto::Allocation`]).
+    Allocation,
+    /// Actuators ([`proto::Actuators`]).
+    Actuators,
+    /// Lyapunov candidates ([`proto::Lyapunov`]).
+    Lyapunov,
+    /// Hover classification ([`proto::Hover`]).
+    Hover,
+    /// The team's pose (`foxglove.FrameTransform`).
+    FrameTransform,
+    /// The 3D scene (`foxglove.SceneUpdate`).
+    Scene,
+}
+
+impl LogKind {
+    /// All kinds, in channel order.
+    pub const ALL: [LogKind; 10] = [
+        LogKind::State,
+        LogKind::Reference,
+        LogKind::Planner,
+        LogKind::Control,
+        LogKind::Allocation,
+        LogKind::Actuators,
+        LogKind::Lyapunov,
+        LogKind::Hover,
+        LogKind::FrameTransform,
+        LogKind::Scene,
+    ];
+
+    /// The channel's topic.
+    pub fn topic(self) -> &'static str {
+        match self {
+            Self::State => "/state",
+            Self::Reference => "/reference",
+            Self::Planner => "/planner",
+            Self::Control => "/control",
+            Self::Allocation => "/allocation",
+            Self::Actuators => "/actuators",
+            Self::Lyapunov => "/lyapunov",
+            Self::Hover => "/hover",
+            Self::FrameTransform => "/tf",
+            Self::Scene => "/scene",
+        }
+    }
+
+    /// The protobuf message name of the channel's schema.
+    pub fn schema_name(self) -> &'static str {
+        use proto::ProtoName;
+        match self {
+            Self::State => proto::State::NAME,
+            Self::Reference => proto::Reference::NAME,
+            Self::Planner => proto::Planner::NAME,
+            Self::Control => proto::Control::NAME,
+            Self::Allocation => proto::Allocation::NAME,
+            Self::Actuators => proto::Actuators::NAME,
+            Self::Lyapunov => proto::Lyapunov::NAME,
+            Self::Hover => proto::Hover::NAME,
+            Self::FrameTransform => "foxglove.FrameTransform",
+            Self::Scene => "foxglove.SceneUpdate",
+        }
+    }
+
+    /// True for the topics [`LogSettings::decimation`] thins.
+    pub fn is_heavy(self) -> bool {
+        matches!(
+            self,
+            Self::Planner | Self::Control | Self::Allocation | Self::Actuators
+        )
+    }
+}
+
+/// One typed channel per topic, all in the log's context.
+struct Channels {
+    state: Channel<proto::State>,
+    reference: Channel<proto::Reference>,
+    planner: Channel<proto::Planner>,
+    control: Channel<proto::Control>,
+    allocation: Channel<proto::Allocation>,
+    actuators: Channel<proto::Actuators>,
+    lyapunov: Channel<proto::Lyapunov>,
+    hover: Channel<proto::Hover>,
+    tf: Channel<FrameTransform>,
+    scene: Channel<SceneUpdate>,
+}
+
+impl Channels {
+    fn new(ctx: &Arc<Context>) -> Self {
+        fn build<T: Encode>(ctx: &Arc<Context>, kind: LogKind) -> Channel<T> {
+            ctx.channel_builder(kind.topic()).build()
+        }
+        Self {
+            state: build(ctx, LogKind::State),
+            reference: build(ctx, LogKind::Reference),
+            planner: build(ctx, LogKind::Planner),
+            control: build(ctx, LogKind::Control),
+            allocation: build(ctx, LogKind::Allocation),
+            actuators: build(ctx, LogKind::Actuators),
+            lyapunov: build(ctx, LogKind::Lyapunov),
+            hover: build(ctx, LogKind::Hover),
+            tf: build(ctx, LogKind::FrameTransform),
+            scene: build(ctx, LogKind::Scene),
+        }
+    }
+}
+
+/// A message the log can write: which channel it goes to.
+pub trait LogMessage: Encode + Sized {
+    /// Its kind.
+    const KIND: LogKind;
+    #[doc(hidden)]
+    fn log(&self, channels: &LogChannels, nanos: u64);
+}
+
+/// The channels of a [`RunLog`] (opaque; used by [`LogMessage`]).
+pub struct LogChannels(Channels);
+
+macro_rules! log_message {
+    ($ty:ty, $kind:ident, $field:ident) => {
+        impl LogMessage for $ty {
+            const KIND: LogKind = LogKind::$kind;
+            fn log(&self, channels: &LogChannels, nanos: u64) {
+                channels.0.$field.log_with_time(self, nanos);
+            }
+        }
+    };
+}
+
+log_message!(proto::State, State, state);
+log_message!(proto::Reference, Reference, reference);
+log_message!(proto::Planner, Planner, planner);
+log_message!(proto::Control, Control, control);
+log_message!(proto::Allocation, Allocation, allocation);
+log_message!(proto::Actuators, Actuators, actuators);
+log_message!(proto::Lyapunov, Lyapunov, lyapunov);
+log_message!(proto::Hover, Hover, hover);
+log_message!(FrameTransform, FrameTransform, tf);
+log_message!(SceneUpdate, Scene, scene);
+
+type McapFile = McapWriterHandle<BufWriter<File>>;
+
+/// The log of one run: its own Foxglove context with every channel, and its sinks (an MCAP
+/// file, a live server, or both).
+pub struct RunLog {
+    channels: LogChannels,
+    mcap: Option<McapFile>,
+    live: Option<LiveServer>,
+    messages: u64,
+    finished: bool,
+    // Dropped last: the channels and sinks belong to it.
+    context: Arc<Context>,
+}
+
+impl RunLog {
+    /// A log with no sink yet (messages go nowhere until one is added).
+    pub fn new() -> Self {
+        let context = Context::new();
+        Self {
+            channels: LogChannels(Channels::new(&context)),
+            mcap: None,
+            live: None,
+            messages: 0,
+            finished: false,
+            context,
+        }
+    }
+
+    /// A log writing to a new MCAP file at `path` (truncated; parent directories created).
+    /// I/O errors name the path ([`SimError::File`]).
+    pub fn create(path: impl AsRef<Path>) -> Result<Self, SimError> {
+        let mut log = Self::new();
+        log.add_mcap(path)?;
+        Ok(log)
+    }
+
+    /// Adds an MCAP file sink at `path` (at most one per log).
+    pub fn add_mcap(&mut self, path: impl AsRef<Path>) -> Result<(), SimError> {
+        let path = path.as_ref();
+        const ACTION: &str = "write the MCAP log";
+        if self.mcap.is_some() {
+            return Err(SimError::InvalidArgument {
+                name: "log".into(),
+                reason: "the run already writes an MCAP file".into(),
+            });
+        }
+        crate::paths::create_parent(path, ACTION)?;
+        let file = BufWriter::new(File::create(path).map_err(SimError::file(ACTION, path))?);
+        let options = foxglove::McapWriteOptions::new()
+            .profile("")
+            .library(concat!("tvmd-sim ", env!("CARGO_PKG_VERSION")));
+        let handle = self
+            .context
+            .mcap_writer_with_options(options)
+            .create(file)
+            .map_err(SimError::foxglove)?;
+        self.mcap = Some(handle);
+        Ok(())
+    }
+
+    /// Starts a live server on this log's context ([`LiveServer`]); returns its address.
+    pub fn serve(&mut self, options: &LiveOptions) -> Result<std::net::SocketAddr, SimError> {
+        let server = LiveServer::start(&self.context, options)?;
+        let addr = server.address();
+        self.live = Some(server);
+        Ok(addr)
+    }
+
+    /// The live server, if one was started.
+    pub fn live(&self) -> Option<&LiveServer> {
+        self.live.as_ref()
+    }
+
+    /// With a live server, publishes `t` and holds the run to its pace
+    /// ([`LiveServer::pace`]); otherwise returns at once.
+    pub fn pace(&mut self, t: f64) {
+        if let Some(live) = self.live.as_mut() {
+            live.pace(t);
+        }
+    }
+
+    /// Writes an MCAP metadata record `name` with string key/value pairs (for example the
+    /// scenario, see [`METADATA_SCENARIO`]); a no-op without an MCAP file.
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        values: BTreeMap<String, String>,
+    ) -> Result<(), SimError> {
+        if self.finished {
+            return Err(SimError::LogFinished);
+        }
+        match &self.mcap {
+            Some(m) => m.write_metadata(name, values).map_err(SimError::foxglove),
+            None => Ok(()),
+        }
+    }
+
+    /// Number of messages written so far.
+    pub fn message_count(&self) -> u64 {
+        self.messages
+    }
+
+    /// Writes `msg` at simulation time `t` (s) on its channel.
+    pub fn write<M: LogMessage>(&mut self, t: f64, msg: &M) -> Result<(), SimError> {
+        if self.finished {
+            return Err(SimError::LogFinished);
+        }
+        msg.log(&self.channels, nanos(t));
+        self.messages += 1;
+        Ok(())
+    }
+
+    /// Writes the pose of frame `team` in frame `world` (`foxglove.FrameTransform`).
+    pub fn write_frame_transform(
+        &mut self,
+        t: f64,
+        position: &Vector3<f64>,
+        rotation: &Matrix3<f64>,
+    ) -> Result<(), SimError> {
+        let msg = FrameTransform {
+            timestamp: Some(timestamp(t)),
+            parent_frame_id: "world".into(),
+            child_frame_id: "team".into(),
+            translation: Some(fg_vector(position)),
+            rotation: Some(fg_quaternion(&UnitQuaternion::from_matrix(rotation))),
+        };
+        self.write(t, &msg)
+    }
+
+    /// Finalises the MCAP file (summary, footer, flush) and stops the live server. Further
+    /// writes fail with [`SimError::LogFinished`]; calling `finish` again is a no-op.
+    pub fn finish(&mut self) -> Result<(), SimError> {
+        if self.finished {
+            return Ok(());
+        }
+        self.finished = true;
+        if let Some(live) = self.live.take() {
+            live.stop();
+        }
+        if let Some(m) = self.mcap.take() {
+            let mut file = m.close().map_err(SimError::foxglove)?;
+            file.flush()?;
+        }
+        Ok(())
+    }
+}
+
+impl Default for RunLog {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Drop for RunLog {
+    fn drop(&mut self) {
+        // Best effort: finalise so the file stays a valid MCAP even on an error path.
+        let _ = self.finish();
+    }
+}
+
+/// `t` (s) as non-negative nanoseconds (0 for negative or non-finite times).
+pub fn nanos(t: f64) -> u64 {
+    if t.is_finite() && t > 0.0 {
+        (t * 1e9).round() as u64
+    } else {
+        0
+    }
+}
+
+/// `t` (s) as a Foxglove timestamp.
+pub fn timestamp(t: f64) -> foxglove::messages::Timestamp {
+    let ns = nanos(t);
+    foxglove::messages::Timestamp::new(
+        u32::try_from(ns / 1_000_000_000).unwrap_or(u32::MAX),
+        (ns % 1_000_000_000) as u32,
+    )
+}
+
+/// A nalgebra vector as `foxglove.Vector3`.
+pub fn fg_vector(v: &Vector3<f64>) -> FgVector3 {
+    FgVector3 {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    }
+}
+
+/// A unit quaternion as `foxglove.Quaternion`.
+pub fn fg_quaternion(q: &UnitQuaternion<f64>) -> Quaternion {
+    Quaternion {
+        x: q.i,
+        y: q.j,
+        z: q.k,
+        w: q.w,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_name_their_topics_and_schemas_once() {
+        let topics: std::collections::BTreeSet<_> =
+            LogKind::ALL.iter().map(|k| k.topic()).collect();
+        assert_eq!(topics.len(), LogKind::ALL.len());
+        assert_eq!(LogKind::State.schema_name(), "tvmd.State");
+        assert_eq!(LogKind::Scene.schema_name(), "foxglove.SceneUpdate");
+        assert!(LogKind::Allocation.is_heavy() && !LogKind::State.is_heavy());
+    }
+
+    #[test]
+    fn times_become_nanoseconds() {
+        assert_eq!(nanos(1.5), 1_500_000_000);
+        assert_eq!(nanos(-1.0), 0);
+        assert_eq!(nanos(f64::NAN), 0);
+        let ts = timestamp(2.25);
+        assert_eq!((ts.sec(), ts.nsec()), (2, 250_000_000));
+    }
+
+    #[test]
+    fn a_finished_log_refuses_writes() {
+        let mut log = RunLog::new();
+        log.finish().unwrap();
+        let msg = proto::Lyapunov::default();
+        assert!(matches!(log.write(0.0, &msg), Err(SimError::LogFinished)));
+        log.finish().unwrap();
+    }
+}
