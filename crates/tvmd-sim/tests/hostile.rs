@@ -211,6 +211,10 @@ fn extreme_scenarios_are_refused_naming_the_field() {
         "physics.solver_iterations",
     );
     rejects("[physics]\ngravity = 1e300\n", "physics.gravity");
+    rejects("[log]\ndecimation = 0\n", "log.decimation");
+    rejects("[log]\ndecimation = 1000000000\n", "log.decimation");
+    rejects("[log]\nscene_period = nan\n", "log.scene_period");
+    rejects("[log]\nscene_period = 0.0\n", "log.scene_period");
     rejects("[team]\nagent_mass = 1e300\n", "team.agent_mass");
     rejects("[team]\nagent_mass = 1e-300\n", "team.agent_mass");
     rejects(

@@ -125,3 +125,29 @@ fn a_client_receives_the_live_run() {
     assert!(status.success(), "{status}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bad_live_options_are_refused_before_the_flight() {
+    for (args, name) in [
+        (["--live-speed", "0"], "live speed"),
+        (["--live-wait", "nan"], "live wait"),
+        (["--live-host", "not a host name"], "live"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_tvmd-sim"))
+            .args([
+                "run",
+                "paper-tilt",
+                "--no-log",
+                "--live",
+                "--live-port",
+                "0",
+            ])
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(&format!("`{name}`")), "{args:?}: {stderr}");
+        assert!(!String::from_utf8_lossy(&out.stdout).contains("live:"));
+    }
+}

@@ -44,7 +44,7 @@ impl Landing {
     }
 
     /// Whether the team has touched down at time `t`: the reference is down and the team's
-    /// centre of mass is within [`TOUCHDOWN_HEIGHT`] of the rest height.
+    /// centre of mass is within `TOUCHDOWN_HEIGHT` (0.05 m) of the rest height.
     pub fn touched_down(&self, t: f64, position: &Vector3<f64>) -> bool {
         t >= self.touchdown_time() && position.z <= TOUCHDOWN_HEIGHT
     }

@@ -1,6 +1,6 @@
 //! The protobuf schema of the numeric topics, `tvmd/log.proto` (package `tvmd`).
 //!
-//! Each message is declared once, in [`proto_messages!`]: as a prost struct with fixed field
+//! Each message is declared once, in `proto_messages!`: as a prost struct with fixed field
 //! numbers (so a log stays readable by every later version) and as its descriptor. Every
 //! channel carries the whole file as its MCAP schema (`encoding = "protobuf"`, a serialized
 //! `google.protobuf.FileDescriptorSet`), which is how Foxglove and the Python `mcap-protobuf`
