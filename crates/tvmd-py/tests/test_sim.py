@@ -402,6 +402,10 @@ def test_relaxation_sweep_mcap_dir(tmp_path):
     for r, s in zip(results, ("0.25", "1")):
         assert r.mcap_path == str(tmp_path / f"paper-tilt-s{s}.mcap")
         _check_mcap(r.mcap_path)
+        # Parallel runs log through their own Foxglove contexts: each file holds its run only.
+        states = _decode_all(r.mcap_path)["/state"]
+        assert len(states) == len(r.t)
+        np.testing.assert_allclose([list(m.position) for _, m in states], r.position, atol=1e-12)
 
 
 # ---------------------------------------------------------------------------

@@ -300,10 +300,11 @@ pub struct PhysicsConfig {
     pub friction: f64,
     /// Number of rapier solver iterations (substeps) per step; default 1. More substeps
     /// make the free flight's symplectic-Euler integration finer (its position error is
-    /// about `dt / (2 n)` times the velocity change) and cost about 10% of a flight each,
-    /// ground contact 40% each (BENCHMARKS.md); the paper's metrics move by less than
-    /// `5e-5` from 1 to 4. The number is the same in the air and on the ground: switching
-    /// it near the ground made flights differ at touchdown by far more than that.
+    /// about `dt / (2 n)` times the velocity change) but re-solve every ground contact each
+    /// time: 4 cost `paper-tilt` about 50% more instructions than 1, for reproduction metrics
+    /// that differ by at most 3.4e-5 m (BENCHMARKS.md). The number is the same in the air and
+    /// on the ground: switching it near the ground made flights differ at touchdown by far
+    /// more than that.
     pub solver_iterations: usize,
 }
 

@@ -152,7 +152,7 @@ pub fn fly_live(
         samples: spec.samples,
     };
     let mut sim = Simulation::with_options(scenario, options)?;
-    let mut mcap = match (spec.log.as_deref(), &live) {
+    let mut log = match (spec.log.as_deref(), &live) {
         (None, None) => None,
         (path, _) => {
             let mut l = RunLog::new();
@@ -163,7 +163,7 @@ pub fn fly_live(
             Some(l)
         }
     };
-    if let (Some(view), Some(log)) = (live, mcap.as_mut()) {
+    if let (Some(view), Some(log)) = (live, log.as_mut()) {
         let address = log.serve(&view.options)?;
         (view.on_listen)(address);
         if let Some(server) = log.live() {
@@ -173,12 +173,12 @@ pub fn fly_live(
     let run = match progress {
         Some(p) => sim.run_until(
             &mut WithProgress::new(&mut controller, p),
-            mcap.as_mut(),
+            log.as_mut(),
             cancel,
         ),
-        None => sim.run_until(&mut controller, mcap.as_mut(), cancel),
+        None => sim.run_until(&mut controller, log.as_mut(), cancel),
     };
-    let finished = mcap.as_mut().map_or(Ok(()), RunLog::finish);
+    let finished = log.as_mut().map_or(Ok(()), RunLog::finish);
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
         (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),

@@ -224,6 +224,8 @@ def run(
         toml: inline TOML scenario text instead of ``scenario`` (fields left out take the
             paper-tilt defaults; see ``scenario_toml("paper-tilt")``).
         mcap: write an MCAP log there (parent directories are created; open it in Foxglove).
+            Every channel is protobuf with its schema in the file; read it with ``mcap`` and
+            ``mcap-protobuf-support``: ``make_reader(f, decoder_factories=[DecoderFactory()])``.
         relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
         allocator: override the allocator ("exact-boundary-redistribution", the default;
             "redistributed-pseudo-inverse", the paper's; "pseudo-inverse",
