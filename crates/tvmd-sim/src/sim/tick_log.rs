@@ -10,7 +10,7 @@ use crate::diagnostics::{
 };
 use crate::flight::FlightOutput;
 use crate::log::proto::{self, Vec3};
-use crate::log::RunLog;
+use crate::log::{LogMessage, RunLog};
 use crate::math::{from_rows, roll_pitch_yaw};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
@@ -123,6 +123,22 @@ fn hover(t: f64, h: &HoverDiagnostics) -> proto::Hover {
     }
 }
 
+/// Writes the message `build` makes unless its kind is thinned on this tick: a heavy kind
+/// ([`crate::log::LogKind::is_heavy`], the one list of them) is written only on `heavy` ticks, and is not
+/// even built otherwise.
+fn write_thinned<M: LogMessage>(
+    log: &mut RunLog,
+    t: f64,
+    heavy: bool,
+    build: impl FnOnce() -> M,
+) -> Result<(), SimError> {
+    if heavy || !M::KIND.is_heavy() {
+        log.write(t, &build())
+    } else {
+        Ok(())
+    }
+}
+
 impl Tick<'_> {
     /// Writes the tick's messages (everything but `/scene`); the heavy topics
     /// ([`crate::log::LogKind::is_heavy`]) only when `heavy`.
@@ -162,29 +178,25 @@ impl Tick<'_> {
             },
         )?;
         let d = &self.output.diagnostics;
-        if heavy {
-            if let Some(p) = &d.planner {
-                log.write(t, &planner(t, p))?;
-            }
-            if let Some(c) = &d.control {
-                log.write(t, &control(t, c))?;
-            }
-            if let Some(a) = &d.allocation {
-                log.write(t, &allocation(t, a))?;
-            }
-            log.write(
-                t,
-                &proto::Actuators {
-                    t,
-                    commanded: self.output.commands.iter().map(command).collect(),
-                    actual: self.actual.iter().map(command).collect(),
-                    failed: self.failed.to_vec(),
-                    forces_body: self.forces_body.iter().map(Vec3::of).collect(),
-                },
-            )?;
+        if let Some(p) = &d.planner {
+            write_thinned(log, t, heavy, || planner(t, p))?;
         }
+        if let Some(c) = &d.control {
+            write_thinned(log, t, heavy, || control(t, c))?;
+        }
+        if let Some(a) = &d.allocation {
+            write_thinned(log, t, heavy, || allocation(t, a))?;
+        }
+        write_thinned(log, t, heavy, || proto::Actuators {
+            t,
+            commanded: self.output.commands.iter().map(command).collect(),
+            actual: self.actual.iter().map(command).collect(),
+            failed: self.failed.to_vec(),
+            forces_body: self.forces_body.iter().map(Vec3::of).collect(),
+        })?;
         if d.cycle_error.is_some() || d.failure_note.is_some() {
-            // A skipped cycle has no law output: say why on the control channel, every time.
+            // A skipped cycle has no law output: say why on the control channel, every time
+            // (never thinned).
             log.write(
                 t,
                 &proto::Control {
