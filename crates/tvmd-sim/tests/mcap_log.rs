@@ -84,7 +84,7 @@ fn write_small(log: &mut RunLog) {
             v_x: 1.0,
             v_r: 2.0,
         };
-        log.write(t, &msg).unwrap();
+        log.write(t, msg).unwrap();
         log.write_frame_transform(t, &Vector3::new(0.0, 0.0, t), &rot_x(0.1))
             .unwrap();
         let f = vec![Vector3::new(0.0, 1.0, 7.0); 4];
@@ -98,9 +98,9 @@ fn small_log_reads_back() {
     let path = tmp("small.mcap");
     let mut log = RunLog::create(&path).unwrap();
     write_small(&mut log);
-    assert_eq!(log.message_count(), 9);
     log.finish().unwrap();
-    assert!(log.write(1.0, &proto::State::default()).is_err());
+    assert_eq!(log.message_count(), 9);
+    assert!(log.write(1.0, proto::State::default()).is_err());
     let bytes = std::fs::read(&path).unwrap();
     let summary = Summary::read(&bytes).unwrap().expect("summary present");
     // The channels that carried messages: /lyapunov, /tf and /scene.

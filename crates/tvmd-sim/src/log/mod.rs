@@ -21,17 +21,20 @@
 //!
 //! Every message carries the simulation time `t` (s) as its MCAP log and publish time (ns).
 //! Each [`RunLog`] logs through its own `foxglove::Context`, so runs in parallel never share a
-//! sink. The file is finalised by [`RunLog::finish`] and, if that was not called (an error or
+//! sink, and builds and writes its messages on its own thread ([`writer`]), in the order they
+//! were handed to it. The file is finalised by [`RunLog::finish`] and, if that was not called (an error or
 //! a panic unwound the caller), by `Drop`, so it is never left truncated.
 
 pub mod live;
 pub mod proto;
 pub mod scene;
+pub mod writer;
 
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use foxglove::messages::{FrameTransform, Quaternion, SceneUpdate, Vector3 as FgVector3};
@@ -42,6 +45,9 @@ use serde::{Deserialize, Serialize};
 use crate::SimError;
 
 pub use live::{LiveOptions, LiveServer};
+pub use writer::{LogJob, QUEUE_JOBS};
+
+use writer::{LogWriter, Written};
 
 /// Name of the metadata record holding the scenario of a run: keys `name`, `relaxation`,
 /// `allocator`, `controller_precision` and `toml` (the whole scenario as TOML).
@@ -186,22 +192,25 @@ impl Channels {
 }
 
 /// A message the log can write: which channel it goes to.
-pub trait LogMessage: Encode + Sized {
+pub trait LogMessage: Encode + Send + Sized + 'static {
     /// Its kind.
     const KIND: LogKind;
     #[doc(hidden)]
     fn log(&self, channels: &LogChannels, nanos: u64);
 }
 
-/// The channels of a [`RunLog`] (opaque; used by [`LogMessage`]).
-pub struct LogChannels(Channels);
+/// The channels of a [`RunLog`], owned by its writer thread: a [`LogJob`] writes through them.
+pub struct LogChannels {
+    channels: Channels,
+    written: Written,
+}
 
 macro_rules! log_message {
     ($ty:ty, $kind:ident, $field:ident) => {
         impl LogMessage for $ty {
             const KIND: LogKind = LogKind::$kind;
             fn log(&self, channels: &LogChannels, nanos: u64) {
-                channels.0.$field.log_with_time(self, nanos);
+                channels.channels.$field.log_with_time(self, nanos);
             }
         }
     };
@@ -223,10 +232,12 @@ type McapFile = McapWriterHandle<BufWriter<File>>;
 /// The log of one run: its own Foxglove context with every channel, and its sinks (an MCAP
 /// file, a live server, or both).
 pub struct RunLog {
-    channels: LogChannels,
+    // The channels until the writer thread starts (with the first message), then the thread.
+    channels: Option<LogChannels>,
+    writer: Option<LogWriter>,
+    written: Written,
     mcap: Option<McapFile>,
     live: Option<LiveServer>,
-    messages: u64,
     finished: bool,
     // Dropped last: the channels and sinks belong to it.
     context: Arc<Context>,
@@ -236,11 +247,16 @@ impl RunLog {
     /// A log with no sink yet (messages go nowhere until one is added).
     pub fn new() -> Self {
         let context = Context::new();
+        let written = Written::default();
         Self {
-            channels: LogChannels(Channels::new(&context)),
+            channels: Some(LogChannels {
+                channels: Channels::new(&context),
+                written: written.clone(),
+            }),
+            writer: None,
+            written,
             mcap: None,
             live: None,
-            messages: 0,
             finished: false,
             context,
         }
@@ -315,19 +331,34 @@ impl RunLog {
         }
     }
 
-    /// Number of messages written so far.
+    /// Number of messages written so far by the writer thread; after [`RunLog::finish`], all
+    /// of them.
     pub fn message_count(&self) -> u64 {
-        self.messages
+        self.written.load(Ordering::Relaxed)
     }
 
-    /// Writes `msg` at simulation time `t` (s) on its channel.
-    pub fn write<M: LogMessage>(&mut self, t: f64, msg: &M) -> Result<(), SimError> {
+    /// Queues `job` for the log's writer thread, which builds and writes its messages there
+    /// ([`writer`]); waits while [`QUEUE_JOBS`] jobs are queued.
+    pub fn submit(
+        &mut self,
+        job: impl FnOnce(&mut LogChannels) + Send + 'static,
+    ) -> Result<(), SimError> {
         if self.finished {
             return Err(SimError::LogFinished);
         }
-        msg.log(&self.channels, nanos(t));
-        self.messages += 1;
-        Ok(())
+        if let Some(channels) = self.channels.take() {
+            self.writer = Some(LogWriter::start(channels)?);
+        }
+        match &self.writer {
+            Some(w) => w.submit(Box::new(job)),
+            None => Err(SimError::LogFinished),
+        }
+    }
+
+    /// Writes `msg` at simulation time `t` (s) on its channel (on the writer thread, after
+    /// every message queued before it).
+    pub fn write<M: LogMessage>(&mut self, t: f64, msg: M) -> Result<(), SimError> {
+        self.submit(move |w| w.write(t, &msg))
     }
 
     /// Writes the pose of frame `team` in frame `world` (`foxglove.FrameTransform`).
@@ -337,23 +368,21 @@ impl RunLog {
         position: &Vector3<f64>,
         rotation: &Matrix3<f64>,
     ) -> Result<(), SimError> {
-        let msg = FrameTransform {
-            timestamp: Some(timestamp(t)),
-            parent_frame_id: "world".into(),
-            child_frame_id: "team".into(),
-            translation: Some(fg_vector(position)),
-            rotation: Some(fg_quaternion(&UnitQuaternion::from_matrix(rotation))),
-        };
-        self.write(t, &msg)
+        let (position, rotation) = (*position, *rotation);
+        self.submit(move |w| w.write(t, &frame_transform(t, &position, &rotation)))
     }
 
-    /// Finalises the MCAP file (summary, footer, flush) and stops the live server. Further
-    /// writes fail with [`SimError::LogFinished`]; calling `finish` again is a no-op.
+    /// Waits for the writer thread to write everything queued, finalises the MCAP file
+    /// (summary, footer, flush) and stops the live server. Further writes fail with
+    /// [`SimError::LogFinished`]; calling `finish` again is a no-op. A job that panicked on the
+    /// writer thread is reported here ([`SimError::Foxglove`]), after the file is finalised.
     pub fn finish(&mut self) -> Result<(), SimError> {
         if self.finished {
             return Ok(());
         }
         self.finished = true;
+        self.channels = None;
+        let drained = self.writer.take().map_or(Ok(()), LogWriter::stop);
         if let Some(live) = self.live.take() {
             live.stop();
         }
@@ -361,7 +390,7 @@ impl RunLog {
             let mut file = m.close().map_err(SimError::foxglove)?;
             file.flush()?;
         }
-        Ok(())
+        drained
     }
 }
 
@@ -375,6 +404,17 @@ impl Drop for RunLog {
     fn drop(&mut self) {
         // Best effort: finalise so the file stays a valid MCAP even on an error path.
         let _ = self.finish();
+    }
+}
+
+/// The pose of frame `team` in frame `world` at `t` as `foxglove.FrameTransform`.
+pub fn frame_transform(t: f64, position: &Vector3<f64>, rotation: &Matrix3<f64>) -> FrameTransform {
+    FrameTransform {
+        timestamp: Some(timestamp(t)),
+        parent_frame_id: "world".into(),
+        child_frame_id: "team".into(),
+        translation: Some(fg_vector(position)),
+        rotation: Some(fg_quaternion(&crate::math::rotation_quaternion(rotation))),
     }
 }
 
@@ -443,7 +483,7 @@ mod tests {
         let mut log = RunLog::new();
         log.finish().unwrap();
         let msg = proto::Lyapunov::default();
-        assert!(matches!(log.write(0.0, &msg), Err(SimError::LogFinished)));
+        assert!(matches!(log.write(0.0, msg), Err(SimError::LogFinished)));
         log.finish().unwrap();
     }
 }

@@ -113,7 +113,8 @@ pub fn team_scene(
 }
 
 impl RunLog {
-    /// Writes [`team_scene`] on `/scene`.
+    /// Writes [`team_scene`] on `/scene` (built on the writer thread from copies of the
+    /// arguments).
     pub fn write_scene(
         &mut self,
         t: f64,
@@ -122,7 +123,10 @@ impl RunLog {
         failed: &[bool],
         max_thrust: f64,
     ) -> Result<(), SimError> {
-        self.write(t, &team_scene(t, team, forces_body, failed, max_thrust))
+        let (team, forces_body, failed) = (team.clone(), forces_body.to_vec(), failed.to_vec());
+        self.submit(move |w| {
+            w.write(t, &team_scene(t, &team, &forces_body, &failed, max_thrust));
+        })
     }
 }
 

@@ -372,25 +372,26 @@ impl Simulation {
                 self.fold.push(&sample);
                 self.samples.push(tick, || sample);
                 if let Some(log) = log.as_deref_mut() {
-                    let forces_body = self.forces(&actual);
-                    let tick_log = tick_log::Tick {
+                    // The scene shows the commanded forces: at a tick the actual ones still lag
+                    // by one period.
+                    let scene_forces =
+                        (tick % scene_every == 0).then(|| self.forces(&out.commands));
+                    let heavy = tick % heavy_every == 0;
+                    let record = tick_log::Tick {
                         t,
-                        state: &truth,
-                        reference: &reference,
-                        output: &out,
-                        actual: &actual,
-                        forces_body: &forces_body,
-                        failed: &self.failed_true,
+                        state: truth,
+                        reference,
+                        forces_body: self.forces(&actual),
+                        output: out,
+                        actual,
+                        failed: self.failed_true.clone(),
                     };
-                    tick_log.write(log, tick % heavy_every == 0)?;
-                    if tick % scene_every == 0 {
-                        // Show the commanded forces: at a tick the actual ones still lag by one
-                        // period.
-                        let cmd_forces = self.forces(&out.commands);
+                    log.submit(move |w| record.write(w, heavy))?;
+                    if let Some(forces) = scene_forces {
                         log.write_scene(
                             t,
                             &self.team,
-                            &cmd_forces,
+                            &forces,
                             &self.failed_true,
                             self.max_thrust,
                         )?;

@@ -1,8 +1,9 @@
 //! What the loop logs at each controller tick: the messages of one tick (`/state`,
 //! `/reference`, the diagnostics channels, `/actuators`, `/tf`), built from the loop's values
-//! as the protobuf messages of [`crate::log::proto`].
+//! as the protobuf messages of [`crate::log::proto`]. The loop hands a [`Tick`] (owned values)
+//! to the log's writer thread ([`crate::log::writer`]), which builds and writes them there.
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::actuators::ActuatorCommand;
 use crate::diagnostics::{
@@ -10,28 +11,27 @@ use crate::diagnostics::{
 };
 use crate::flight::FlightOutput;
 use crate::log::proto::{self, Vec3};
-use crate::log::{LogMessage, RunLog};
-use crate::math::{from_rows, roll_pitch_yaw};
+use crate::log::{frame_transform, LogChannels, LogMessage};
+use crate::math::{from_rows, roll_pitch_yaw, rotation_quaternion};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
-use crate::SimError;
 
 /// The values of one tick to log.
-pub struct Tick<'a> {
+pub struct Tick {
     /// Time (s).
     pub t: f64,
     /// True state.
-    pub state: &'a PlantState,
+    pub state: PlantState,
     /// Reference.
-    pub reference: &'a ReferenceSample,
+    pub reference: ReferenceSample,
     /// The controller's output.
-    pub output: &'a FlightOutput,
+    pub output: FlightOutput,
     /// Actual actuator outputs.
-    pub actual: &'a [ActuatorCommand],
+    pub actual: Vec<ActuatorCommand>,
     /// Body-frame forces of the actual outputs.
-    pub forces_body: &'a [Vector3<f64>],
+    pub forces_body: Vec<Vector3<f64>>,
     /// True failure flags.
-    pub failed: &'a [bool],
+    pub failed: Vec<bool>,
 }
 
 fn v(x: &Vector3<f64>) -> Vec<f64> {
@@ -127,24 +127,22 @@ fn hover(t: f64, h: &HoverDiagnostics) -> proto::Hover {
 /// ([`crate::log::LogKind::is_heavy`], the one list of them) is written only on `heavy` ticks, and is not
 /// even built otherwise.
 fn write_thinned<M: LogMessage>(
-    log: &mut RunLog,
+    log: &mut LogChannels,
     t: f64,
     heavy: bool,
     build: impl FnOnce() -> M,
-) -> Result<(), SimError> {
+) {
     if heavy || !M::KIND.is_heavy() {
-        log.write(t, &build())
-    } else {
-        Ok(())
+        log.write(t, &build());
     }
 }
 
-impl Tick<'_> {
+impl Tick {
     /// Writes the tick's messages (everything but `/scene`); the heavy topics
     /// ([`crate::log::LogKind::is_heavy`]) only when `heavy`.
-    pub fn write(self, log: &mut RunLog, heavy: bool) -> Result<(), SimError> {
-        let (t, s, r) = (self.t, self.state, self.reference);
-        let q = UnitQuaternion::from_matrix(&s.rotation);
+    pub fn write(self, log: &mut LogChannels, heavy: bool) {
+        let (t, s, r) = (self.t, &self.state, &self.reference);
+        let q = rotation_quaternion(&s.rotation);
         log.write(
             t,
             &proto::State {
@@ -162,7 +160,7 @@ impl Tick<'_> {
                 roll_pitch_yaw: roll_pitch_yaw(&s.rotation).to_vec(),
                 omega: v(&s.omega),
             },
-        )?;
+        );
         log.write(
             t,
             &proto::Reference {
@@ -176,16 +174,16 @@ impl Tick<'_> {
                 roll_rate: r.roll_rate,
                 roll_pitch_yaw: roll_pitch_yaw(&r.rotation).to_vec(),
             },
-        )?;
+        );
         let d = &self.output.diagnostics;
         if let Some(p) = &d.planner {
-            write_thinned(log, t, heavy, || planner(t, p))?;
+            write_thinned(log, t, heavy, || planner(t, p));
         }
         if let Some(c) = &d.control {
-            write_thinned(log, t, heavy, || control(t, c))?;
+            write_thinned(log, t, heavy, || control(t, c));
         }
         if let Some(a) = &d.allocation {
-            write_thinned(log, t, heavy, || allocation(t, a))?;
+            write_thinned(log, t, heavy, || allocation(t, a));
         }
         write_thinned(log, t, heavy, || proto::Actuators {
             t,
@@ -193,7 +191,7 @@ impl Tick<'_> {
             actual: self.actual.iter().map(command).collect(),
             failed: self.failed.to_vec(),
             forces_body: self.forces_body.iter().map(Vec3::of).collect(),
-        })?;
+        });
         if d.cycle_error.is_some() || d.failure_note.is_some() {
             // A skipped cycle has no law output: say why on the control channel, every time
             // (never thinned).
@@ -205,7 +203,7 @@ impl Tick<'_> {
                     failure_note: d.failure_note.clone().unwrap_or_default(),
                     ..Default::default()
                 },
-            )?;
+            );
         }
         if let Some(l) = &d.lyapunov {
             log.write(
@@ -215,12 +213,12 @@ impl Tick<'_> {
                     v_x: l.v_x,
                     v_r: l.v_r,
                 },
-            )?;
+            );
         }
         if let Some(h) = &d.hover {
-            log.write(t, &hover(t, h))?;
+            log.write(t, &hover(t, h));
         }
-        log.write_frame_transform(t, &s.position, &s.rotation)
+        log.write(t, &frame_transform(t, &s.position, &s.rotation));
     }
 }
 
