@@ -1,8 +1,9 @@
 //! Speed of the simulator (issue 19): the real-time factor of the 16 s `paper-tilt` flight (rapier
 //! at 1 kHz, the tvmd controller at 100 Hz) with and without its MCAP log, the coarse-step mode
-//! (`physics.dt = 0.002`), flights per second for a batch on every core, and the floor: a bare
-//! rapier world like the simulator's (one dynamic body of five balls over a cuboid ground) stepped
-//! alone.
+//! (`physics.dt = 0.002`), flights per second for a batch on every core, and two floors: a bare
+//! rapier world like the issue's (one dynamic body of five balls over a cuboid ground) stepped
+//! alone, and the simulator's own `PhysicsWorld` stepped alone, hovering and resting on the
+//! ground.
 //!
 //! `cargo bench -p tvmd-sim --bench paper_tilt`; after criterion's report it prints one line per
 //! case, `RTF = simulated time / median wall time`.
@@ -11,11 +12,14 @@ use std::cell::RefCell;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use nalgebra::Vector3;
 use rapier3d_f64::prelude::{ColliderBuilder, IntegrationParameters, RigidBodyBuilder};
 use rapier3d_f64::{math as rm, pipeline::PhysicsWorld};
+use tvmd_sim::physics::{ExtraWrench, PhysicsWorld as TvmdWorld, PlantState};
 use tvmd_sim::runner::{fly, run_many, worker_count, RunSpec};
 use tvmd_sim::scenario::Scenario;
 use tvmd_sim::sim::SampleRetention;
+use tvmd_sim::GRAVITY;
 
 fn spec(scenario: &Scenario, log: Option<std::path::PathBuf>) -> RunSpec {
     RunSpec {
@@ -89,6 +93,8 @@ fn bare_world(iterations: usize) -> PhysicsWorld {
     world
 }
 
+const STEPS: usize = 16_000;
+
 fn speed(c: &mut Criterion) {
     let scenario = Scenario::builtin("paper-tilt").expect("built-in scenario");
     let mut coarse = scenario.clone();
@@ -117,7 +123,6 @@ fn speed(c: &mut Criterion) {
         }
     });
 
-    const STEPS: usize = 16_000;
     let mut floors = Vec::new();
     for iterations in [4, 1] {
         let name = format!("bare_rapier_16000_steps_{iterations}_iterations");
@@ -129,6 +134,28 @@ fn speed(c: &mut Criterion) {
             std::hint::black_box(&world.bodies);
         });
         floors.push((iterations, t));
+    }
+
+    // The simulator's own world (one body, the compound collider, gyroscopic terms, a wrench
+    // applied every step) hovering in the air, and resting on the ground: the physics part of a
+    // flight without the controller and the loop.
+    let team = scenario.team_body().expect("paper-tilt team");
+    let hover = vec![Vector3::new(0.0, 0.0, team.mass() * GRAVITY / team.len() as f64); 4];
+    let mut own = Vec::new();
+    for (name, z, forces) in [
+        ("hovering", 1.5, hover),
+        ("resting_on_the_ground", 0.0, vec![Vector3::zeros(); 4]),
+    ] {
+        let t = time_flights(c, &format!("tvmd_world_16000_steps_{name}"), || {
+            let at = PlantState::at_rest(Vector3::new(0.0, 0.0, z));
+            let mut world = TvmdWorld::new(&team, &scenario.physics, &at).expect("world");
+            let extra = ExtraWrench::default();
+            for _ in 0..STEPS {
+                world.step(&forces, &extra).expect("step");
+            }
+            std::hint::black_box(world.state());
+        });
+        own.push((name, t));
     }
 
     let d = scenario.duration;
@@ -159,6 +186,13 @@ fn speed(c: &mut Criterion) {
              real time at most",
             t / STEPS as f64 * 1e6,
             1e-3 * STEPS as f64 / t
+        );
+    }
+    for (name, t) in own {
+        println!(
+            "tvmd-sim world {}: {:.2} us per 1 ms step",
+            name.replace('_', " "),
+            t / STEPS as f64 * 1e6
         );
     }
     let _ = std::fs::remove_dir_all(&dir);

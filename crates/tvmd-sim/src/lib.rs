@@ -1,8 +1,8 @@
 //! Rigid-body simulator for thrust-vectoring modular team UAVs (TVMD).
 //!
-//! The team is simulated as **one** rapier3d-f64 rigid body built from colliders: every agent
-//! is a small ball collider at its position `p_i` carrying the agent's mass as a point mass,
-//! and the navigator module is a ball at the centre carrying `m_0` and `J_0`. The body's mass
+//! The team is simulated as **one** rapier3d-f64 rigid body with one compound collider: a
+//! small ball at every agent's position `p_i`, the agents' masses point masses there, and the
+//! navigator's `m_0` and `J_0` added at the centre (it has no collider). The body's mass
 //! and inertia therefore equal the model's `m_C = m_0 + sum m_i` and
 //! `J_C = J_0 - sum m_i [p_i]x [p_i]x` (see [`physics::TeamBody`]). A fixed ground cuboid with
 //! contact lets runs start on the ground and land.

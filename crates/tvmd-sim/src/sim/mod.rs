@@ -35,6 +35,7 @@ use serde::Serialize;
 
 use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
+use crate::log::scene::team_scene;
 use crate::log::RunLog;
 use crate::physics::{ExtraWrench, PhysicsWorld, PlantState, TeamBody};
 use crate::scenario::{Failure, Scenario, StateNoise};
@@ -323,6 +324,10 @@ impl Simulation {
         let scene_every = ((settings.scene_period / period).round() as usize).max(1);
         let heavy_every = settings.decimation.max(1);
         let mut held = vec![ActuatorCommand::default(); self.team.len()];
+        // Shared with the log's jobs: one copy per run, not one per scene.
+        let team = log
+            .is_some()
+            .then(|| std::sync::Arc::new(self.team.clone()));
         // Reused every physics step: the step allocates nothing of its own.
         let mut forces = Vec::with_capacity(self.team.len());
         while self.step_index < self.total_steps {
@@ -373,9 +378,12 @@ impl Simulation {
                 self.samples.push(tick, || sample);
                 if let Some(log) = log.as_deref_mut() {
                     // The scene shows the commanded forces: at a tick the actual ones still lag
-                    // by one period.
-                    let scene_forces =
-                        (tick % scene_every == 0).then(|| self.forces(&out.commands));
+                    // by one period. One job per tick, the scene included: each job wakes the
+                    // writer thread.
+                    let scene = team
+                        .clone()
+                        .filter(|_| tick % scene_every == 0)
+                        .map(|team| (team, self.forces(&out.commands), self.max_thrust));
                     let heavy = tick % heavy_every == 0;
                     let record = tick_log::Tick {
                         t,
@@ -386,16 +394,15 @@ impl Simulation {
                         actual,
                         failed: self.failed_true.clone(),
                     };
-                    log.submit(move |w| record.write(w, heavy))?;
-                    if let Some(forces) = scene_forces {
-                        log.write_scene(
-                            t,
-                            &self.team,
-                            &forces,
-                            &self.failed_true,
-                            self.max_thrust,
-                        )?;
-                    }
+                    log.submit(move |w| {
+                        let scene = scene.map(|(team, forces, max_thrust)| {
+                            team_scene(t, &team, &forces, &record.failed, max_thrust)
+                        });
+                        record.write(w, heavy);
+                        if let Some(scene) = scene {
+                            w.write(t, &scene);
+                        }
+                    })?;
                     log.pace(t);
                 }
             }
