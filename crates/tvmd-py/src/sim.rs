@@ -556,10 +556,16 @@ record! {
         planned_rpy => o.vector(py, |x| x.planned_roll_pitch_yaw)?,
         /// (K,) angle between `R` and `R_d` (rad).
         attitude_error => o.scalar(py, |x| x.attitude_error)?,
+        /// (K,) angle between `R` and `R_r` (rad).
+        reference_attitude_error => o.scalar(py, |x| Some(x.reference_attitude_error))?,
         /// (K,) planner angle `theta*` (rad).
         theta => o.scalar(py, |x| x.theta)?,
         /// (K,) allocation error `e_f` (N).
         e_f => o.scalar(py, |x| x.e_f)?,
+        /// (K,) moment error `e_tau` (N m).
+        e_tau => o.scalar(py, |x| x.e_tau)?,
+        /// (K,) thrust efficiency `||u_f|| / sum_i ||f_i||`.
+        thrust_efficiency => o.scalar(py, |x| x.thrust_efficiency)?,
         /// (K,) int64: agents the allocator saturated (-1 if not reported).
         saturated_agents => o.column(py, &[], |x| [x.saturated_agents.map_or(-1, |c| i64::try_from(c).unwrap_or(i64::MAX))])?,
         /// (K,) Lyapunov candidate `V_x`.

@@ -36,7 +36,7 @@ RUN_SUMMARY_FIELDS = {
     "max_roll", "max_planned_roll", "max_e_f", "max_e_f_time", "max_e_f_over_weight",
     "final_v_x", "final_v_r", "min_thrust", "max_thrust", "max_abs_eta_x", "max_abs_eta_y",
     "saturated_periods", "cycle_errors", "hover_classifications", "controller_calls",
-    "physics_steps", "wall_time", "real_time_factor",
+    "physics_steps", "wall_time", "real_time_factor", "metrics", "verdict",
 }  # fmt: skip
 
 
@@ -174,6 +174,14 @@ def test_paper_summary_and_dict(paper):
     assert s["controller_calls"] == len(paper) and s["physics_steps"] == 16000
     assert math.isclose(s["time"], 16.0)
     assert s["max_e_f"] == float(np.max(paper.e_f))
+    # The flight metrics fold the same samples (docs/method.md, "Flight metrics").
+    m = s["metrics"]
+    assert m["force_error"]["max"] == s["max_e_f"]
+    assert m["moment_error"]["max"] == float(np.max(paper.e_tau))
+    assert m["thrust_efficiency"]["min"] == float(np.min(paper.thrust_efficiency))
+    assert m["attitude"]["peak"] == float(np.max(paper.reference_attitude_error))
+    assert m["planned_attitude"]["peak"] == float(np.max(paper.attitude_error))
+    assert s["verdict"] == {"success": True, "failures": []}
     # The final state is the physics' after the last step, one tick after the last sample.
     np.testing.assert_allclose(s["final_position"], paper.position[-1], atol=1e-3)
     d = paper.to_dict()

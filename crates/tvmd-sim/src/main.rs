@@ -598,6 +598,10 @@ fn opt(v: Option<f64>, unit: &str) -> String {
     v.map_or_else(|| "-".to_string(), |x| format!("{x:.6} {unit}"))
 }
 
+fn settled(t: Option<f64>) -> String {
+    t.map_or_else(|| "not settled".to_string(), |x| format!("{x:.2} s"))
+}
+
 fn opt_e(v: Option<f64>, unit: &str) -> String {
     v.map_or_else(|| "-".to_string(), |x| format!("{x:.3e} {unit}"))
 }
@@ -689,6 +693,41 @@ fn print_run(r: &RunReport<'_>) {
             ),
         ),
     ];
+    let m = &s.metrics;
+    if let Some(e) = &m.position {
+        rows.push((
+            "pos. settling / steady",
+            format!(
+                "{} / {}",
+                settled(e.settling_time),
+                opt(e.steady_state, "m")
+            ),
+        ));
+    }
+    if let Some(e) = &m.planned_attitude {
+        rows.push((
+            "R_d settling / steady",
+            format!(
+                "{} / {}",
+                settled(e.settling_time),
+                opt(e.steady_state, "rad")
+            ),
+        ));
+    }
+    if let Some(eta) = &m.thrust_efficiency {
+        rows.push((
+            "thrust efficiency mean/min",
+            format!("{:.4} / {:.4}", eta.mean, eta.min),
+        ));
+    }
+    rows.push((
+        "verdict",
+        if s.verdict.success {
+            "success".to_string()
+        } else {
+            format!("FAILED: {}", s.verdict.failures.join("; "))
+        },
+    ));
     if let (Some(name), Some(n)) = (&r.null_space, &s.null_space) {
         rows.push(("null-space stage", name.clone()));
         rows.push((

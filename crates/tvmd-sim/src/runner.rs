@@ -17,7 +17,7 @@ use crate::flight::{FlightController, FlightOutput};
 use crate::log::{LiveOptions, RunLog, METADATA_SCENARIO};
 use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
-use crate::scenario::{Precision, Scenario};
+use crate::scenario::{Precision, Scenario, Verdict};
 use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
 use crate::SimError;
 
@@ -185,6 +185,7 @@ pub fn fly_live(
     };
     result.summary.controller_target = controller.target_label();
     result.summary.error = error.as_ref().map(ToString::to_string);
+    result.summary.verdict = Verdict::judge(&result.summary, &scenario.success);
     Ok(Flight { result, error })
 }
 

@@ -60,14 +60,20 @@ class SimResult:
         attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of ``R``, ``R_r``
             and the planned ``R_d``.
         reference_roll: (K,) ``phi_r``. planned_roll: (K,) ``phi_d = atan2(R_d[2,1], R_d[2,2])``.
-        attitude_error: (K,) angle between ``R`` and ``R_d``. theta: (K,) planner angle ``theta*``.
-        e_f: (K,) allocation error ``||u_fd - u_f||`` (N). saturated_agents: (K,) int64, agents
-            the allocator saturated (-1 if not reported).
+        attitude_error: (K,) angle between ``R`` and ``R_d``. reference_attitude_error: (K,)
+            angle between ``R`` and ``R_r``. theta: (K,) planner angle ``theta*``.
+        e_f: (K,) allocation error ``||u_fd - u_f||`` (N). e_tau: (K,) moment error
+            ``||u_taud - u_tau||`` (N m). thrust_efficiency: (K,) ``||u_f|| / sum_i ||f_i||``.
+            saturated_agents: (K,) int64, agents the allocator saturated (-1 if not reported).
         V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
         commands, actual: (K, n, 3) commanded and actual actuator values, columns
             ``eta_x, eta_y`` (rad), ``thrust`` (N). failed: (K, n) bool, true failure flags.
         summary: dict, every field of tvmd-sim's ``RunSummary`` (``max_planned_roll``, ``max_e_f``,
-            ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...).
+            ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...),
+            with ``metrics`` (settling time, steady-state, peak and integral errors, force and
+            moment errors, thrust efficiency, time saturated; docs/method.md, "Flight metrics")
+            and ``verdict`` (``{"success": bool, "failures": [str]}`` against the scenario's
+            ``[success]`` bounds).
         paper_metrics: dict, tvmd-sim's ``PaperMetrics`` (horizontal errors at 4 and 12 s,
             stage-B attitude settling, ``e_f`` onset, ``V_x`` rise, ...).
         scenario_toml: the scenario that ran, as TOML.
@@ -145,11 +151,20 @@ class SimResult:
     def attitude_error(self) -> _F64:
         """(K,) angle between ``R`` and ``R_d`` (rad)."""
     @property
+    def reference_attitude_error(self) -> _F64:
+        """(K,) angle between ``R`` and ``R_r`` (rad)."""
+    @property
     def theta(self) -> _F64:
         """(K,) planner angle ``theta*`` (rad)."""
     @property
     def e_f(self) -> _F64:
         """(K,) allocation error ``||u_fd - u_f||`` (N)."""
+    @property
+    def e_tau(self) -> _F64:
+        """(K,) moment error ``||u_taud - u_tau||`` (N m)."""
+    @property
+    def thrust_efficiency(self) -> _F64:
+        """(K,) thrust efficiency ``||u_f|| / sum_i ||f_i||`` (NaN: no thrust)."""
     @property
     def saturated_agents(self) -> NDArray[np.int64]:
         """(K,) agents the allocator saturated (-1: not reported)."""

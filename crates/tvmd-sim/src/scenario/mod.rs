@@ -54,6 +54,10 @@
 //! wind = [0.5, 0.0, 0.0]
 //! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
 //! state_noise = { position = 0.01, velocity = 0.02, attitude = 0.005, angular_velocity = 0.01, seed = 7 }
+//!
+//! [success]                  # the verdict's bounds (see `SuccessBounds`)
+//! max_steady_state_position_error = 0.05
+//! # max_settling_time = 6.0
 //! ```
 
 use std::f64::consts::PI;
@@ -75,6 +79,7 @@ mod certified;
 pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 mod null_space;
 mod overrides;
+mod success;
 mod validate;
 
 pub use builtin::BUILTIN_NAMES;
@@ -82,6 +87,7 @@ pub use null_space::{
     NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
 };
 pub use overrides::Overrides;
+pub use success::{SuccessBounds, Verdict};
 use validate::invalid;
 
 /// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a
@@ -440,6 +446,8 @@ pub struct Scenario {
     pub disturbances: Disturbances,
     /// What the run's log keeps (`[log]`: `decimation`, `scene_period`).
     pub log: LogSettings,
+    /// The bounds of a successful flight (`[success]`), judged in the summary's verdict.
+    pub success: SuccessBounds,
 }
 
 impl Default for Scenario {
@@ -467,6 +475,7 @@ impl Default for Scenario {
             failure_response: FailureResponse::default(),
             disturbances: Disturbances::default(),
             log: LogSettings::default(),
+            success: SuccessBounds::default(),
         }
     }
 }

@@ -126,6 +126,30 @@ impl Scenario {
             ));
         }
         check_range("log.scene_period", self.log.scene_period, 1e-6, 1e6)?;
+        let success = &self.success;
+        check_range(
+            "success.steady_state_window",
+            success.steady_state_window,
+            self.controller_period,
+            1e6,
+        )?;
+        for (field, bound) in [
+            (
+                "success.max_steady_state_position_error",
+                success.max_steady_state_position_error,
+            ),
+            (
+                "success.max_steady_state_attitude_error",
+                success.max_steady_state_attitude_error,
+            ),
+            ("success.max_position_error", success.max_position_error),
+            (
+                "success.max_settling_time",
+                success.max_settling_time.unwrap_or(0.0),
+            ),
+        ] {
+            check_nonneg(field, &[bound])?;
+        }
         check_nonneg("physics.friction", &[self.physics.friction])?;
         check_magnitude("initial_position", &self.initial_position, MAX_DISTANCE)?;
         if self.initial_position[2] < 0.0 {

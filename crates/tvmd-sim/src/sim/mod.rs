@@ -44,7 +44,10 @@ use crate::SimError;
 pub use difference::FlightDifference;
 pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
-pub use summary::{NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, SummaryFold, VxRise};
+pub use summary::{
+    EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics, NullSpaceSummary,
+    PaperMetrics, RunSummary, RunTotals, SummaryFold, VxRise,
+};
 
 /// The valid range of the physics: beyond it a run ends with [`SimError::Diverged`] rather than
 /// run on in a state rapier clamps (its default caps speeds) or cannot represent. A team of the

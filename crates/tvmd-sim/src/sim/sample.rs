@@ -4,7 +4,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::actuators::ActuatorCommand;
-use crate::diagnostics::HoverDiagnostics;
+use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
 use crate::flight::FlightOutput;
 use crate::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
 use crate::physics::PlantState;
@@ -33,10 +33,18 @@ pub struct Sample {
     pub planned_roll_pitch_yaw: Option<[f64; 3]>,
     /// Angle between `R` and the planned `R_d` (rad), if `R_d` was reported.
     pub attitude_error: Option<f64>,
+    /// Angle between `R` and the reference `R_r` (rad).
+    pub reference_attitude_error: f64,
     /// Planner angle `theta*` (rad), if reported.
     pub theta: Option<f64>,
     /// Allocation error `e_f` (N), if reported.
     pub e_f: Option<f64>,
+    /// Moment error `e_tau = ||u_taud - u_tau||` (N m): the desired moment against the
+    /// allocated one, if both were reported.
+    pub e_tau: Option<f64>,
+    /// Thrust efficiency `||u_f|| / sum_i ||f_i||` of the allocated forces, if reported and
+    /// some agent thrusts.
+    pub thrust_efficiency: Option<f64>,
     /// Number of agents the allocator saturated, if reported.
     pub saturated_agents: Option<usize>,
     /// The null-space stage's smallest normalized margin before and after, if it ran.
@@ -70,6 +78,20 @@ fn norm3(a: &[f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
+/// The moment part `[tau]` of a wrench `[tau; f]`.
+fn head3(w: &[f64; 6]) -> [f64; 3] {
+    [w[0], w[1], w[2]]
+}
+
+/// `||u_f|| / sum_i ||f_i||` of an allocation: the share of the agents' thrust that acts as the
+/// team's force (1 with every agent thrusting along one direction); `None` without forces or
+/// with no thrust at all.
+fn thrust_efficiency(a: &AllocationDiagnostics) -> Option<f64> {
+    let total: f64 = a.forces.iter().map(norm3).sum();
+    let useful = norm3(&[a.wrench[3], a.wrench[4], a.wrench[5]]);
+    (total > 0.0).then(|| (useful / total).min(1.0))
+}
+
 impl Sample {
     /// The sample of a tick: true state `s`, reference `r`, the controller's output, the
     /// actuators' actual outputs and the true failure flags.
@@ -94,8 +116,15 @@ impl Sample {
             planned_roll: r_d.as_ref().map(planned_roll),
             planned_roll_pitch_yaw: r_d.as_ref().map(roll_pitch_yaw),
             attitude_error: r_d.as_ref().map(|m| rotation_distance(&s.rotation, m)),
+            reference_attitude_error: rotation_distance(&s.rotation, &r.rotation),
             theta: d.planner.as_ref().map(|p| p.theta),
             e_f: d.allocation.as_ref().map(|a| a.e_f),
+            e_tau: d
+                .control
+                .as_ref()
+                .zip(d.allocation.as_ref())
+                .map(|(c, a)| norm3(&sub3(&head3(&c.u_d), &head3(&a.wrench)))),
+            thrust_efficiency: d.allocation.as_ref().and_then(thrust_efficiency),
             saturated_agents: d
                 .allocation
                 .as_ref()

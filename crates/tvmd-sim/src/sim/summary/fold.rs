@@ -2,6 +2,7 @@
 //! a time, so that a run is summarised in constant memory whatever its length (the loop folds
 //! every tick whether or not it keeps the samples).
 
+use super::metrics::MetricsFold;
 use super::rules::{ArgMax, Max, MaxRise, Min, Nearest, Settling, Spacing};
 use super::{
     e_f_visible, HoverClassification, NullSpaceSummary, PaperMetrics, RunSummary, RunTotals,
@@ -9,7 +10,7 @@ use super::{
 };
 use crate::math::roll_pitch_yaw;
 use crate::reference::ReferenceConfig;
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, Verdict};
 use crate::sim::sample::{arr, Sample};
 
 /// The times at which [`PaperMetrics::v_x_at`] reads `V_x` (before the final sample) (s).
@@ -94,6 +95,7 @@ pub struct SummaryFold {
     stage_b_max_attitude_error: Max,
     max_v_x_after_4s: Max,
     max_v_x_rise: MaxRise,
+    metrics: MetricsFold,
 }
 
 impl SummaryFold {
@@ -135,6 +137,10 @@ impl SummaryFold {
             stage_b_max_attitude_error: Max::default(),
             max_v_x_after_4s: Max::default(),
             max_v_x_rise: MaxRise::default(),
+            metrics: MetricsFold::new(
+                scenario.controller_period,
+                scenario.duration - scenario.success.steady_state_window,
+            ),
         }
     }
 
@@ -149,6 +155,7 @@ impl SummaryFold {
     pub fn push(&mut self, x: &Sample) {
         let t = x.t;
         let error = x.position_error();
+        self.metrics.push(x);
         self.spacing.push(t);
         let at = (x.horizontal_error(), x.v_x);
         self.at.iter_mut().for_each(|n| n.push(t, at));
@@ -225,7 +232,7 @@ impl SummaryFold {
         let weight = totals.mass * scenario.physics.gravity;
         let e_f = self.max_e_f.get();
         let last = self.last;
-        RunSummary {
+        let mut summary = RunSummary {
             scenario: scenario.name.clone(),
             controller_precision: scenario.controller_precision,
             controller_target: crate::flight::HOST_TARGET.to_string(),
@@ -265,7 +272,11 @@ impl SummaryFold {
             } else {
                 f64::INFINITY
             },
-        }
+            metrics: self.metrics.get(),
+            verdict: Verdict::default(),
+        };
+        summary.verdict = Verdict::judge(&summary, &scenario.success);
+        summary
     }
 
     /// The paper's metrics of the samples so far.

@@ -8,6 +8,7 @@
 //! half a sample spacing ([`rules::Nearest`]).
 
 mod fold;
+pub mod metrics;
 pub mod rules;
 #[cfg(test)]
 pub(crate) mod tests;
@@ -15,10 +16,11 @@ pub(crate) mod tests;
 use serde::Serialize;
 
 use crate::physics::PlantState;
-use crate::scenario::{Precision, Scenario};
+use crate::scenario::{Precision, Scenario, Verdict};
 use crate::sim::sample::Sample;
 
 pub use fold::SummaryFold;
+pub use metrics::{EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics};
 pub use rules::Rise as VxRise;
 
 /// Time after which [`RunSummary::max_position_error_after_4s`] is taken (s): the end of
@@ -164,6 +166,10 @@ pub struct RunSummary {
     pub wall_time: f64,
     /// Real-time factor: simulated time over wall time.
     pub real_time_factor: f64,
+    /// The flight metrics (`docs/method.md`, "Flight metrics").
+    pub metrics: FlightMetrics,
+    /// The verdict against the scenario's `[success]` bounds.
+    pub verdict: Verdict,
 }
 
 /// The null-space stage over a run: its smallest normalized margin to the admissible
