@@ -27,6 +27,7 @@ const DEFAULT_SCENARIO: &str = "paper-tilt";
 /// The keys a `run_many` dict may hold (the keyword arguments of `run`).
 const RUN_KEYS: &[&str] = &[
     "scenario",
+    "team",
     "toml",
     "mcap",
     "relaxation",
@@ -116,6 +117,7 @@ struct RunArgs<'a, 'py> {
     precision: Option<String>,
     pil: Option<String>,
     max_samples: Option<i64>,
+    team: Option<String>,
 }
 
 /// A `max_samples` argument: `None` keeps every tick, `n >= 0` at most `n` evenly spaced.
@@ -165,6 +167,7 @@ impl RunArgs<'_, '_> {
             allocator: self.allocator,
             precision,
             null_space: null_space_arg(self.null_space.as_deref())?,
+            team: self.team,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
         let samples = retention_arg(self.max_samples)?;
@@ -229,6 +232,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         precision: opt(dict, &name, "precision")?,
         pil: opt(dict, &name, "pil")?,
         max_samples: opt(dict, &name, "max_samples")?,
+        team: opt(dict, &name, "team")?,
     }
     .spec(&format!("{name}['scenario']"))
 }
@@ -313,7 +317,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -326,6 +330,7 @@ fn run(
     pil: Option<String>,
     null_space: Option<String>,
     max_samples: Option<i64>,
+    team: Option<String>,
 ) -> PyResult<PySimResult> {
     let spec = RunArgs {
         scenario,
@@ -337,6 +342,7 @@ fn run(
         precision,
         pil,
         max_samples,
+        team,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?

@@ -89,6 +89,10 @@ enum Command {
         /// (the scenario's `null_space`; see docs/method.md, "Null-space stage").
         #[arg(long, value_name = "OBJECTIVE")]
         null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
+        /// Fly the scenario with a catalogue team instead of its own (`team.preset`: a3-con,
+        /// a4-inc, a6-inc, ..., t10-con; see `tvmd-sim afs`).
+        #[arg(long)]
+        team: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]
@@ -275,6 +279,7 @@ fn main() -> ExitCode {
             relaxation,
             allocator,
             null_space,
+            team,
             precision,
             pil,
             live,
@@ -291,6 +296,7 @@ fn main() -> ExitCode {
             relaxation,
             allocator,
             null_space,
+            team,
             precision,
             pil,
             live: live.then_some(LiveOptions {
@@ -424,6 +430,7 @@ struct RunArgs {
     relaxation: Option<f64>,
     allocator: Option<String>,
     null_space: Option<tvmd_sim::scenario::NullSpaceConfig>,
+    team: Option<String>,
     precision: Option<String>,
     pil: Option<String>,
     live: Option<LiveOptions>,
@@ -473,6 +480,7 @@ fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         allocator: a.allocator,
         precision,
         null_space: a.null_space,
+        team: a.team,
     })?;
     let mut spec = RunSpec::on_target(scenario, None, pil, precision)?;
     let stem = file_stem(&spec.scenario.name);

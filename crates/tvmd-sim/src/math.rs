@@ -18,7 +18,12 @@ pub fn rot_x(angle: f64) -> Matrix3<f64> {
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
 }
 
-/// Roll, pitch and yaw (ZYX convention, `R = R_z(yaw) R_y(pitch) R_x(roll)`) of a rotation matrix.
+/// The rotation `R = R_z(yaw) R_y(pitch) R_x(roll)` of roll, pitch and yaw (ZYX).
+pub fn from_roll_pitch_yaw([roll, pitch, yaw]: [f64; 3]) -> Matrix3<f64> {
+    Rotation3::from_euler_angles(roll, pitch, yaw).into_inner()
+}
+
+/// Roll, pitch, yaw (ZYX) of `r`, the inverse of [`from_roll_pitch_yaw`] away from gimbal lock.
 pub fn roll_pitch_yaw(r: &Matrix3<f64>) -> [f64; 3] {
     let (roll, pitch, yaw) = Rotation3::from_matrix_unchecked(*r).euler_angles();
     [roll, pitch, yaw]

@@ -334,6 +334,34 @@ pub struct ExtraWrench {
     pub torque_body: Vector3<f64>,
 }
 
+/// How the flown body's mass differs from its team description (the mass part of a model
+/// error): mass and inertia scales and the centre of mass's offset from the body origin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassError {
+    /// Mass over the team's `m_C`.
+    pub mass_scale: f64,
+    /// Inertia about the centre of mass over the team's `J`.
+    pub inertia_scale: f64,
+    /// Centre of mass in the body frame (m), against the team's (the body origin).
+    pub com_offset: Vector3<f64>,
+}
+
+impl Default for MassError {
+    fn default() -> Self {
+        Self {
+            mass_scale: 1.0,
+            inertia_scale: 1.0,
+            com_offset: Vector3::zeros(),
+        }
+    }
+}
+
+impl MassError {
+    fn is_nominal(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
 /// The rapier world holding the team body and the ground.
 pub struct PhysicsWorld {
     world: RapierWorld,
@@ -341,6 +369,11 @@ pub struct PhysicsWorld {
     team: TeamBody,
     config: PhysicsConfig,
     time: f64,
+    /// Mass rapier adds to the collider's: the navigator (nominal mass) and the payloads.
+    additional: Vec<MassProperties>,
+    /// The centre of mass in the body frame: where rapier's velocity and torque refer to. Zero
+    /// for a nominal team (the body origin is the team's centre of mass by construction).
+    com: Vector3<f64>,
 }
 
 fn to_rapier(v: &Vector3<f64>) -> rm::Vector {
@@ -385,6 +418,18 @@ impl PhysicsWorld {
         config: &PhysicsConfig,
         initial: &PlantState,
     ) -> Result<Self, SimError> {
+        Self::with_mass_error(team, config, initial, &MassError::default())
+    }
+
+    /// As [`PhysicsWorld::new`], flying a body whose mass, inertia and centre of mass differ
+    /// from `team`'s by `error`; the body origin (the position [`PhysicsWorld::state`] reports
+    /// and `p_i` refer to) stays the team's centre of mass.
+    pub fn with_mass_error(
+        team: &TeamBody,
+        config: &PhysicsConfig,
+        initial: &PlantState,
+        error: &MassError,
+    ) -> Result<Self, SimError> {
         team.validate()?;
         if !(config.dt.is_finite() && config.dt > 0.0) {
             return Err(SimError::InvalidScenario {
@@ -409,14 +454,7 @@ impl PhysicsWorld {
             ..IntegrationParameters::default()
         };
 
-        let omega_world = initial.rotation * initial.omega;
         let body = RigidBodyBuilder::dynamic()
-            .pose(rm::Pose::from_parts(
-                to_rapier(&initial.position),
-                quat_to_rapier(&initial.rotation),
-            ))
-            .linvel(to_rapier(&initial.velocity))
-            .angvel(to_rapier(&omega_world))
             .can_sleep(false)
             .allow_fast_rotation(true)
             .gyroscopic_forces_enabled(true)
@@ -442,25 +480,46 @@ impl PhysicsWorld {
             .iter()
             .map(|a| MassProperties::new(to_rapier(&a.position_vector()), a.mass, rm::Vector::ZERO))
             .sum();
-        let c = ColliderBuilder::compound(balls)
-            .mass_properties(point_masses)
-            .friction(config.friction)
-            .restitution(0.0);
-        world.insert_collider(c, Some(body));
         // The navigator has mass but no collider: the centre of mass (the origin) is a convex
         // combination of the agent positions, so a ball there can never be lower than the
         // lowest agent ball and never touch a flat ground first. A collider there would only
         // add a contact pair to every step near the ground.
         let j0 = crate::math::from_rows(&team.navigator_inertia);
-        if team.navigator_mass > 0.0 || j0.abs().max() > 0.0 {
-            let navigator = MassProperties::with_inertia_matrix(
+        let navigator = (team.navigator_mass > 0.0 || j0.abs().max() > 0.0).then(|| {
+            MassProperties::with_inertia_matrix(
                 rm::Vector::ZERO,
                 team.navigator_mass,
                 mat_to_rapier(&j0),
+            )
+        });
+        let (collider_mass, additional) = if error.is_nominal() {
+            (point_masses, navigator.into_iter().collect())
+        } else {
+            // The whole nominal body, scaled about its centre of mass and moved.
+            let nominal = navigator.map_or(point_masses, |n| point_masses + n);
+            let inertia = nominal.reconstruct_inertia_matrix() * error.inertia_scale;
+            let plant = MassProperties::with_inertia_matrix(
+                nominal.local_com + to_rapier(&error.com_offset),
+                nominal.mass() * error.mass_scale,
+                inertia,
             );
-            world.bodies[body].set_additional_mass_properties(navigator, false);
+            (plant, Vec::new())
+        };
+        let c = ColliderBuilder::compound(balls)
+            .mass_properties(collider_mass)
+            .friction(config.friction)
+            .restitution(0.0);
+        world.insert_collider(c, Some(body));
+        if !additional.is_empty() {
+            let sum: MassProperties = additional.iter().copied().sum();
+            world.bodies[body].set_additional_mass_properties(sum, false);
         }
         world.bodies[body].recompute_mass_properties_from_colliders(&world.colliders);
+        let com = if error.is_nominal() {
+            Vector3::zeros()
+        } else {
+            from_rapier(world.bodies[body].local_center_of_mass())
+        };
 
         if config.ground {
             // A cuboid, not a halfspace: a halfspace's infinite bounding box keeps every ball
@@ -473,13 +532,41 @@ impl PhysicsWorld {
             world.insert_collider(ground, None);
         }
 
-        Ok(Self {
+        let mut out = Self {
             world,
             body,
             team: team.clone(),
             config: config.clone(),
             time: 0.0,
-        })
+            additional,
+            com,
+        };
+        out.set_state(initial);
+        Ok(out)
+    }
+
+    /// Attaches a point mass `mass` (kg) at `offset` (body frame, m), moving with the body: the
+    /// body origin keeps its velocity and the centre of mass moves towards the payload.
+    pub fn attach_payload(&mut self, mass: f64, offset: &Vector3<f64>) -> Result<(), SimError> {
+        if !(mass.is_finite() && mass > 0.0 && offset.iter().all(|c| c.is_finite())) {
+            return Err(SimError::InvalidScenario {
+                field: "payloads".into(),
+                reason: format!("mass {mass} kg at {offset:?} m: must be finite and > 0"),
+            });
+        }
+        let before = self.state();
+        self.additional.push(MassProperties::new(
+            to_rapier(offset),
+            mass,
+            rm::Vector::ZERO,
+        ));
+        let sum: MassProperties = self.additional.iter().copied().sum();
+        let rb = &mut self.world.bodies[self.body];
+        rb.set_additional_mass_properties(sum, true);
+        rb.recompute_mass_properties_from_colliders(&self.world.colliders);
+        self.com = from_rapier(rb.local_center_of_mass());
+        self.set_state(&before);
+        Ok(())
     }
 
     /// The team description this world was built from.
@@ -513,32 +600,45 @@ impl PhysicsWorld {
         mat_from_rapier(&mp.reconstruct_inertia_matrix())
     }
 
-    /// The body's centre of mass in the body frame, as rapier computed it (should be ~0).
+    /// The body's centre of mass in the body frame, as rapier computed it: ~0 for a
+    /// nominal team, moved by a model error or a payload.
     pub fn local_center_of_mass(&self) -> Vector3<f64> {
         from_rapier(self.world.bodies[self.body].local_center_of_mass())
     }
 
-    /// Current state of the team body.
+    /// Current state of the team body: the body origin (the team's centre of mass in the
+    /// controller's model) and its velocity.
     pub fn state(&self) -> PlantState {
         let rb = &self.world.bodies[self.body];
         let rotation = quat_from_rapier(rb.rotation());
+        let omega_world = from_rapier(rb.angvel());
+        // rapier's linear velocity is the centre of mass's.
+        let mut velocity = from_rapier(rb.linvel());
+        if self.com != Vector3::zeros() {
+            velocity -= omega_world.cross(&(rotation * self.com));
+        }
         PlantState {
             position: from_rapier(rb.translation()),
             rotation,
-            velocity: from_rapier(rb.linvel()),
-            omega: rotation.transpose() * from_rapier(rb.angvel()),
+            velocity,
+            omega: rotation.transpose() * omega_world,
         }
     }
 
     /// Overwrites the body's state (teleport); contacts are re-detected at the next step.
     pub fn set_state(&mut self, state: &PlantState) {
+        let omega_world = state.rotation * state.omega;
+        let mut velocity = state.velocity;
+        if self.com != Vector3::zeros() {
+            velocity += omega_world.cross(&(state.rotation * self.com));
+        }
         let rb = &mut self.world.bodies[self.body];
         rb.set_position(
             rm::Pose::from_parts(to_rapier(&state.position), quat_to_rapier(&state.rotation)),
             true,
         );
-        rb.set_linvel(to_rapier(&state.velocity), true);
-        rb.set_angvel(to_rapier(&(state.rotation * state.omega)), true);
+        rb.set_linvel(to_rapier(&velocity), true);
+        rb.set_angvel(to_rapier(&omega_world), true);
     }
 
     /// Advances the world by one step `dt`.
@@ -581,7 +681,7 @@ impl PhysicsWorld {
         let mut torque_body = extra.torque_body;
         for (a, f) in self.team.agents.iter().zip(agent_forces_body) {
             force_body += f;
-            torque_body += a.position_vector().cross(f);
+            torque_body += (a.position_vector() - self.com).cross(f);
         }
         let force = rotation * force_body + extra.force_world;
         let torque = rotation * torque_body + extra.torque_world;
@@ -667,6 +767,58 @@ mod tests {
             );
             assert!(w.local_center_of_mass().norm() < 1e-12);
         }
+    }
+
+    /// A model error and a payload move the centre of mass off the body origin: the mass
+    /// properties follow, and the reported velocity stays the origin's (the finite difference
+    /// of the reported position).
+    #[test]
+    fn mass_errors_and_payloads_keep_the_origin_state() {
+        let team = TeamBody::a4_inc();
+        let config = PhysicsConfig {
+            gravity: 0.0,
+            ground: false,
+            ..PhysicsConfig::default()
+        };
+        let error = MassError {
+            mass_scale: 1.1,
+            inertia_scale: 1.5,
+            com_offset: Vector3::new(0.05, -0.02, 0.01),
+        };
+        let initial = PlantState {
+            omega: Vector3::new(0.3, -0.2, 0.5),
+            velocity: Vector3::new(0.1, 0.0, 0.0),
+            ..PlantState::at_rest(Vector3::new(0.0, 0.0, 1.0))
+        };
+        let mut w = PhysicsWorld::with_mass_error(&team, &config, &initial, &error).unwrap();
+        assert!((w.mass() - 1.1 * team.mass()).abs() < 1e-12);
+        assert!((w.local_center_of_mass() - error.com_offset).norm() < 1e-12);
+        let j = w.inertia();
+        assert!((j - team.inertia() * 1.5).abs().max() < 1e-12, "{j}");
+        let s0 = w.state();
+        assert!((s0.velocity - initial.velocity).norm() < 1e-12);
+        assert!((s0.omega - initial.omega).norm() < 1e-12);
+        w.attach_payload(0.3, &Vector3::new(0.2, 0.0, 0.0)).unwrap();
+        assert!((w.mass() - (1.1 * team.mass() + 0.3)).abs() < 1e-12);
+        let s1 = w.state();
+        assert!((s1.velocity - s0.velocity).norm() < 1e-12);
+        let com_velocity = |w: &PhysicsWorld, s: &PlantState| {
+            s.velocity + (s.rotation * s.omega).cross(&(s.rotation * w.local_center_of_mass()))
+        };
+        let v0 = com_velocity(&w, &s1);
+        let forces = vec![Vector3::zeros(); team.len()];
+        let extra = ExtraWrench::default();
+        for _ in 0..50 {
+            let a = w.state();
+            w.step(&forces, &extra).unwrap();
+            let b = w.state();
+            let fd = (b.position - a.position) / config.dt;
+            let mid = 0.5 * (a.velocity + b.velocity);
+            assert!((fd - mid).norm() < 1e-4, "{fd} vs {mid}");
+        }
+        // Free of forces, the centre of mass moves in a straight line at constant speed.
+        let v = com_velocity(&w, &w.state());
+        assert!((v - v0).norm() < 1e-9, "{v} vs {v0}");
     }
 
     #[test]

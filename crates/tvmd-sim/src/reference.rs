@@ -17,6 +17,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::rot_x;
 
+mod tracking;
+
+pub use tracking::{FigureEight, Sine, Step};
+
 /// The reference at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReferenceSample {
@@ -82,6 +86,12 @@ pub enum ReferenceConfig {
         #[serde(default)]
         roll: f64,
     },
+    /// A reference jump between two hover positions.
+    Step(Step),
+    /// Sine tracking about a hover position.
+    Sine(Sine),
+    /// A horizontal figure-eight.
+    FigureEight(FigureEight),
 }
 
 impl Default for ReferenceConfig {
@@ -157,6 +167,9 @@ impl ReferenceConfig {
                 roll: *roll,
                 roll_rate: 0.0,
             },
+            Self::Step(s) => s.at(t),
+            Self::Sine(s) => s.at(t),
+            Self::FigureEight(f) => f.at(t),
         }
     }
 }

@@ -226,6 +226,7 @@ def run(
     pil: Optional[_PilTarget] = None,
     null_space: Optional[str] = None,
     max_samples: Optional[int] = None,
+    team: Optional[str] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -265,6 +266,11 @@ def run(
             stays flat; ``summary`` and ``paper_metrics`` still cover every tick. Default None:
             every tick, which a run longer than 2,000,000 controller ticks (about 2 GB) refuses
             with a ``ValueError`` naming ``duration``.
+        team: fly the scenario with a catalogue team instead of its own (``team.preset``:
+            ``"a3-con"`` ... ``"a10-inc"``, ``"a4-diamond-inc"``, ``"t10-con"``, ``"t10-inc"``);
+            the scenario families (``"hover"``, ``"wind"``, ``"payload"``, ``"model-error"``,
+            ``"reference-jump"``, ``"sine"``, ``"figure-eight"``, ``"initial-attitude-<rad>"``)
+            are built for any of them (docs/method.md "Scenario families").
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the

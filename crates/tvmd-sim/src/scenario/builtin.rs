@@ -21,6 +21,19 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "a4-inc",
     "agent-failure",
     "a6-agent-failure",
+    // The scenario families (`families.rs`).
+    "hover",
+    "wind",
+    "payload",
+    "model-error",
+    "reference-jump",
+    "sine",
+    "figure-eight",
+    "initial-attitude-0.5",
+    "initial-attitude-1.0",
+    "initial-attitude-1.5",
+    "initial-attitude-2.0",
+    "initial-attitude-2.5",
 ];
 
 impl Scenario {
@@ -109,7 +122,7 @@ impl Scenario {
                 )
             }
             other => {
-                return Err(SimError::UnknownScenario {
+                return super::families::family(other).ok_or_else(|| SimError::UnknownScenario {
                     name: other.to_string(),
                     known: BUILTIN_NAMES.join(", "),
                 })
@@ -121,6 +134,13 @@ impl Scenario {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_families_are_built_ins() {
+        for name in super::super::families::FAMILY_NAMES {
+            assert!(BUILTIN_NAMES.contains(name), "{name}");
+        }
+    }
 
     #[test]
     fn builtins_validate_and_round_trip() {

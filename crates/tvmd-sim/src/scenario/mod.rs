@@ -72,21 +72,27 @@ use crate::reference::ReferenceConfig;
 use crate::{SimError, GRAVITY};
 use tvmd_core::team::presets::Preset;
 
+mod air;
 mod builtin;
 mod certified;
+mod families;
 
 /// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
 pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 mod null_space;
 mod overrides;
+mod plant;
 mod success;
 mod validate;
 
+pub use air::{Air, Gust, DRAG_AREA_PER_AGENT};
 pub use builtin::BUILTIN_NAMES;
+pub use families::{FAMILY_NAMES, HOVER_HEIGHT, RELEASE_HEIGHT};
 pub use null_space::{
     NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
 };
 pub use overrides::Overrides;
+pub use plant::{Payload, PlantError};
 pub use success::{SuccessBounds, Verdict};
 use validate::invalid;
 
@@ -378,11 +384,15 @@ impl Default for StateNoise {
 }
 
 /// Optional disturbances.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Disturbances {
-    /// Constant wind force through the centre of mass, world frame (N).
+    /// Constant force through the centre of mass, world frame (N): wind as a force, with no
+    /// drag model (see `air` for wind as air velocity).
     pub wind: [f64; 3],
+    /// Wind as air velocity (steady plus gusts) through the team's drag.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air: Option<Air>,
     /// External wrench.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub external_wrench: Option<ExternalWrenchSpec>,
@@ -406,6 +416,9 @@ pub struct Scenario {
     /// Initial position of the centre of mass (m); `[0.5, -0.5, 0]`, i.e. resting on the
     /// ground (the ground lies at `z = -rest height`, see [`crate::physics`]).
     pub initial_position: [f64; 3],
+    /// Initial attitude as roll, pitch, yaw (rad, ZYX: `R = R_z(yaw) R_y(pitch) R_x(roll)`);
+    /// level. Away from level the team must start in the air (no agent below the ground).
+    pub initial_attitude: [f64; 3],
     /// Planner relaxation `s` in `(0, 1]`; 0.5. In TOML also `"certified"`: the AFS atlas's
     /// `s*` of the team ([`Scenario::certified_relaxation`]), resolved when the file is read.
     pub relaxation: f64,
@@ -444,6 +457,12 @@ pub struct Scenario {
     pub failure_response: FailureResponse,
     /// Disturbances.
     pub disturbances: Disturbances,
+    /// Model error: how the flown team differs from the controller's model of it.
+    #[serde(skip_serializing_if = "PlantError::is_nominal")]
+    pub plant: PlantError,
+    /// Payloads that attach during the flight.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub payloads: Vec<Payload>,
     /// What the run's log keeps (`[log]`: `decimation`, `scene_period`).
     pub log: LogSettings,
     /// The bounds of a successful flight (`[success]`), judged in the summary's verdict.
@@ -460,6 +479,7 @@ impl Default for Scenario {
             duration: 16.0,
             controller_period: 0.01,
             initial_position: [0.5, -0.5, 0.0],
+            initial_attitude: [0.0; 3],
             relaxation: 0.5,
             allocator: tvmd_core::AnyAllocator::<f64, 1>::DEFAULT_NAME.into(),
             controller_rate_limits: None,
@@ -474,6 +494,8 @@ impl Default for Scenario {
             failures: Vec::new(),
             failure_response: FailureResponse::default(),
             disturbances: Disturbances::default(),
+            plant: PlantError::nominal(),
+            payloads: Vec::new(),
             log: LogSettings::default(),
             success: SuccessBounds::default(),
         }

@@ -1,5 +1,5 @@
 //! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator` /
-//! `--precision`, the Python keywords `relaxation=` / `allocator=` / `precision=`), applied
+//! `--precision` / `--team`, the Python keywords `relaxation=` / `allocator=` / `precision=`), applied
 //! with validation.
 
 use super::{NullSpaceConfig, Precision, Scenario};
@@ -16,6 +16,8 @@ pub struct Overrides {
     pub precision: Option<Precision>,
     /// A null-space stage after the allocator (`null_space`).
     pub null_space: Option<NullSpaceConfig>,
+    /// A catalogue team (`team.preset`, e.g. `"a6-inc"`), replacing the scenario's team.
+    pub team: Option<String>,
 }
 
 impl Overrides {
@@ -25,6 +27,7 @@ impl Overrides {
             && self.allocator.is_none()
             && self.precision.is_none()
             && self.null_space.is_none()
+            && self.team.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -40,6 +43,10 @@ impl Overrides {
         }
         if let Some(n) = self.null_space {
             scenario.null_space = Some(n);
+        }
+        if let Some(team) = &self.team {
+            scenario.team.preset = Some(team.clone());
+            scenario.team.agents = None;
         }
         scenario.validate()
     }
@@ -64,12 +71,20 @@ mod tests {
             allocator: Some("pseudo-inverse".into()),
             precision: Some(Precision::F32),
             null_space: Some("margin".parse().unwrap()),
+            team: Some("a6-inc".into()),
         };
         assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();
         assert_eq!(s.relaxation, 1.0);
         assert_eq!(s.allocator, "pseudo-inverse");
         assert_eq!(s.controller_precision, Precision::F32);
+        assert_eq!(s.team_body().unwrap().len(), 6);
+        let bad = Overrides {
+            team: Some("a99".into()),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(e.to_string().contains("team.preset"), "{e}");
         assert_eq!(
             s.null_space.map(|n| n.to_string()).as_deref(),
             Some("margin")

@@ -30,7 +30,7 @@ pub const MAX_DISTANCE: f64 = 1e4;
 pub const MAX_EXTERNAL: f64 = 1e4;
 
 /// `Err` naming `field` unless `v` is in `[lo, hi]`.
-fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), SimError> {
+pub(super) fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), SimError> {
     if v >= lo && v <= hi {
         Ok(())
     } else {
@@ -42,7 +42,7 @@ fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), SimError> {
 }
 
 /// `Err` naming `field` unless every component of `v` has `|x| <= limit`.
-fn check_magnitude(field: &str, v: &[f64], limit: f64) -> Result<(), SimError> {
+pub(super) fn check_magnitude(field: &str, v: &[f64], limit: f64) -> Result<(), SimError> {
     check_finite(field, v)?;
     match v.iter().find(|x| x.abs() > limit) {
         None => Ok(()),
@@ -53,7 +53,7 @@ fn check_magnitude(field: &str, v: &[f64], limit: f64) -> Result<(), SimError> {
     }
 }
 
-fn check_pos(field: &str, v: f64) -> Result<(), SimError> {
+pub(super) fn check_pos(field: &str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -61,14 +61,14 @@ fn check_pos(field: &str, v: f64) -> Result<(), SimError> {
     }
 }
 
-fn check_nonneg(field: &str, v: &[f64]) -> Result<(), SimError> {
+pub(super) fn check_nonneg(field: &str, v: &[f64]) -> Result<(), SimError> {
     match v.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
         None => Ok(()),
         Some(x) => Err(invalid(field, format!("must be finite and >= 0, got {x}"))),
     }
 }
 
-fn check_finite(field: &str, v: &[f64]) -> Result<(), SimError> {
+pub(super) fn check_finite(field: &str, v: &[f64]) -> Result<(), SimError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
@@ -232,6 +232,25 @@ impl Scenario {
                 check_magnitude("reference.position", position, MAX_DISTANCE)?;
                 check_magnitude("reference.roll", &[*roll], PI)?;
             }
+            ReferenceConfig::Step(s) => {
+                check_magnitude("reference.initial", &s.initial, MAX_DISTANCE)?;
+                check_magnitude("reference.target", &s.target, MAX_DISTANCE)?;
+                check_magnitude("reference.time", &[s.time], MAX_DURATION)?;
+            }
+            ReferenceConfig::Sine(s) => {
+                check_magnitude("reference.center", &s.center, MAX_DISTANCE)?;
+                check_magnitude("reference.amplitude", &s.amplitude, MAX_DISTANCE)?;
+                check_range("reference.frequency", s.frequency, 0.0, 100.0)?;
+                check_magnitude("reference.start", &[s.start], MAX_DURATION)?;
+                check_range("reference.ramp", s.ramp, 1e-3, MAX_DURATION)?;
+            }
+            ReferenceConfig::FigureEight(f) => {
+                check_magnitude("reference.center", &f.center, MAX_DISTANCE)?;
+                check_range("reference.size", f.size, 0.0, MAX_DISTANCE)?;
+                check_range("reference.period", f.period, 0.01, MAX_DURATION)?;
+                check_magnitude("reference.start", &[f.start], MAX_DURATION)?;
+                check_range("reference.ramp", f.ramp, 1e-3, MAX_DURATION)?;
+            }
         }
         if let Some(s) = &self.actuators.servo {
             check_pos("actuators.servo.natural_frequency", s.natural_frequency)?;
@@ -290,6 +309,36 @@ impl Scenario {
                         format!("ends at {e} s, before it starts ({} s)", w.start),
                     ));
                 }
+            }
+        }
+        if let Some(a) = &self.disturbances.air {
+            a.validate()?;
+        }
+        self.plant.validate(team.len())?;
+        for (i, p) in self.payloads.iter().enumerate() {
+            p.validate(&format!("payloads[{i}]"))?;
+        }
+        check_magnitude("initial_attitude", &self.initial_attitude, 2.0 * PI)?;
+        if self.physics.ground {
+            // Tilted, an agent's ball swings below where it rests level.
+            let r = crate::math::from_roll_pitch_yaw(self.initial_attitude);
+            let ground = -team.rest_height();
+            let lowest = team
+                .agents
+                .iter()
+                .map(|a| self.initial_position[2] + (r * a.position_vector()).z)
+                .fold(f64::INFINITY, f64::min)
+                - team.collider_radius;
+            if lowest < ground - 1e-9 {
+                return Err(invalid(
+                    "initial_attitude",
+                    format!(
+                        "at z = {} m this attitude puts an agent {:.3} m below the ground: start \
+                         higher",
+                        self.initial_position[2],
+                        ground - lowest
+                    ),
+                ));
             }
         }
         if let Some(n) = &self.disturbances.state_noise {

@@ -37,8 +37,8 @@ use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
 use crate::log::scene::team_scene;
 use crate::log::RunLog;
-use crate::physics::{ExtraWrench, PhysicsWorld, PlantState, TeamBody};
-use crate::scenario::{Failure, Scenario, StateNoise};
+use crate::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
+use crate::scenario::{Failure, Payload, PlantError, Scenario, StateNoise};
 use crate::SimError;
 
 pub use difference::FlightDifference;
@@ -62,15 +62,26 @@ pub const MAX_BODY_RATE: f64 = 200.0;
 fn body_forces<'a>(
     outputs: impl IntoIterator<Item = &'a ActuatorCommand>,
     team: &TeamBody,
+    plant: &PlantError,
     out: &mut Vec<Vector3<f64>>,
 ) {
     out.clear();
-    out.extend(
-        outputs
-            .into_iter()
-            .zip(&team.agents)
-            .map(|(c, a)| agent_force_body(c, a.quarter_turns)),
-    );
+    let outputs = outputs.into_iter().zip(&team.agents);
+    if plant.actuation_is_nominal() {
+        out.extend(outputs.map(|(c, a)| agent_force_body(c, a.quarter_turns)));
+    } else {
+        // Model error: the gimbal reaches its angles off by the offsets and the rotor makes
+        // a share of its thrust.
+        out.extend(outputs.enumerate().map(|(i, (c, a))| {
+            let [dx, dy] = plant.gimbal_offset(i);
+            let real = ActuatorCommand {
+                eta_x: c.eta_x + dx,
+                eta_y: c.eta_y + dy,
+                thrust: c.thrust * plant.efficiency(i),
+            };
+            agent_force_body(&real, a.quarter_turns)
+        }));
+    }
 }
 
 /// `Err(Diverged)` when the state at `t` is not finite or outside the valid range.
@@ -137,6 +148,8 @@ pub struct Simulation {
     total_steps: usize,
     failures: Vec<Failure>,
     applied: Vec<bool>,
+    /// Payloads not attached yet, latest first.
+    payloads: Vec<Payload>,
     failed_true: Vec<bool>,
     failed_told: Vec<bool>,
     noise: Option<(StateNoise, ChaCha8Rng)>,
@@ -160,8 +173,19 @@ impl Simulation {
     pub fn with_options(scenario: &Scenario, options: SimOptions) -> Result<Self, SimError> {
         scenario.validate()?;
         let team = scenario.team_body()?;
-        let initial = PlantState::at_rest(Vector3::from(scenario.initial_position));
-        let world = PhysicsWorld::new(&team, &scenario.physics, &initial)?;
+        let initial = PlantState {
+            rotation: crate::math::from_roll_pitch_yaw(scenario.initial_attitude),
+            ..PlantState::at_rest(Vector3::from(scenario.initial_position))
+        };
+        let p = &scenario.plant;
+        let mass_error = MassError {
+            mass_scale: p.mass_scale,
+            inertia_scale: p.inertia_scale,
+            com_offset: Vector3::from(p.com_offset),
+        };
+        let world = PhysicsWorld::with_mass_error(&team, &scenario.physics, &initial, &mass_error)?;
+        let mut payloads = scenario.payloads.clone();
+        payloads.sort_by(|a, b| b.time.total_cmp(&a.time));
         let n = team.len();
         let mut failures = scenario.failures.clone();
         failures.sort_by(|a, b| a.time.total_cmp(&b.time));
@@ -174,6 +198,7 @@ impl Simulation {
             actuators: ActuatorBank::new(scenario.actuators, n),
             applied: vec![false; failures.len()],
             failures,
+            payloads,
             failed_true: vec![false; n],
             failed_told: vec![false; n],
             noise: scenario
@@ -261,6 +286,10 @@ impl Simulation {
             force_world: Vector3::from(d.wind),
             ..Default::default()
         };
+        if let Some(air) = &d.air {
+            let v = self.world.state().velocity;
+            w.force_world += Vector3::from(air.force(t, v.into(), self.team.len()));
+        }
         if let Some(e) = d.external_wrench.as_ref().filter(|e| e.active(t)) {
             w.force_world += Vector3::from(e.force);
             w.torque_body += Vector3::from(e.torque);
@@ -281,9 +310,18 @@ impl Simulation {
         }
     }
 
+    fn attach_payloads(&mut self, t: f64) -> Result<(), SimError> {
+        while let Some(p) = self.payloads.last().filter(|p| p.time <= t + 1e-12) {
+            let (mass, offset) = (p.mass, Vector3::from(p.offset));
+            self.payloads.pop();
+            self.world.attach_payload(mass, &offset)?;
+        }
+        Ok(())
+    }
+
     fn forces(&self, actual: &[ActuatorCommand]) -> Vec<Vector3<f64>> {
         let mut out = Vec::with_capacity(actual.len());
-        body_forces(actual, &self.team, &mut out);
+        body_forces(actual, &self.team, &self.scenario.plant, &mut out);
         out
     }
 
@@ -337,6 +375,7 @@ impl Simulation {
             let k = self.step_index;
             let t = k as f64 * dt;
             self.apply_failures(t);
+            self.attach_payloads(t)?;
             if k % self.steps_per_control == 0 {
                 if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
                     self.interrupted = true;
@@ -410,7 +449,12 @@ impl Simulation {
                 }
             }
             self.actuators.step(&held, dt);
-            body_forces(self.actuators.outputs(), &self.team, &mut forces);
+            body_forces(
+                self.actuators.outputs(),
+                &self.team,
+                &self.scenario.plant,
+                &mut forces,
+            );
             let extra = self.extra_wrench(t);
             self.world.step(&forces, &extra)?;
             self.step_index += 1;
