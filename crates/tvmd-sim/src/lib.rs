@@ -50,6 +50,7 @@ mod error;
 pub mod flight;
 pub mod log;
 pub mod math;
+pub mod montecarlo;
 pub mod paths;
 pub mod physics;
 pub mod plot;

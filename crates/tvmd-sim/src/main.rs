@@ -58,6 +58,11 @@ enum Command {
     /// The AFS atlas of a catalogue team: the exact attainable lateral forces (bracketed)
     /// against the elliptic cone, and the certified relaxation s* (docs/afs-atlas.md).
     Afs(tvmd_sim::afs_atlas::cli::AfsArgs),
+    /// A Monte Carlo study: the scenario flown --runs times per team, allocator and
+    /// model-error level with model errors and initial conditions drawn from stated
+    /// distributions (docs/method.md, "Monte Carlo"); prints the success rate and writes
+    /// flights.csv, groups.csv and box plots.
+    Montecarlo(tvmd_sim::montecarlo::cli::MonteCarloArgs),
     /// Run one scenario with the tvmd controller; print a summary, write the MCAP log, the
     /// summary JSON and (with --plots) the figures.
     Run {
@@ -270,6 +275,7 @@ fn main() -> ExitCode {
         Command::Afs(args) => tvmd_sim::afs_atlas::cli::run(&args)
             .map(|(_, table)| print!("{table}"))
             .map_err(CliError::Sim),
+        Command::Montecarlo(args) => cmd_montecarlo(&args),
         Command::Run {
             scenario,
             out,
@@ -379,6 +385,30 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn cmd_montecarlo(args: &tvmd_sim::montecarlo::cli::MonteCarloArgs) -> Result<(), CliError> {
+    let bar = std::sync::OnceLock::new();
+    let progress = |done: usize, total: usize| {
+        bar.get_or_init(|| progress_bar(total as u64, "flights"))
+            .set_position(done as u64);
+    };
+    let out = tvmd_sim::montecarlo::cli::run(args, Some(&progress))?;
+    if let Some(b) = bar.get() {
+        b.finish_and_clear();
+    }
+    print!("{}", out.table);
+    println!(
+        "success rate {:.1}% of {} flights",
+        100.0 * out.success_rate,
+        out.flights
+    );
+    println!("flights:  {}", out.files.flights.display());
+    println!("groups:   {}", out.files.groups.display());
+    for p in &out.files.plots {
+        println!("plot:     {}", p.display());
+    }
+    Ok(())
 }
 
 fn progress_bar(ticks: u64, message: &str) -> ProgressBar {

@@ -1,0 +1,134 @@
+//! `tvmd-sim montecarlo SCENARIO --runs N --seed S`: the binary parses these arguments and
+//! prints what [`run`] returns.
+
+use std::path::PathBuf;
+
+use super::{
+    fly_all, group_summaries, text_table, write_report, Distributions, ReportFiles, Study,
+};
+use crate::scenario::Scenario;
+use crate::SimError;
+
+/// Arguments of `tvmd-sim montecarlo`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MonteCarloArgs {
+    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file.
+    #[arg(default_value = "paper-tilt")]
+    pub scenario: String,
+    /// Flights per team, allocator and model-error level.
+    #[arg(long, default_value_t = 100)]
+    pub runs: usize,
+    /// Seed of every draw (flight k of a group always draws the same errors).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Catalogue teams, comma-separated (default: the scenario's).
+    #[arg(long, value_delimiter = ',')]
+    pub teams: Vec<String>,
+    /// Allocators, comma-separated (default: the scenario's).
+    #[arg(long, value_delimiter = ',')]
+    pub allocators: Vec<String>,
+    /// Model-error multipliers, comma-separated, one group each (default: 1).
+    #[arg(long, value_delimiter = ',')]
+    pub model_error: Vec<f64>,
+    /// Mass error half-width (plant mass over the model's in `[1 - e, 1 + e]`).
+    #[arg(long)]
+    pub mass: Option<f64>,
+    /// Inertia error half-width.
+    #[arg(long)]
+    pub inertia: Option<f64>,
+    /// Centre-of-mass offset half-width per axis (m).
+    #[arg(long)]
+    pub com_offset: Option<f64>,
+    /// Thrust efficiency loss half-width per agent (efficiency in `[1 - e, 1]`).
+    #[arg(long)]
+    pub thrust_efficiency: Option<f64>,
+    /// Gimbal offset half-width per agent and axis (rad).
+    #[arg(long)]
+    pub gimbal_offset: Option<f64>,
+    /// Initial horizontal offset half-width per axis (m).
+    #[arg(long)]
+    pub initial_position: Option<f64>,
+    /// Largest initial tilt (rad, at most 2.5; the scenario must start in the air).
+    #[arg(long)]
+    pub initial_tilt: Option<f64>,
+    /// Directory for `flights.csv`, `groups.csv` and the PNG figures (default:
+    /// `out/montecarlo/<scenario>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads (default: every core).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+}
+
+impl MonteCarloArgs {
+    /// The study these arguments describe.
+    pub fn study(&self) -> Result<Study, SimError> {
+        let scenario = Scenario::load(&self.scenario)?;
+        let d = Distributions::default();
+        let or = |v: Option<f64>, default: f64| v.unwrap_or(default);
+        Ok(Study {
+            runs: self.runs,
+            seed: self.seed,
+            teams: self.teams.clone(),
+            allocators: self.allocators.clone(),
+            model_errors: self.model_error.clone(),
+            distributions: Distributions {
+                model_error: d.model_error,
+                mass: or(self.mass, d.mass),
+                inertia: or(self.inertia, d.inertia),
+                com_offset: or(self.com_offset, d.com_offset),
+                thrust_efficiency: or(self.thrust_efficiency, d.thrust_efficiency),
+                gimbal_offset: or(self.gimbal_offset, d.gimbal_offset),
+                initial_position: or(self.initial_position, d.initial_position),
+                initial_tilt: or(self.initial_tilt, d.initial_tilt),
+            },
+            scenario,
+        })
+    }
+
+    /// The output directory.
+    pub fn out_dir(&self, study: &Study) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            PathBuf::from("out")
+                .join("montecarlo")
+                .join(crate::paths::file_stem(&study.scenario.name))
+        })
+    }
+}
+
+/// What a study printed and wrote.
+#[derive(Debug)]
+pub struct MonteCarloOutput {
+    /// The group table as text.
+    pub table: String,
+    /// Overall success rate.
+    pub success_rate: f64,
+    /// Flights flown.
+    pub flights: usize,
+    /// The files written.
+    pub files: ReportFiles,
+}
+
+/// Runs the study of `args`; `progress(done, total)` after each flight.
+pub fn run(
+    args: &MonteCarloArgs,
+    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
+) -> Result<MonteCarloOutput, SimError> {
+    let study = args.study()?;
+    let specs = study.specs()?;
+    let total = specs.len();
+    let each = progress.map(|p| move |done: usize| p(done, total));
+    let rows = fly_all(
+        &specs,
+        args.jobs,
+        each.as_ref().map(|f| f as &(dyn Fn(usize) + Sync)),
+    )?;
+    let files = write_report(&rows, &args.out_dir(&study))?;
+    let successes = rows.iter().filter(|r| r.success).count();
+    Ok(MonteCarloOutput {
+        table: text_table(&group_summaries(&rows)),
+        success_rate: successes as f64 / rows.len().max(1) as f64,
+        flights: rows.len(),
+        files,
+    })
+}
