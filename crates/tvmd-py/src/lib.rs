@@ -22,6 +22,7 @@ mod controller;
 mod convert;
 mod errors;
 mod law;
+mod montecarlo;
 mod planner;
 mod record;
 mod sim;

@@ -87,7 +87,7 @@ pub(crate) fn value_error(error: SimError) -> PyErr {
 
 /// The scenario of a `scenario` argument: a `str` by the CLI's name-or-file rule
 /// (`Scenario::load`), an `os.PathLike` a file.
-fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
+pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
     if let Ok(s) = obj.cast::<PyString>() {
         let s = s.to_cow()?;
         return Scenario::load(&s).map_err(|e| sim_error(e, "", Some((READ, Path::new(&*s)))));
@@ -626,5 +626,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(run_many, &sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep, &sim)?)?;
     sim.add_class::<PySimResult>()?;
+    crate::montecarlo::register(&sim)?;
     m.add_submodule(&sim)
 }

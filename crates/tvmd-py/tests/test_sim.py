@@ -621,3 +621,61 @@ def test_team_override_flies_a_family_with_another_team():
         sim.run("hover", team="a99")
     many = sim.run_many([{"scenario": "hover", "team": "a3-inc", "max_samples": 0}])
     assert many[0].n_agents == 3
+
+
+MC_SHORT = """
+name = "mc-hover"
+duration = 2.0
+initial_position = [0.0, 0.0, 1.5]
+[reference]
+kind = "hover"
+position = [0.0, 0.0, 1.5]
+[success]
+steady_state_window = 0.5
+"""
+
+
+def test_monte_carlo_in_threads_and_on_an_executor_agree(tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    kw = dict(toml=MC_SHORT, runs=3, seed=5, teams=["a4-inc", "a6-inc"], model_errors=[0.0, 1.0])
+    here = sim.monte_carlo(**kw, out=tmp_path)
+    with ThreadPoolExecutor(2) as pool:
+        there = sim.monte_carlo(**kw, executor=pool)
+    assert here["flights"] == there["flights"] and here["groups"] == there["groups"]
+    assert len(here["flights"]) == 12 and len(here["groups"]) == 4
+    # Model error 0 with the initial offset drawn: every flight has the nominal plant.
+    nominal = [r for r in here["flights"] if r["model_error"] == 0.0]
+    assert all(r["mass_scale"] == 1.0 and r["max_gimbal_offset"] == 0.0 for r in nominal)
+    disturbed = [r for r in here["flights"] if r["model_error"] == 1.0]
+    assert all(abs(r["mass_scale"] - 1.0) <= 0.02 for r in disturbed)
+    assert any(r["mass_scale"] != 1.0 for r in disturbed)
+    # The same draw for both teams (common random numbers).
+    a4 = [r["mass_scale"] for r in disturbed if r["team"] == "a4-inc"]
+    a6 = [r["mass_scale"] for r in disturbed if r["team"] == "a6-inc"]
+    assert a4 == a6
+    rate = sum(r["success"] for r in here["flights"]) / 12
+    assert here["success_rate"] == rate
+    files = here["files"]
+    header = open(files["flights"]).readline().strip().split(",")
+    assert header[:3] == ["scenario", "team", "allocator"] and "position_steady_state" in header
+    assert len(files["plots"]) == 6
+    assert all(open(p, "rb").read(4) == b"\x89PNG" for p in files["plots"])
+    assert there["files"] is None
+
+
+def test_monte_carlo_rejects_bad_studies():
+    with pytest.raises(ValueError, match="runs"):
+        sim.monte_carlo(toml=MC_SHORT, runs=0)
+    with pytest.raises(ValueError, match="distributions"):
+        sim.monte_carlo(toml=MC_SHORT, runs=1, distributions={"mass": -1.0})
+    with pytest.raises(ValueError, match="unknown field"):
+        sim.monte_carlo(toml=MC_SHORT, runs=1, distributions={"mas": 0.1})
+    with pytest.raises(ValueError, match="team"):
+        sim.monte_carlo(toml=MC_SHORT, runs=1, teams=["a99"])
+    with pytest.raises(ValueError, match="initial_attitude"):
+        sim.monte_carlo("paper-tilt", runs=1, distributions={"initial_tilt": 0.5})
+    with pytest.raises(ValueError, match="executor"):
+        sim.monte_carlo(toml=MC_SHORT, runs=1, jobs=2, executor=object())
+    with pytest.raises(ValueError, match="flight spec"):
+        sim.monte_carlo_flight("{}")

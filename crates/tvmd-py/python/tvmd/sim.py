@@ -9,12 +9,60 @@ ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
 * :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads.
+* :func:`monte_carlo` -- a Monte Carlo study (model errors and initial conditions drawn per
+  flight) on threads or on any ``concurrent.futures.Executor`` (a process pool, a Dask
+  cluster's ``client.get_executor()``); the results equal for the same seed wherever they fly.
 
 Errors: ``ValueError`` (unknown scenario, bad TOML or field, bad override; the message names the
 field), ``TypeError``, ``OSError`` (scenario file, log), ``RuntimeError`` (the run failed).
 """
 
 from ._tvmd import sim as _sim
+
+monte_carlo_specs = _sim.monte_carlo_specs
+monte_carlo_flight = _sim.monte_carlo_flight
+monte_carlo_fly = _sim.monte_carlo_fly
+monte_carlo_report = _sim.monte_carlo_report
+
+
+def _fly(spec):
+    # Module-level, so executors pickle it by reference (``tvmd.sim._fly``) to their workers.
+    return _sim.monte_carlo_flight(spec)
+
+
+def monte_carlo(
+    scenario=None,
+    *,
+    toml=None,
+    runs=100,
+    seed=0,
+    teams=None,
+    allocators=None,
+    model_errors=None,
+    distributions=None,
+    out=None,
+    jobs=None,
+    executor=None,
+):
+    """A Monte Carlo study; see the stub (``sim.pyi``) for the arguments and the result."""
+    specs = _sim.monte_carlo_specs(
+        scenario,
+        toml=toml,
+        runs=runs,
+        seed=seed,
+        teams=teams,
+        allocators=allocators,
+        model_errors=model_errors,
+        distributions=distributions,
+    )
+    if executor is None:
+        rows = _sim.monte_carlo_fly(specs, jobs=jobs)
+    else:
+        if jobs is not None:
+            raise ValueError("give `jobs` (threads here) or `executor`, not both")
+        rows = list(executor.map(_fly, specs))
+    return _sim.monte_carlo_report(rows, out=out)
+
 
 SimResult = _sim.SimResult
 builtin_scenarios = _sim.builtin_scenarios
@@ -26,6 +74,11 @@ scenario_toml = _sim.scenario_toml
 __all__ = [
     "SimResult",
     "builtin_scenarios",
+    "monte_carlo",
+    "monte_carlo_flight",
+    "monte_carlo_fly",
+    "monte_carlo_report",
+    "monte_carlo_specs",
     "relaxation_sweep",
     "run",
     "run_many",

@@ -20,7 +20,7 @@ Log paths are checked before anything runs: two runs of a batch on one file rais
 """
 
 import os
-from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, Union, final
+from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, TypedDict, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -342,10 +342,106 @@ def relaxation_sweep(
         TypeError, OSError, KeyboardInterrupt, RuntimeError: as ``run``.
     """
 
+class Distributions(TypedDict, total=False):
+    """The uniform distributions of a Monte Carlo study (docs/method.md "Monte Carlo"); a key
+    left out keeps its default. Model-error half-widths are multiplied by ``model_error``."""
+
+    model_error: float
+    """Multiplier of every model-error half-width (default 1)."""
+    mass: float
+    """Plant mass over the model's in ``[1 - e, 1 + e]`` (default 0.02)."""
+    inertia: float
+    """Plant inertia over the model's in ``[1 - e, 1 + e]`` (default 0.1)."""
+    com_offset: float
+    """Centre-of-mass offset per axis in ``[-e, e]`` m (default 0.01)."""
+    thrust_efficiency: float
+    """Each agent's thrust efficiency in ``[1 - e, 1]`` (default 0.02)."""
+    gimbal_offset: float
+    """Each agent's gimbal offsets per axis in ``[-e, e]`` rad (default 0.01)."""
+    initial_position: float
+    """Initial horizontal offset per axis in ``[-e, e]`` m (default 0.1; not scaled)."""
+    initial_tilt: float
+    """Initial tilt in ``[0, e]`` rad about a random horizontal axis (default 0, at most 2.5;
+    the scenario must start in the air)."""
+
+def monte_carlo(
+    scenario: Optional[_ScenarioArg] = None,
+    *,
+    toml: Optional[str] = None,
+    runs: int = 100,
+    seed: int = 0,
+    teams: Optional[Iterable[str]] = None,
+    allocators: Optional[Iterable[AllocatorName]] = None,
+    model_errors: Optional[Iterable[float]] = None,
+    distributions: Optional[Distributions] = None,
+    out: Optional[_PathArg] = None,
+    jobs: Optional[int] = None,
+    executor: Optional[Any] = None,
+) -> dict[str, Any]:
+    """A Monte Carlo study: ``runs`` flights of the scenario for every team, allocator and
+    model-error level, each with a plant error and initial conditions drawn from
+    ``distributions`` (flight ``k`` of a group draws from the stream ``(seed, k)``, so teams
+    and allocators meet the same errors and the results do not depend on where they fly).
+
+    Args:
+        scenario, toml: as ``run`` (default ``"paper-tilt"``).
+        runs: flights per group.
+        seed: the study's seed.
+        teams: catalogue teams (``team.preset`` names); default the scenario's own.
+        allocators: allocators; default the scenario's.
+        model_errors: model-error multipliers, one group each; default
+            ``distributions["model_error"]``.
+        distributions: the half-widths (``Distributions``).
+        out: write ``flights.csv``, ``groups.csv`` and the box plots (PNG) into this directory.
+        jobs: threads of this process (default: every core); not with ``executor``.
+        executor: any ``concurrent.futures.Executor`` (``ProcessPoolExecutor``, a Dask
+            ``Client.get_executor()``): each flight is one task, its spec and row JSON text.
+
+    Returns:
+        ``{"flights": [row, ...], "groups": [group, ...], "success_rate": float,
+        "files": {"flights": path, "groups": path, "plots": [path, ...]} or None}``: one row
+        dict per flight (what it drew and its metrics: ``success``, ``position_steady_state``,
+        ``position_settling_time``, ...; ``None`` where the run has no value), one dict per
+        group (``success_rate``, medians); ``pandas.DataFrame(result["flights"])`` or
+        ``polars.DataFrame(result["flights"])`` loads them.
+
+    Raises:
+        ValueError: as ``run``; ``runs < 1``, an unknown team, allocator or distributions key,
+            a half-width out of range, a draw that makes an invalid scenario (a tilted start on
+            the ground), ``jobs`` with ``executor``.
+    """
+
+def monte_carlo_specs(
+    scenario: Optional[_ScenarioArg] = None,
+    *,
+    toml: Optional[str] = None,
+    runs: int = 100,
+    seed: int = 0,
+    teams: Optional[Iterable[str]] = None,
+    allocators: Optional[Iterable[str]] = None,
+    model_errors: Optional[Iterable[float]] = None,
+    distributions: Optional[Distributions] = None,
+) -> list[str]:
+    """The study's flights as JSON specs, group by group (as ``monte_carlo``, nothing flown)."""
+
+def monte_carlo_flight(spec: str) -> str:
+    """Flies one JSON spec (GIL released); its row as JSON. What an executor's task runs."""
+
+def monte_carlo_fly(specs: list[str], *, jobs: Optional[int] = None) -> list[str]:
+    """Flies JSON specs on this process's threads (GIL released); rows as JSON, input order."""
+
+def monte_carlo_report(rows: list[str], *, out: Optional[_PathArg] = None) -> dict[str, Any]:
+    """The report of JSON rows, as ``monte_carlo`` returns it (with ``out``, the files too)."""
+
 
 __all__ = [
     "SimResult",
     "builtin_scenarios",
+    "monte_carlo",
+    "monte_carlo_flight",
+    "monte_carlo_fly",
+    "monte_carlo_report",
+    "monte_carlo_specs",
     "relaxation_sweep",
     "run",
     "run_many",

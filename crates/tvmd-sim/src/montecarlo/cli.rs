@@ -3,9 +3,7 @@
 
 use std::path::PathBuf;
 
-use super::{
-    fly_all, group_summaries, text_table, write_report, Distributions, ReportFiles, Study,
-};
+use super::{fly_all, text_table, Distributions, ReportFiles, Study, StudyReport};
 use crate::scenario::Scenario;
 use crate::SimError;
 
@@ -123,12 +121,13 @@ pub fn run(
         args.jobs,
         each.as_ref().map(|f| f as &(dyn Fn(usize) + Sync)),
     )?;
-    let files = write_report(&rows, &args.out_dir(&study))?;
-    let successes = rows.iter().filter(|r| r.success).count();
+    let report = StudyReport::new(rows, Some(&args.out_dir(&study)))?;
     Ok(MonteCarloOutput {
-        table: text_table(&group_summaries(&rows)),
-        success_rate: successes as f64 / rows.len().max(1) as f64,
-        flights: rows.len(),
-        files,
+        table: text_table(&report.groups),
+        success_rate: report.success_rate,
+        flights: report.flights.len(),
+        files: report
+            .files
+            .ok_or_else(|| SimError::Internal("the report wrote no files".into()))?,
     })
 }

@@ -157,7 +157,7 @@ pub fn fly_all(
 }
 
 /// What [`write_report`] wrote.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ReportFiles {
     /// One row per flight.
     pub flights: PathBuf,
@@ -179,6 +179,34 @@ pub fn write_report(rows: &[FlightRow], dir: &Path) -> Result<ReportFiles, SimEr
     write_csv(&groups, &files.groups)?;
     let plots = boxplot::write_plots(rows, &groups, dir)?;
     Ok(ReportFiles { plots, ..files })
+}
+
+/// A study's results: every flight, the group summaries, the overall success rate and the
+/// files written (with an output directory).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StudyReport {
+    /// One row per flight.
+    pub flights: Vec<FlightRow>,
+    /// One summary per group.
+    pub groups: Vec<GroupSummary>,
+    /// Successful flights over all flights.
+    pub success_rate: f64,
+    /// The CSV tables and figures, when written.
+    pub files: Option<ReportFiles>,
+}
+
+impl StudyReport {
+    /// The report of `rows`, writing the tables and figures into `out` if given.
+    pub fn new(rows: Vec<FlightRow>, out: Option<&Path>) -> Result<Self, SimError> {
+        let files = out.map(|dir| write_report(&rows, dir)).transpose()?;
+        let successes = rows.iter().filter(|r| r.success).count();
+        Ok(Self {
+            groups: group_summaries(&rows),
+            success_rate: successes as f64 / rows.len().max(1) as f64,
+            flights: rows,
+            files,
+        })
+    }
 }
 
 #[cfg(test)]

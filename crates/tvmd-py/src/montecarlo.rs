@@ -1,0 +1,129 @@
+//! `tvmd.sim`'s Monte Carlo functions: thin adapters over `tvmd_sim::montecarlo`. Specs and rows
+//! cross the boundary as JSON text so that any `concurrent.futures.Executor` (a process pool,
+//! a Dask cluster) can ship them; `tvmd/sim.py`'s `monte_carlo` composes them.
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use tvmd_sim::montecarlo::{
+    fly_all, fly_flight, Distributions, FlightRow, FlightSpec, Study, StudyReport,
+};
+use tvmd_sim::scenario::Scenario;
+
+use crate::sim::{record_to_py, scenario_arg, value_error};
+
+/// The study's flights as JSON specs. See the stub.
+#[pyfunction]
+#[pyo3(signature = (scenario = None, *, toml = None, runs = 100, seed = 0, teams = None, allocators = None, model_errors = None, distributions = None))]
+#[allow(clippy::too_many_arguments)]
+fn monte_carlo_specs(
+    scenario: Option<&Bound<'_, PyAny>>,
+    toml: Option<String>,
+    runs: i64,
+    seed: u64,
+    teams: Option<Vec<String>>,
+    allocators: Option<Vec<String>>,
+    model_errors: Option<Vec<f64>>,
+    distributions: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<String>> {
+    let base = match (scenario.filter(|s| !s.is_none()), toml) {
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err(
+                "give either `scenario` (a name or a file) or `toml` (TOML text), not both",
+            ))
+        }
+        (Some(s), None) => scenario_arg(s, "scenario")?,
+        (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
+        (None, None) => Scenario::builtin("paper-tilt").map_err(value_error)?,
+    };
+    let runs = usize::try_from(runs)
+        .map_err(|_| PyValueError::new_err(format!("`runs` must be >= 1, got {runs}")))?;
+    let distributions = match distributions.filter(|d| !d.is_none()) {
+        None => Distributions::default(),
+        Some(d) => {
+            let py = d.py();
+            let text: String = py
+                .import(pyo3::intern!(py, "json"))?
+                .call_method1(pyo3::intern!(py, "dumps"), (d,))?
+                .extract()?;
+            serde_json::from_str(&text)
+                .map_err(|e| PyValueError::new_err(format!("`distributions`: {e}")))?
+        }
+    };
+    let study = Study {
+        scenario: base,
+        runs,
+        seed,
+        teams: teams.unwrap_or_default(),
+        allocators: allocators.unwrap_or_default(),
+        model_errors: model_errors.unwrap_or_default(),
+        distributions,
+    };
+    let specs = study.specs().map_err(value_error)?;
+    specs
+        .iter()
+        .map(|s| s.to_json().map_err(value_error))
+        .collect()
+}
+
+/// Flies one JSON spec (GIL released) and returns its row as JSON. See the stub.
+#[pyfunction]
+fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
+    let spec = FlightSpec::from_json(spec).map_err(value_error)?;
+    let row = py.detach(|| fly_flight(&spec)).map_err(value_error)?;
+    serde_json::to_string(&row).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Flies the JSON specs on threads (GIL released), rows as JSON in input order. See the stub.
+#[pyfunction]
+#[pyo3(signature = (specs, *, jobs = None))]
+fn monte_carlo_fly(
+    py: Python<'_>,
+    specs: Vec<String>,
+    jobs: Option<usize>,
+) -> PyResult<Vec<String>> {
+    if jobs == Some(0) {
+        return Err(PyValueError::new_err("`jobs` must be >= 1 or None"));
+    }
+    let specs = specs
+        .iter()
+        .map(|s| FlightSpec::from_json(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(value_error)?;
+    let rows = py
+        .detach(|| fly_all(&specs, jobs, None))
+        .map_err(value_error)?;
+    rows.iter()
+        .map(|r| serde_json::to_string(r).map_err(|e| PyValueError::new_err(e.to_string())))
+        .collect()
+}
+
+/// The report of JSON rows: the flights and groups as lists of dicts, the overall success
+/// rate, and with `out` the CSV tables and figures written there. See the stub.
+#[pyfunction]
+#[pyo3(signature = (rows, *, out = None))]
+fn monte_carlo_report<'py>(
+    py: Python<'py>,
+    rows: Vec<String>,
+    out: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let rows = rows
+        .iter()
+        .map(|r| serde_json::from_str::<FlightRow>(r))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(format!("`rows`: not a flight row: {e}")))?;
+    let report = py
+        .detach(|| StudyReport::new(rows, out.as_deref()))
+        .map_err(value_error)?;
+    record_to_py(py, &report)
+}
+
+/// Adds the Monte Carlo functions to the `sim` submodule.
+pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
+    sim.add_function(wrap_pyfunction!(monte_carlo_specs, sim)?)?;
+    sim.add_function(wrap_pyfunction!(monte_carlo_flight, sim)?)?;
+    sim.add_function(wrap_pyfunction!(monte_carlo_fly, sim)?)?;
+    sim.add_function(wrap_pyfunction!(monte_carlo_report, sim)?)?;
+    Ok(())
+}
