@@ -63,6 +63,9 @@ enum Command {
     /// distributions (docs/method.md, "Monte Carlo"); prints the success rate and writes
     /// flights.csv, groups.csv and box plots.
     Montecarlo(tvmd_sim::montecarlo::cli::MonteCarloArgs),
+    /// Every catalogue team with every allocator through a step, wind, a one-agent failure
+    /// and model error: the README's results table (Markdown on stdout).
+    Catalogue(tvmd_sim::montecarlo::catalogue::CatalogueArgs),
     /// Run one scenario with the tvmd controller; print a summary, write the MCAP log, the
     /// summary JSON and (with --plots) the figures.
     Run {
@@ -276,6 +279,9 @@ fn main() -> ExitCode {
             .map(|(_, table)| print!("{table}"))
             .map_err(CliError::Sim),
         Command::Montecarlo(args) => cmd_montecarlo(&args),
+        Command::Catalogue(args) => tvmd_sim::montecarlo::catalogue::run_and_write(&args)
+            .map(|table| print!("{table}"))
+            .map_err(CliError::Sim),
         Command::Run {
             scenario,
             out,

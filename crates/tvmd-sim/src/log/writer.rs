@@ -21,7 +21,7 @@ use crate::SimError;
 /// them with [`LogChannels::write`].
 pub type LogJob = Box<dyn FnOnce(&mut LogChannels) + Send + 'static>;
 
-/// Jobs the queue holds before [`LogWriter::submit`] waits for the writer (about 1,000 ticks:
+/// Jobs the queue holds before `LogWriter::submit` waits for the writer (about 1,000 ticks:
 /// 10 s of a 100 Hz flight, a few MB at most).
 pub const QUEUE_JOBS: usize = 1024;
 

@@ -8,6 +8,7 @@
 //! index, so the table is the same on one thread, many threads or many machines.
 
 pub mod boxplot;
+pub mod catalogue;
 pub mod cli;
 pub mod distributions;
 pub mod flight;
