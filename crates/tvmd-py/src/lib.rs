@@ -21,6 +21,7 @@ mod atlas;
 mod controller;
 mod convert;
 mod errors;
+mod executor;
 mod law;
 mod montecarlo;
 mod planner;

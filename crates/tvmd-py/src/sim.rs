@@ -107,17 +107,17 @@ pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scena
 
 /// The arguments of one run, as `run` takes them.
 #[derive(Default)]
-struct RunArgs<'a, 'py> {
-    scenario: Option<&'a Bound<'py, PyAny>>,
-    toml: Option<String>,
-    mcap: Option<PathBuf>,
-    relaxation: Option<f64>,
-    allocator: Option<String>,
-    null_space: Option<String>,
-    precision: Option<String>,
-    pil: Option<String>,
-    max_samples: Option<i64>,
-    team: Option<String>,
+pub(crate) struct RunArgs<'a, 'py> {
+    pub(crate) scenario: Option<&'a Bound<'py, PyAny>>,
+    pub(crate) toml: Option<String>,
+    pub(crate) mcap: Option<PathBuf>,
+    pub(crate) relaxation: Option<f64>,
+    pub(crate) allocator: Option<String>,
+    pub(crate) null_space: Option<String>,
+    pub(crate) precision: Option<String>,
+    pub(crate) pil: Option<String>,
+    pub(crate) max_samples: Option<i64>,
+    pub(crate) team: Option<String>,
 }
 
 /// A `max_samples` argument: `None` keeps every tick, `n >= 0` at most `n` evenly spaced.
@@ -179,7 +179,7 @@ impl RunArgs<'_, '_> {
 }
 
 /// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments.
-fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
+pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
     let name = format!("runs[{k}]");
     let Ok(dict) = item.cast::<PyDict>() else {
         if item.is_instance_of::<PyString>() || item.hasattr("__fspath__")? {
@@ -390,13 +390,6 @@ fn relaxation_sweep(
     pil: Option<String>,
     max_samples: Option<i64>,
 ) -> PyResult<Vec<PySimResult>> {
-    let values = match relaxations.filter(|r| !r.is_none()) {
-        Some(r) => match scalars(r, "relaxations")? {
-            (values, shape) if shape.len() == 1 => values,
-            (_, shape) => return Err(shape_error("relaxations", "(k,)", &shape)),
-        },
-        None => vec![0.25, 0.5, 0.75, 1.0],
-    };
     let args = RunArgs {
         scenario,
         toml,
@@ -406,6 +399,26 @@ fn relaxation_sweep(
         max_samples,
         ..RunArgs::default()
     };
+    let specs = sweep_run_specs(relaxations, args, mcap_dir)?;
+    run_specs(py, specs, jobs, |_, s| {
+        format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
+    })
+}
+
+/// The runs of a relaxation study as `relaxation_sweep` takes them: `args`' scenario once per
+/// relaxation (default 0.25, 0.5, 0.75, 1), each with `args`' target and sample retention.
+pub(crate) fn sweep_run_specs(
+    relaxations: Option<&Bound<'_, PyAny>>,
+    args: RunArgs<'_, '_>,
+    mcap_dir: Option<PathBuf>,
+) -> PyResult<Vec<RunSpec>> {
+    let values = match relaxations.filter(|r| !r.is_none()) {
+        Some(r) => match scalars(r, "relaxations")? {
+            (values, shape) if shape.len() == 1 => values,
+            (_, shape) => return Err(shape_error("relaxations", "(k,)", &shape)),
+        },
+        None => vec![0.25, 0.5, 0.75, 1.0],
+    };
     let base = args.spec("scenario")?;
     let mut specs =
         sweep_specs(&base.scenario, &values, mcap_dir.as_deref()).map_err(value_error)?;
@@ -413,13 +426,29 @@ fn relaxation_sweep(
         spec.pil = base.pil;
         spec.samples = base.samples;
     }
-    run_specs(py, specs, jobs, |_, s| {
-        format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
-    })
+    Ok(specs)
+}
+
+/// A scenario in a `SimResult`'s pickle: its TOML (every field, validated on the way back).
+mod scenario_as_toml {
+    use serde::{Deserialize, Deserializer, Serializer};
+    use tvmd_sim::scenario::Scenario;
+
+    pub(super) fn serialize<S: Serializer>(s: &Scenario, out: S) -> Result<S::Ok, S::Error> {
+        let text = s.to_toml_string().map_err(serde::ser::Error::custom)?;
+        out.serialize_str(&text)
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Scenario, D::Error> {
+        let text = String::deserialize(d)?;
+        Scenario::from_toml_str(&text).map_err(serde::de::Error::custom)
+    }
 }
 
 /// One run as `SimResult` keeps it: the scenario that ran, its samples and metrics.
+#[derive(serde::Serialize, serde::Deserialize)]
 pub(crate) struct SimData {
+    #[serde(with = "scenario_as_toml")]
     scenario: Scenario,
     mcap: Option<PathBuf>,
     samples: Vec<Sample>,
@@ -597,6 +626,16 @@ record! {
         fn __len__(&self) -> usize {
             self.inner.samples.len()
         }
+
+        /// Pickles as `tvmd.sim._sim_result_from_state(bytes)`: every sample and summary in
+        /// CBOR (NaN kept), so an executor's worker can send its result back.
+        fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, pyo3::types::PyBytes>,))> {
+            let mut bytes = Vec::new();
+            ciborium::into_writer(&self.inner, &mut bytes)
+                .map_err(|e| PyRuntimeError::new_err(format!("cannot pickle a SimResult: {e}")))?;
+            let rebuild = py.import("tvmd.sim")?.getattr("_sim_result_from_state")?;
+            Ok((rebuild, (pyo3::types::PyBytes::new(py, &bytes),)))
+        }
     }
 }
 
@@ -626,6 +665,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(run_many, &sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep, &sim)?)?;
     sim.add_class::<PySimResult>()?;
+    crate::executor::register(&sim)?;
     crate::montecarlo::register(&sim)?;
     m.add_submodule(&sim)
 }

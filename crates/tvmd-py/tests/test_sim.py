@@ -679,3 +679,37 @@ def test_monte_carlo_rejects_bad_studies():
         sim.monte_carlo(toml=MC_SHORT, runs=1, jobs=2, executor=object())
     with pytest.raises(ValueError, match="flight spec"):
         sim.monte_carlo_flight("{}")
+
+
+def test_results_pickle_and_batches_fly_on_an_executor(tmp_path):
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    r = sim.run(toml=MC_SHORT)
+    back = pickle.loads(pickle.dumps(r))
+    assert back.to_dict().keys() == r.to_dict().keys()
+    for name, value in r.to_dict().items():
+        if isinstance(value, np.ndarray):
+            np.testing.assert_array_equal(getattr(back, name), value)
+        else:
+            assert getattr(back, name) == value, name
+    items = [{"toml": MC_SHORT, "max_samples": 5}, {"toml": MC_SHORT, "relaxation": 1.0}]
+    here = sim.run_many(items)
+    with ProcessPoolExecutor(2) as pool:
+        there = sim.run_many(items, executor=pool)
+        sweep = sim.relaxation_sweep([0.5, 1.0], toml=MC_SHORT, executor=pool, max_samples=3)
+    for a, b in zip(here, there):
+        np.testing.assert_array_equal(a.position, b.position)
+        assert a.summary["metrics"] == b.summary["metrics"]
+    assert [s.scenario_name for s in sweep] == ["mc-hover-s0.5", "mc-hover-s1"]
+    assert [s.relaxation for s in sweep] == [0.5, 1.0] and all(len(s) <= 3 for s in sweep)
+    same = sim.relaxation_sweep([0.5, 1.0], toml=MC_SHORT, max_samples=3)
+    np.testing.assert_array_equal(sweep[1].position, same[1].position)
+    # Checked before anything flies: two runs on one log, `jobs` with an executor.
+    log = str(tmp_path / "x.mcap")
+    with pytest.raises(ValueError, match="clash"):
+        sim.run_many([{"toml": MC_SHORT, "mcap": log}] * 2, executor=object())
+    with pytest.raises(ValueError, match="executor"):
+        sim.run_many(items, jobs=2, executor=object())
+    with pytest.raises(ValueError, match="pickled"):
+        sim._sim_result_from_state(b"nope")

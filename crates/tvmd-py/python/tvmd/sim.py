@@ -8,7 +8,8 @@ ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``
 * :func:`builtin_scenarios`, :func:`scenario_toml` -- the built-in scenarios.
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
-* :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads.
+* :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads, or one task per
+  run on any ``concurrent.futures.Executor`` (``executor=``; results pickle back).
 * :func:`monte_carlo` -- a Monte Carlo study (model errors and initial conditions drawn per
   flight) on threads or on any ``concurrent.futures.Executor`` (a process pool, a Dask
   cluster's ``client.get_executor()``); the results equal for the same seed wherever they fly.
@@ -66,10 +67,58 @@ def monte_carlo(
 
 SimResult = _sim.SimResult
 builtin_scenarios = _sim.builtin_scenarios
-relaxation_sweep = _sim.relaxation_sweep
 run = _sim.run
-run_many = _sim.run_many
 scenario_toml = _sim.scenario_toml
+# `SimResult.__reduce__` names it here: an executor's worker sends its result back pickled.
+_sim_result_from_state = _sim._sim_result_from_state
+
+
+def _run_one(item):
+    # Module-level, so executors pickle it by reference (``tvmd.sim._run_one``).
+    return _sim.run_many([item], jobs=1)[0]
+
+
+def _on_executor(items, jobs, executor):
+    if jobs is not None:
+        raise ValueError("give `jobs` (threads here) or `executor`, not both")
+    return list(executor.map(_run_one, items))
+
+
+def run_many(runs, *, jobs=None, executor=None):
+    """Many runs, results in input order; see the stub (``sim.pyi``)."""
+    if executor is None:
+        return _sim.run_many(runs, jobs=jobs)
+    items = runs if isinstance(runs, (str, dict)) else list(runs)
+    _sim._check_runs(items)
+    return _on_executor(items, jobs, executor)
+
+
+def relaxation_sweep(
+    relaxations=None,
+    scenario=None,
+    *,
+    toml=None,
+    allocator=None,
+    precision=None,
+    mcap_dir=None,
+    jobs=None,
+    pil=None,
+    max_samples=None,
+    executor=None,
+):
+    """The relaxation study; see the stub (``sim.pyi``)."""
+    kw = dict(
+        toml=toml,
+        allocator=allocator,
+        precision=precision,
+        mcap_dir=mcap_dir,
+        pil=pil,
+        max_samples=max_samples,
+    )
+    if executor is None:
+        return _sim.relaxation_sweep(relaxations, scenario, jobs=jobs, **kw)
+    items = _sim._relaxation_sweep_runs(relaxations, scenario, **kw)
+    return _on_executor(items, jobs, executor)
 
 __all__ = [
     "SimResult",

@@ -287,7 +287,9 @@ def run(
             found (the message says how to install or build it).
     """
 
-def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[SimResult]:
+def run_many(
+    runs: Iterable[_RunItem], *, jobs: Optional[int] = None, executor: Optional[Any] = None
+) -> list[SimResult]:
     """Runs many scenarios in parallel threads (GIL released) and returns their results in input
     order.
 
@@ -298,6 +300,10 @@ def run_many(runs: Iterable[_RunItem], *, jobs: Optional[int] = None) -> list[Si
             ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` and ``"null_space"``
             too, as ``run``; ``"max_samples"`` bounds that run's samples).
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
+        executor: fly on any ``concurrent.futures.Executor`` instead of this process's
+            threads (``ProcessPoolExecutor``, a Dask ``Client.get_executor()``): one task per
+            run, each ``SimResult`` pickled back; logs are written where the task runs. The
+            batch is checked here first (items, no two runs on one log); not with ``jobs``.
 
     Every item is loaded and validated before any run starts. If runs fail, the first failure
     in input order is raised, its message prefixed with ``runs[k]``.
@@ -318,6 +324,7 @@ def relaxation_sweep(
     jobs: Optional[int] = None,
     pil: Optional[_PilTarget] = None,
     max_samples: Optional[int] = None,
+    executor: Optional[Any] = None,
 ) -> list[SimResult]:
     """The paper's relaxation study: one scenario flown once per relaxation ``s`` (in parallel
     threads, GIL released), results in the order of ``relaxations``. The planner's roll limit in
@@ -333,6 +340,10 @@ def relaxation_sweep(
         precision: override the controller's float type, as ``run``.
         mcap_dir: write one MCAP log per run there, ``<name>-s<s>.mcap``.
         jobs: worker threads (default: the available cores).
+        executor: fly on any ``concurrent.futures.Executor`` instead of this process's
+            threads (``ProcessPoolExecutor``, a Dask ``Client.get_executor()``): one task per
+            run, each ``SimResult`` pickled back; logs are written where the task runs. The
+            batch is checked here first (items, no two runs on one log); not with ``jobs``.
         pil: fly every run with the controller on this emulated target, as ``run``.
         max_samples: bound every run's samples, as ``run``.
 

@@ -51,7 +51,7 @@ impl Default for SuccessBounds {
 }
 
 /// The verdict of a run against its scenario's [`SuccessBounds`].
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Verdict {
     /// Every bound met and the flight reached the scenario's end.
     pub success: bool,

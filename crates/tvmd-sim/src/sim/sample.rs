@@ -1,7 +1,7 @@
 //! What the loop records at each controller tick: [`Sample`].
 
 use nalgebra::Vector3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::actuators::ActuatorCommand;
 use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
@@ -11,7 +11,7 @@ use crate::physics::PlantState;
 use crate::reference::ReferenceSample;
 
 /// One recorded sample (at each controller tick, true state).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
     /// Time (s).
     pub t: f64,

@@ -3,7 +3,7 @@
 //! force and moment errors, thrust efficiency and time saturated, each folded one sample at a
 //! time.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::rules::{ArgMax, Max, Min};
 use crate::sim::sample::Sample;
@@ -19,7 +19,7 @@ pub const POSITION_BAND_FLOOR: f64 = 1e-3;
 pub const ATTITUDE_BAND_FLOOR: f64 = 1e-3;
 
 /// The metrics of one error signal `e(t) >= 0` over a run.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ErrorMetrics {
     /// Largest error (m or rad).
     pub peak: f64,
@@ -127,7 +127,7 @@ impl ErrorFold {
 }
 
 /// Largest, mean and integral of a magnitude reported at some samples.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MagnitudeMetrics {
     /// Largest value.
     pub max: f64,
@@ -166,7 +166,7 @@ impl MagnitudeFold {
 }
 
 /// Mean and lowest thrust efficiency.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EfficiencyMetrics {
     /// Mean `||u_f|| / sum_i ||f_i||` over the samples that report it.
     pub mean: f64,
@@ -175,7 +175,7 @@ pub struct EfficiencyMetrics {
 }
 
 /// The flight metrics of a run (`docs/method.md`, "Flight metrics").
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlightMetrics {
     /// Position error `||x - x_r||` (m); `None` for a run without samples.
     pub position: Option<ErrorMetrics>,

@@ -13,7 +13,7 @@ pub mod rules;
 #[cfg(test)]
 pub(crate) mod tests;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::physics::PlantState;
 use crate::scenario::{Precision, Scenario, Verdict};
@@ -77,7 +77,7 @@ pub struct RunTotals {
 }
 
 /// One hover classification of a run: when the controller accepted a new failure mask.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HoverClassification {
     /// Time (s) of the controller tick that accepted the mask.
     pub time: f64,
@@ -90,7 +90,7 @@ pub struct HoverClassification {
 }
 
 /// Summary of a run.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
     /// Scenario name.
     pub scenario: String,
@@ -175,7 +175,7 @@ pub struct RunSummary {
 /// The null-space stage over a run: its smallest normalized margin to the admissible
 /// boundary (`docs/method.md`, "Null-space stage") before and after it, over the samples where
 /// it ran.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NullSpaceSummary {
     /// Samples where the stage ran.
     pub periods: usize,
@@ -200,7 +200,7 @@ impl RunSummary {
 }
 
 /// Metrics of a paper-tilt-like run.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PaperMetrics {
     /// Horizontal error at `t = 4 s` (m) (calibration: 0.23 m).
     pub horizontal_error_at_4s: Option<f64>,

@@ -163,7 +163,7 @@ impl ArgMax {
 }
 
 /// A rise of a value between two times.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Rise {
     /// `v(to) - v(from)`.
     pub rise: f64,

@@ -1,0 +1,96 @@
+//! What `tvmd.sim`'s batch functions need to fly on any `concurrent.futures.Executor` (a
+//! process pool, a Dask cluster): a `SimResult` that pickles, the batch checks `run_many` does
+//! before flying, and a relaxation study as `run_many` items. `tvmd/sim.py` composes them.
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use tvmd_sim::runner;
+use tvmd_sim::sim::SampleRetention;
+
+use crate::sim::{run_item, sweep_run_specs, value_error, PySimResult, RunArgs, SimData};
+
+/// A `SimResult` from its pickle (`SimResult.__reduce__`).
+#[pyfunction]
+#[pyo3(name = "_sim_result_from_state")]
+fn sim_result_from_state(state: &[u8]) -> PyResult<PySimResult> {
+    let inner: SimData = ciborium::from_reader(state)
+        .map_err(|e| PyValueError::new_err(format!("not a pickled SimResult: {e}")))?;
+    Ok(PySimResult { inner })
+}
+
+/// Checks a batch as `run_many` would before flying (every item, and no two runs on one log),
+/// for `run_many(executor=...)`, whose items fly one task each.
+#[pyfunction]
+#[pyo3(name = "_check_runs")]
+fn check_runs(runs: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
+        return Err(PyTypeError::new_err(
+            "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
+        ));
+    }
+    let specs = runs
+        .try_iter()
+        .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?
+        .enumerate()
+        .map(|(k, item)| run_item(&item?, k))
+        .collect::<PyResult<Vec<_>>>()?;
+    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    Ok(specs.len())
+}
+
+/// The runs of a relaxation study as `run_many` items (TOML text, log, target, retention), for
+/// `relaxation_sweep(executor=...)`.
+#[pyfunction]
+#[pyo3(name = "_relaxation_sweep_runs")]
+#[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, pil = None, max_samples = None))]
+#[allow(clippy::too_many_arguments)]
+fn relaxation_sweep_runs<'py>(
+    py: Python<'py>,
+    relaxations: Option<&Bound<'py, PyAny>>,
+    scenario: Option<&Bound<'py, PyAny>>,
+    toml: Option<String>,
+    allocator: Option<String>,
+    precision: Option<String>,
+    mcap_dir: Option<PathBuf>,
+    pil: Option<String>,
+    max_samples: Option<i64>,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let args = RunArgs {
+        scenario,
+        toml,
+        allocator,
+        precision,
+        pil,
+        max_samples,
+        ..RunArgs::default()
+    };
+    let specs = sweep_run_specs(relaxations, args, mcap_dir)?;
+    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    specs
+        .into_iter()
+        .map(|spec| {
+            let d = PyDict::new(py);
+            d.set_item("toml", spec.scenario.to_toml_string().map_err(value_error)?)?;
+            d.set_item("mcap", spec.log)?;
+            d.set_item("pil", spec.pil.map(|p| p.to_string()))?;
+            let kept = match spec.samples {
+                SampleRetention::All => None,
+                SampleRetention::AtMost(n) => Some(n),
+                SampleRetention::None => Some(0),
+            };
+            d.set_item("max_samples", kept)?;
+            Ok(d)
+        })
+        .collect()
+}
+
+/// Adds the executor helpers to the `sim` submodule.
+pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
+    sim.add_function(wrap_pyfunction!(sim_result_from_state, sim)?)?;
+    sim.add_function(wrap_pyfunction!(check_runs, sim)?)?;
+    sim.add_function(wrap_pyfunction!(relaxation_sweep_runs, sim)?)?;
+    Ok(())
+}
