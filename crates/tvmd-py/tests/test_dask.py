@@ -1,11 +1,10 @@
 """A Monte Carlo batch on a two-worker dask.distributed LocalCluster equals the in-process batch
 for the same seed (each flight is one task: its spec and row are JSON text)."""
 
-import pytest
+# A hard import, not importorskip: a broken install fails the test command instead of skipping.
+import distributed
 
 from tvmd import sim
-
-distributed = pytest.importorskip("distributed")
 
 SHORT = """
 name = "mc-dask"
