@@ -21,6 +21,10 @@ use tvmd_sim::scenario::Scenario;
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::GRAVITY;
 
+/// The CLI's allocator (`src/main.rs`), so the flights here cost what `tvmd-sim run` pays.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn spec(scenario: &Scenario, log: Option<std::path::PathBuf>) -> RunSpec {
     RunSpec {
         scenario: scenario.clone(),

@@ -93,6 +93,12 @@ impl ActuatorModel {
     pub fn is_ideal(&self) -> bool {
         self.servo.is_none() && self.rotor_lag.is_none() && self.limits.is_none()
     }
+
+    /// True if the outputs depend on the held commands and the failures alone (no servo, no
+    /// rotor lag; saturation allowed): they change only when either does.
+    pub fn is_memoryless(&self) -> bool {
+        self.servo.is_none() && self.rotor_lag.is_none()
+    }
 }
 
 /// What fails in an agent.

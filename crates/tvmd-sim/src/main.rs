@@ -45,6 +45,12 @@ use tvmd_sim::scenario::{Overrides, Precision, Scenario, BUILTIN_NAMES};
 use tvmd_sim::sim::{PaperMetrics, RunSummary, SampleRetention};
 use tvmd_sim::SimError;
 
+/// mimalloc rather than glibc's malloc: rapier allocates and frees solver buffers every physics
+/// step, and a logged run's tick records are freed on the log's writer thread, which made glibc's
+/// arenas contend (BENCHMARKS.md, "Simulator real-time factor").
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Simulator of thrust-vectoring modular team UAVs with the tvmd controller in the loop.
 #[derive(Parser, Debug)]
 #[command(name = "tvmd-sim", version, about, long_about = None)]

@@ -35,7 +35,6 @@ use serde::Serialize;
 
 use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
-use crate::log::scene::team_scene;
 use crate::log::RunLog;
 use crate::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
 use crate::scenario::{Failure, Payload, PlantError, Scenario, StateNoise};
@@ -297,9 +296,12 @@ impl Simulation {
         w
     }
 
-    fn apply_failures(&mut self, t: f64) {
+    /// Applies the failures whose time has come; true if any was applied now.
+    fn apply_failures(&mut self, t: f64) -> bool {
+        let mut any = false;
         for (k, f) in self.failures.iter().enumerate() {
             if !self.applied[k] && f.time <= t + 1e-12 {
+                any = true;
                 self.applied[k] = true;
                 self.actuators.fail(f.agent, f.kind);
                 self.failed_true[f.agent] = true;
@@ -308,6 +310,7 @@ impl Simulation {
                 }
             }
         }
+        any
     }
 
     fn attach_payloads(&mut self, t: f64) -> Result<(), SimError> {
@@ -359,6 +362,23 @@ impl Simulation {
         mut log: Option<&mut RunLog>,
         cancel: Option<&AtomicBool>,
     ) -> Result<(), SimError> {
+        let mut batch = tick_log::TickBatch::for_log(log.as_deref());
+        let flown = self.fly_steps(controller, log.as_deref_mut(), cancel, &mut batch);
+        // What was flown is logged whatever ended the loop (an error, an interrupt, the end).
+        let flushed = match log {
+            Some(log) => batch.flush(log),
+            None => Ok(()),
+        };
+        flown.and(flushed)
+    }
+
+    fn fly_steps(
+        &mut self,
+        controller: &mut dyn FlightController,
+        mut log: Option<&mut RunLog>,
+        cancel: Option<&AtomicBool>,
+        batch: &mut tick_log::TickBatch,
+    ) -> Result<(), SimError> {
         let dt = self.scenario.physics.dt;
         let period = self.scenario.controller_period;
         let settings = self.scenario.log;
@@ -371,10 +391,17 @@ impl Simulation {
             .then(|| std::sync::Arc::new(self.team.clone()));
         // Reused every physics step: the step allocates nothing of its own.
         let mut forces = Vec::with_capacity(self.team.len());
+        // The agents' forces follow the actuator outputs, which actuators without servo or rotor
+        // lag change only at a controller tick or a failure: recomputed (two sines and two
+        // cosines per agent) only then.
+        let memoryless = self.scenario.actuators.is_memoryless();
+        let mut forces_stale = true;
         while self.step_index < self.total_steps {
             let k = self.step_index;
             let t = k as f64 * dt;
-            self.apply_failures(t);
+            if self.apply_failures(t) {
+                forces_stale = true;
+            }
             self.attach_payloads(t)?;
             if k % self.steps_per_control == 0 {
                 if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
@@ -405,6 +432,7 @@ impl Simulation {
                     });
                 }
                 held.clone_from(&out.commands);
+                forces_stale = true;
                 let tick = self.controller_calls;
                 self.controller_calls += 1;
                 let actual = self.actuators.actual();
@@ -420,41 +448,44 @@ impl Simulation {
                 self.samples.push(tick, || sample);
                 if let Some(log) = log.as_deref_mut() {
                     // The scene shows the commanded forces: at a tick the actual ones still lag
-                    // by one period. One job per tick, the scene included: each job wakes the
-                    // writer thread.
+                    // by one period.
                     let scene = team
                         .clone()
                         .filter(|_| tick % scene_every == 0)
-                        .map(|team| (team, self.forces(&out.commands), self.max_thrust));
-                    let heavy = tick % heavy_every == 0;
-                    let record = tick_log::Tick {
-                        t,
-                        state: truth,
-                        reference,
-                        forces_body: self.forces(&actual),
-                        output: out,
-                        actual,
-                        failed: self.failed_true.clone(),
-                    };
-                    log.submit(move |w| {
-                        let scene = scene.map(|(team, forces, max_thrust)| {
-                            team_scene(t, &team, &forces, &record.failed, max_thrust)
+                        .map(|team| tick_log::SceneRecord {
+                            team,
+                            forces_body: self.forces(&out.commands),
+                            max_thrust: self.max_thrust,
                         });
-                        record.write(w, heavy);
-                        if let Some(scene) = scene {
-                            w.write(t, &scene);
-                        }
-                    })?;
+                    batch.push(
+                        log,
+                        tick_log::LoggedTick {
+                            tick: tick_log::Tick {
+                                t,
+                                state: truth,
+                                reference,
+                                forces_body: self.forces(&actual),
+                                output: out,
+                                actual,
+                                failed: self.failed_true.clone(),
+                            },
+                            heavy: tick % heavy_every == 0,
+                            scene,
+                        },
+                    )?;
                     log.pace(t);
                 }
             }
             self.actuators.step(&held, dt);
-            body_forces(
-                self.actuators.outputs(),
-                &self.team,
-                &self.scenario.plant,
-                &mut forces,
-            );
+            if forces_stale || !memoryless {
+                body_forces(
+                    self.actuators.outputs(),
+                    &self.team,
+                    &self.scenario.plant,
+                    &mut forces,
+                );
+                forces_stale = false;
+            }
             let extra = self.extra_wrench(t);
             self.world.step(&forces, &extra)?;
             self.step_index += 1;
