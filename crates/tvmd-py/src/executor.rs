@@ -4,13 +4,13 @@
 
 use std::path::PathBuf;
 
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyDict;
 use tvmd_sim::runner;
 use tvmd_sim::sim::SampleRetention;
 
-use crate::sim::{run_item, sweep_run_specs, value_error, PySimResult, RunArgs, SimData};
+use crate::sim::{run_items, sweep_run_specs, value_error, PySimResult, RunArgs, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
 #[pyfunction]
@@ -26,17 +26,7 @@ fn sim_result_from_state(state: &[u8]) -> PyResult<PySimResult> {
 #[pyfunction]
 #[pyo3(name = "_check_runs")]
 fn check_runs(runs: &Bound<'_, PyAny>) -> PyResult<usize> {
-    if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
-        return Err(PyTypeError::new_err(
-            "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
-        ));
-    }
-    let specs = runs
-        .try_iter()
-        .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?
-        .enumerate()
-        .map(|(k, item)| run_item(&item?, k))
-        .collect::<PyResult<Vec<_>>>()?;
+    let specs = run_items(runs)?;
     runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
     Ok(specs.len())
 }

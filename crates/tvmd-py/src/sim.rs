@@ -179,7 +179,7 @@ impl RunArgs<'_, '_> {
 }
 
 /// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments.
-pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
+fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
     let name = format!("runs[{k}]");
     let Ok(dict) = item.cast::<PyDict>() else {
         if item.is_instance_of::<PyString>() || item.hasattr("__fspath__")? {
@@ -358,20 +358,24 @@ fn run_many(
     runs: &Bound<'_, PyAny>,
     jobs: Option<i64>,
 ) -> PyResult<Vec<PySimResult>> {
+    let specs = run_items(runs)?;
+    run_specs(py, specs, jobs, |k, s| {
+        format!("runs[{k}] ({}): ", s.scenario.name)
+    })
+}
+
+/// The runs of a `run_many` batch, each loaded and validated ([`run_item`]).
+pub(crate) fn run_items(runs: &Bound<'_, PyAny>) -> PyResult<Vec<RunSpec>> {
     if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
         return Err(PyTypeError::new_err(
             "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
         ));
     }
-    let specs = runs
-        .try_iter()
+    runs.try_iter()
         .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?
         .enumerate()
         .map(|(k, item)| run_item(&item?, k))
-        .collect::<PyResult<Vec<_>>>()?;
-    run_specs(py, specs, jobs, |k, s| {
-        format!("runs[{k}] ({}): ", s.scenario.name)
-    })
+        .collect()
 }
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
