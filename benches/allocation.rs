@@ -14,7 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use tvmd::core::allocation::AllocatorOptions;
 use tvmd::core::nalgebra::Vector6;
 use tvmd::core::{AdmissibleSet, AllocationRequest, Allocator, AnyAllocator};
-use tvmd_sim::allocation_bench::{failure_mask, team, team_size, AllocationSet, TeamRequests};
+use tvmd_studies::allocation_bench::{failure_mask, team, team_size, AllocationSet, TeamRequests};
 
 const SET: &str = include_str!("data/allocation_set.json");
 

@@ -2,11 +2,11 @@
 //! [`FlightOutput`] (commands and [`Diagnostics`]). The loop (module `sim`) calls it; the tvmd
 //! adapter (module `control`) and test controllers implement it.
 
-use crate::actuators::ActuatorCommand;
+use tvmd_plant::actuators::ActuatorCommand;
 use crate::diagnostics::Diagnostics;
 use crate::error::BoxedError;
-use crate::physics::PlantState;
-use crate::reference::ReferenceSample;
+use tvmd_plant::physics::PlantState;
+use tvmd_plant::reference::ReferenceSample;
 
 /// Where an in-process controller runs (a summary's `controller_target`; a
 /// processor-in-the-loop flight names its emulated target instead).

@@ -14,11 +14,14 @@ use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
-use crate::log::{LiveOptions, RunLog, METADATA_SCENARIO};
-use crate::physics::PlantState;
-use crate::reference::ReferenceSample;
-use crate::scenario::{Precision, Scenario, Verdict};
+use tvmd_log::{LiveOptions, RunLog, METADATA_SCENARIO};
+use tvmd_plant::physics::PlantState;
+use tvmd_plant::reference::ReferenceSample;
+use tvmd_scenario::{Precision, Scenario};
 use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
+use crate::sim::summary::Verdict;
+use crate::sink::TickSink;
+use crate::tick_log::McapSink;
 use crate::SimError;
 
 /// A controller that reports the time of every call to a callback (for progress bars).
@@ -58,7 +61,7 @@ pub fn write_scenario_metadata(log: &mut RunLog, scenario: &Scenario) -> Result<
         scenario.controller_precision.to_string(),
     );
     meta.insert("toml".to_string(), scenario.to_toml_string()?);
-    log.write_metadata(METADATA_SCENARIO, meta)
+    Ok(log.write_metadata(METADATA_SCENARIO, meta)?)
 }
 
 /// Runs `scenario` with [`AnyTvmdController`] (in the scenario's `controller_precision`) to its end.
@@ -170,15 +173,13 @@ pub fn fly_live(
             server.wait_for_client(cancel);
         }
     }
+    let mut sink = log.as_mut().map(McapSink::new);
+    let sink = sink.as_mut().map(|s| s as &mut dyn TickSink);
     let run = match progress {
-        Some(p) => sim.run_until(
-            &mut WithProgress::new(&mut controller, p),
-            log.as_mut(),
-            cancel,
-        ),
-        None => sim.run_until(&mut controller, log.as_mut(), cancel),
+        Some(p) => sim.run_until(&mut WithProgress::new(&mut controller, p), sink, cancel),
+        None => sim.run_until(&mut controller, sink, cancel),
     };
-    let finished = log.as_mut().map_or(Ok(()), RunLog::finish);
+    let finished = log.as_mut().map_or(Ok(()), |l| l.finish().map_err(SimError::from));
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
         (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),
@@ -339,7 +340,7 @@ pub fn sweep_specs(
             scenario.relaxation = s;
             scenario.name = format!("{}-s{s}", base.name);
             scenario.validate()?;
-            let stem = crate::paths::file_stem(&scenario.name);
+            let stem = tvmd_log::paths::file_stem(&scenario.name);
             let log = log_dir.map(|d| d.join(format!("{stem}.mcap")));
             Ok(RunSpec {
                 scenario,
@@ -351,7 +352,7 @@ pub fn sweep_specs(
         .collect()
 }
 
-/// Checks a batch's logs before any run starts ([`crate::paths::check_outputs`]): two runs
+/// Checks a batch's logs before any run starts ([`tvmd_log::paths::check_outputs`]): two runs
 /// writing one file would corrupt it, and `extra` outputs (a summary) must differ from them.
 pub fn check_batch_outputs(specs: &[RunSpec], extra: &[(String, &Path)]) -> Result<(), SimError> {
     let mut outputs: Vec<(String, &Path)> = specs
@@ -365,7 +366,7 @@ pub fn check_batch_outputs(specs: &[RunSpec], extra: &[(String, &Path)]) -> Resu
         })
         .collect();
     outputs.extend(extra.iter().cloned());
-    crate::paths::check_outputs(&outputs, &[])
+    Ok(tvmd_log::paths::check_outputs(&outputs, &[])?)
 }
 
 /// The relaxation study: [`sweep_specs`] flown by [`run_many`]. An invalid `s` or a log path

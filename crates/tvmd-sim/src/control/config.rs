@@ -10,8 +10,8 @@ use tvmd_core::{
 
 use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
 use super::MAX_AGENTS;
-use crate::math::from_rows;
-use crate::scenario::Scenario;
+use tvmd_plant::math::from_rows;
+use tvmd_scenario::Scenario;
 use crate::SimError;
 
 pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
@@ -143,7 +143,7 @@ pub fn allocator<T: CoreFloat>(name: &str) -> Result<AnyAllocator<T, MAX_AGENTS>
             "allocator",
             format!(
                 "unknown allocator `{name}` (known: {})",
-                crate::scenario::ALLOCATOR_NAMES.join(", ")
+                tvmd_scenario::ALLOCATOR_NAMES.join(", ")
             ),
         ),
         ConfigError::AllocatorUnavailable { .. } => invalid(
@@ -168,11 +168,11 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 }
 
 /// The f32 controller's configuration of a scenario as the words an f32 target builds it from
-/// ([`super::wire::CoreConfig`]): every value rounded exactly as [`team_config`],
+/// ([`tvmd_wire::CoreConfig`]): every value rounded exactly as [`team_config`],
 /// [`controller_settings`] and [`allocator`] round it. Errors name the scenario field, as
 /// [`super::TvmdController::from_scenario`]'s do.
-pub fn wire_config(scenario: &Scenario) -> Result<super::wire::CoreConfig, SimError> {
-    use super::wire::{CoreConfig, AGENTS, ALLOCATOR_NAME_BYTES};
+pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
+    use tvmd_wire::{CoreConfig, AGENTS, ALLOCATOR_NAME_BYTES};
     team_config::<f32>(scenario)?;
     controller_settings::<f32>(scenario)?;
     allocator::<f32>(&scenario.allocator)?;

@@ -4,10 +4,10 @@
 use nalgebra::{Matrix3, Vector3};
 use tvmd_core::Real;
 
-use crate::actuators::ActuatorCommand;
-use crate::physics::PlantState;
-use crate::reference::ReferenceSample;
-use crate::scenario::Precision;
+use tvmd_plant::actuators::ActuatorCommand;
+use tvmd_plant::physics::PlantState;
+use tvmd_plant::reference::ReferenceSample;
+use tvmd_scenario::Precision;
 
 /// A float type the core controller runs in: `f32` (the flight configuration) or `f64`.
 ///

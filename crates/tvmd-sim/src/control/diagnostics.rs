@@ -9,7 +9,7 @@ use crate::diagnostics::{
     AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics,
     NullSpaceDiagnostics, PlannerDiagnostics,
 };
-use crate::math::{planned_roll, to_rows};
+use tvmd_plant::math::{planned_roll, to_rows};
 use tvmd_core::PlannerStatus;
 
 /// The diagnostics of `out` for a team of `n` agents, with the controller's failure note.

@@ -1,7 +1,7 @@
 //! The landing reference flown after a hover-capability loss when the scenario asks for it
 //! (`failure_response.on_hover_loss = "land"`): level, at the `x`, `y` where the loss was
 //! classified, falling with a constant downward acceleration `a` to the rest height `z = 0`
-//! (the team resting on the ground, see [`crate::physics`]); once the reference is down and
+//! (the team resting on the ground, see `tvmd_plant::physics`); once the reference is down and
 //! the team is within [`TOUCHDOWN_HEIGHT`] of it, the rotors go idle (disarmed, as PX4's land
 //! detector does).
 //!
@@ -14,7 +14,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::reference::ReferenceSample;
+use tvmd_plant::reference::ReferenceSample;
 
 /// Height (m) above the rest height under which a landed team is disarmed.
 pub const TOUCHDOWN_HEIGHT: f64 = 0.05;

@@ -28,9 +28,9 @@ use tvmd_core::{AnyAllocator, FailureMask};
 use crate::diagnostics::{Diagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
-use crate::physics::PlantState;
-use crate::reference::ReferenceSample;
-use crate::scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
+use tvmd_plant::physics::PlantState;
+use tvmd_plant::reference::ReferenceSample;
+use tvmd_scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
 use crate::SimError;
 
 mod config;
@@ -40,7 +40,6 @@ pub mod engine;
 mod landing;
 pub mod pil;
 pub mod recording;
-pub mod wire;
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
 pub use landing::Landing;

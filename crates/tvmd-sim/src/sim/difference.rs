@@ -85,7 +85,7 @@ impl FlightDifference {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::rot_x;
+    use tvmd_plant::math::rot_x;
 
     #[test]
     fn rotation_angle_resolves_small_and_large_angles() {

@@ -10,7 +10,7 @@
 //! 3. the controller is called with the state, the reference and the failure flags it is
 //!    told about (a failure with `controller_informed = false` stays `false` for it);
 //! 4. the sample (true state, reference, commands, diagnostics) is recorded ([`sample`]) and
-//!    logged ([`tick_log`]).
+//!    handed to the run's listener, if any ([`crate::TickSink`]: the MCAP log is one).
 //!
 //! Then `steps_per_control` physics steps follow, each one: failures whose time has come are
 //! applied, the actuators move towards the held commands, and the agents' body-frame forces
@@ -23,7 +23,6 @@ pub mod difference;
 pub mod retention;
 pub mod sample;
 pub mod summary;
-pub mod tick_log;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -33,11 +32,11 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::Serialize;
 
-use crate::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
+use tvmd_plant::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
-use crate::log::RunLog;
-use crate::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
-use crate::scenario::{Failure, Payload, PlantError, Scenario, StateNoise};
+use crate::sink::{LoggedTick, SceneRecord, Tick, TickSink};
+use tvmd_plant::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
+use tvmd_scenario::{Failure, Payload, PlantError, Scenario, StateNoise};
 use crate::SimError;
 
 pub use difference::FlightDifference;
@@ -45,7 +44,7 @@ pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
 pub use summary::{
     EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics, NullSpaceSummary,
-    PaperMetrics, RunSummary, RunTotals, SummaryFold, VxRise,
+    PaperMetrics, RunSummary, RunTotals, SummaryFold, Verdict, VxRise,
 };
 
 /// The valid range of the physics: beyond it a run ends with [`SimError::Diverged`] rather than
@@ -173,7 +172,7 @@ impl Simulation {
         scenario.validate()?;
         let team = scenario.team_body()?;
         let initial = PlantState {
-            rotation: crate::math::from_roll_pitch_yaw(scenario.initial_attitude),
+            rotation: tvmd_plant::math::from_roll_pitch_yaw(scenario.initial_attitude),
             ..PlantState::at_rest(Vector3::from(scenario.initial_position))
         };
         let p = &scenario.plant;
@@ -328,16 +327,17 @@ impl Simulation {
         out
     }
 
-    /// Runs the scenario to its end with `controller`, logging to `log` if given.
+    /// Runs the scenario to its end with `controller`, handing every tick to `sink` if given
+    /// (a run's MCAP log is `McapSink`).
     ///
     /// On error the samples recorded so far stay available through
-    /// [`Simulation::samples`]; the caller's log stays valid (finalised on drop).
+    /// [`Simulation::samples`]; the sink has been flushed.
     pub fn run(
         &mut self,
         controller: &mut dyn FlightController,
-        log: Option<&mut RunLog>,
+        sink: Option<&mut dyn TickSink>,
     ) -> Result<RunResult, SimError> {
-        self.run_until(controller, log, None)
+        self.run_until(controller, sink, None)
     }
 
     /// As [`Simulation::run`], stopping at the first controller tick after `cancel` is set
@@ -346,11 +346,11 @@ impl Simulation {
     pub fn run_until(
         &mut self,
         controller: &mut dyn FlightController,
-        log: Option<&mut RunLog>,
+        sink: Option<&mut dyn TickSink>,
         cancel: Option<&AtomicBool>,
     ) -> Result<RunResult, SimError> {
         let start = std::time::Instant::now();
-        let result = self.run_loop(controller, log, cancel);
+        let result = self.run_loop(controller, sink, cancel);
         self.wall_time += start.elapsed().as_secs_f64();
         result?;
         Ok(self.take_result())
@@ -359,14 +359,13 @@ impl Simulation {
     fn run_loop(
         &mut self,
         controller: &mut dyn FlightController,
-        mut log: Option<&mut RunLog>,
+        mut sink: Option<&mut dyn TickSink>,
         cancel: Option<&AtomicBool>,
     ) -> Result<(), SimError> {
-        let mut batch = tick_log::TickBatch::for_log(log.as_deref());
-        let flown = self.fly_steps(controller, log.as_deref_mut(), cancel, &mut batch);
-        // What was flown is logged whatever ended the loop (an error, an interrupt, the end).
-        let flushed = match log {
-            Some(log) => batch.flush(log),
+        let flown = self.fly_steps(controller, sink.as_deref_mut(), cancel);
+        // What was flown is handed on whatever ended the loop (an error, an interrupt, the end).
+        let flushed = match sink {
+            Some(sink) => sink.flush(),
             None => Ok(()),
         };
         flown.and(flushed)
@@ -375,9 +374,8 @@ impl Simulation {
     fn fly_steps(
         &mut self,
         controller: &mut dyn FlightController,
-        mut log: Option<&mut RunLog>,
+        mut sink: Option<&mut (dyn TickSink + '_)>,
         cancel: Option<&AtomicBool>,
-        batch: &mut tick_log::TickBatch,
     ) -> Result<(), SimError> {
         let dt = self.scenario.physics.dt;
         let period = self.scenario.controller_period;
@@ -385,9 +383,10 @@ impl Simulation {
         let scene_every = ((settings.scene_period / period).round() as usize).max(1);
         let heavy_every = settings.decimation.max(1);
         let mut held = vec![ActuatorCommand::default(); self.team.len()];
-        // Shared with the log's jobs: one copy per run, not one per scene.
-        let team = log
-            .is_some()
+        // Shared with the sink's jobs: one copy per run, not one per scene.
+        let team = sink
+            .as_deref()
+            .is_some_and(|s| s.wants_scenes())
             .then(|| std::sync::Arc::new(self.team.clone()));
         // Reused every physics step: the step allocates nothing of its own.
         let mut forces = Vec::with_capacity(self.team.len());
@@ -446,34 +445,31 @@ impl Simulation {
                 );
                 self.fold.push(&sample);
                 self.samples.push(tick, || sample);
-                if let Some(log) = log.as_deref_mut() {
+                if let Some(sink) = sink.as_deref_mut() {
                     // The scene shows the commanded forces: at a tick the actual ones still lag
                     // by one period.
                     let scene = team
                         .clone()
                         .filter(|_| tick % scene_every == 0)
-                        .map(|team| tick_log::SceneRecord {
+                        .map(|team| SceneRecord {
                             team,
                             forces_body: self.forces(&out.commands),
                             max_thrust: self.max_thrust,
                         });
-                    batch.push(
-                        log,
-                        tick_log::LoggedTick {
-                            tick: tick_log::Tick {
-                                t,
-                                state: truth,
-                                reference,
-                                forces_body: self.forces(&actual),
-                                output: out,
-                                actual,
-                                failed: self.failed_true.clone(),
-                            },
-                            heavy: tick % heavy_every == 0,
-                            scene,
+                    sink.tick(LoggedTick {
+                        tick: Tick {
+                            t,
+                            state: truth,
+                            reference,
+                            forces_body: self.forces(&actual),
+                            output: out,
+                            actual,
+                            failed: self.failed_true.clone(),
                         },
-                    )?;
-                    log.pace(t);
+                        heavy: tick % heavy_every == 0,
+                        scene,
+                    })?;
+                    sink.pace(t);
                 }
             }
             self.actuators.step(&held, dt);

@@ -3,12 +3,12 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::actuators::ActuatorCommand;
+use tvmd_plant::actuators::ActuatorCommand;
 use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
 use crate::flight::FlightOutput;
-use crate::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
-use crate::physics::PlantState;
-use crate::reference::ReferenceSample;
+use tvmd_plant::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
+use tvmd_plant::physics::PlantState;
+use tvmd_plant::reference::ReferenceSample;
 
 /// One recorded sample (at each controller tick, true state).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

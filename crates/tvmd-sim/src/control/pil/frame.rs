@@ -6,7 +6,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::Instant;
 
 use super::PilError;
-use crate::control::wire::{
+use tvmd_wire::{
     frame_crc, frame_header, FRAME_HEADER_BYTES, FRAME_MAGIC, MAX_PAYLOAD_BYTES,
 };
 
@@ -229,7 +229,7 @@ mod tests {
     #[test]
     fn crc32_matches_the_standard_check_value() {
         // The CRC-32 check value of "123456789".
-        let crc = !crate::control::wire::crc32_update(!0, b"123456789");
+        let crc = !tvmd_wire::crc32_update(!0, b"123456789");
         assert_eq!(crc, 0xcbf4_3926);
     }
 }

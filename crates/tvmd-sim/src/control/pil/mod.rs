@@ -18,9 +18,10 @@ use std::time::{Duration, Instant};
 use tvmd_core::{FailureMask, Reference, RigidState};
 
 use super::engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-use super::wire::{self, CoreConfig, Reader, Writer};
+use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 use super::MAX_AGENTS;
 use crate::error::BoxedError;
+use crate::SimError;
 
 pub mod frame;
 mod link;
@@ -147,6 +148,12 @@ pub enum PilError {
         /// QEMU's status and stderr.
         qemu: String,
     },
+}
+
+impl From<PilError> for SimError {
+    fn from(e: PilError) -> Self {
+        SimError::Pil(Box::new(e))
+    }
 }
 
 /// Where the PIL firmware is looked for: [`FIRMWARE_ENV`] if set (and then only there), else

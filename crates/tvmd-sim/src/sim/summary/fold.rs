@@ -8,9 +8,11 @@ use super::{
     e_f_visible, HoverClassification, NullSpaceSummary, PaperMetrics, RunSummary, RunTotals,
     ATTITUDE_SETTLED, SETTLING_TIME,
 };
-use crate::math::roll_pitch_yaw;
-use crate::reference::ReferenceConfig;
-use crate::scenario::{Scenario, Verdict};
+use tvmd_plant::math::roll_pitch_yaw;
+use tvmd_plant::reference::ReferenceConfig;
+use tvmd_scenario::Scenario;
+
+use super::Verdict;
 use crate::sim::sample::{arr, Sample};
 
 /// The times at which [`PaperMetrics::v_x_at`] reads `V_x` (before the final sample) (s).

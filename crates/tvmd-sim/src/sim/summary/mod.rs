@@ -10,18 +10,20 @@
 mod fold;
 pub mod metrics;
 pub mod rules;
+mod verdict;
 #[cfg(test)]
 pub(crate) mod tests;
 
 use serde::{Deserialize, Serialize};
 
-use crate::physics::PlantState;
-use crate::scenario::{Precision, Scenario, Verdict};
+use tvmd_plant::physics::PlantState;
+use tvmd_scenario::{Precision, Scenario};
 use crate::sim::sample::Sample;
 
 pub use fold::SummaryFold;
 pub use metrics::{EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics};
 pub use rules::Rise as VxRise;
+pub use verdict::Verdict;
 
 /// Time after which [`RunSummary::max_position_error_after_4s`] is taken (s): the end of
 /// the paper's ascent plus its hover (stage A).

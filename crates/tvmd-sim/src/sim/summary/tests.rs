@@ -93,7 +93,7 @@ fn summary_and_paper_metrics_share_the_rules() {
         ..scenario.clone()
     };
     let f32_paper = PaperMetrics::new(&f32_scenario, &samples);
-    let weight = 2.8 * crate::GRAVITY;
+    let weight = 2.8 * tvmd_plant::GRAVITY;
     assert_eq!(f32_paper.e_f_visible, e_f_visible(Precision::F32, weight));
     assert!((f32_paper.e_f_visible - 16.0 * 1.1920929e-7 * weight).abs() < 1e-12);
     assert_eq!(f32_paper.e_f_onset, None);

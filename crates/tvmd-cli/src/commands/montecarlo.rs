@@ -1,0 +1,31 @@
+//! `tvmd-sim montecarlo`.
+
+use tvmd_studies::montecarlo::MonteCarloRequest;
+
+use crate::error::CliError;
+use crate::progress::progress_bar;
+
+pub fn cmd_montecarlo(args: MonteCarloRequest) -> Result<(), CliError> {
+    let bar = std::sync::OnceLock::new();
+    let progress = |done: usize, total: usize| {
+        bar.get_or_init(|| progress_bar(total as u64, "flights"))
+            .set_position(done as u64);
+    };
+    let out = tvmd_studies::montecarlo::run(&args, Some(&progress))?;
+    if let Some(b) = bar.get() {
+        b.finish_and_clear();
+    }
+    print!("{}", out.table);
+    println!(
+        "success rate {:.1}% of {} flights",
+        100.0 * out.success_rate,
+        out.flights
+    );
+    println!("flights:  {}", out.files.flights.display());
+    println!("groups:   {}", out.files.groups.display());
+    for p in &out.files.plots {
+        println!("plot:     {}", p.display());
+    }
+    Ok(())
+}
+

@@ -1,0 +1,30 @@
+//! `tvmd-sim plot`: figures from MCAP logs.
+
+use std::path::{Path, PathBuf};
+
+use tvmd_studies::plot::{self, PlotSeries};
+
+use crate::error::CliError;
+
+
+pub fn cmd_plot(logs: &[PathBuf], out: &Path) -> Result<(), CliError> {
+    let mut all = Vec::new();
+    for path in logs {
+        let series = PlotSeries::from_mcap_file(path)?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| series.label.clone());
+        for p in plot::write_run_figures(&series, out, &stem)? {
+            println!("figure:   {}", p.display());
+        }
+        all.push(series);
+    }
+    if all.len() > 1 {
+        let path = out.join("relaxation.png");
+        plot::relaxation_study(&all, &path)?;
+        println!("figure:   {}", path.display());
+    }
+    Ok(())
+}
+

@@ -1,0 +1,196 @@
+//! `tvmd-sim run`.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use tvmd_log::paths::{check_outputs, create_parent, file_stem};
+use tvmd_log::LiveOptions;
+use tvmd_scenario::{Overrides, Precision, Scenario};
+use tvmd_sim::control::hover_roll_limit;
+use tvmd_sim::runner::*;
+use tvmd_sim::sim::{PaperMetrics, RunSummary, SampleRetention};
+use tvmd_log::LogError;
+use tvmd_sim::{PilTarget, SimError};
+use tvmd_studies::plot::{self, PlotSeries};
+
+use crate::error::CliError;
+
+use crate::interrupt::{catch_interrupts, INTERRUPT};
+use super::report::print_run;
+use crate::progress::{progress_bar, ticks_of};
+
+/// Everything `run` writes to the summary JSON.
+#[derive(Serialize)]
+pub struct RunReport<'a> {
+    pub(crate) scenario: &'a str,
+    pub(crate) relaxation: f64,
+    pub(crate) allocator: &'a str,
+    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) null_space: Option<String>,
+    /// The controller's float type, `"f64"` or `"f32"`.
+    pub(crate) controller_precision: Precision,
+    /// Where the controller ran: `"host"` or the emulated target.
+    pub(crate) controller_target: &'a str,
+    /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
+    pub(crate) hover_roll_limit: Option<f64>,
+    pub(crate) summary: &'a RunSummary,
+    pub(crate) paper: PaperMetrics,
+    pub(crate) log: Option<String>,
+}
+
+pub struct RunArgs {
+    pub(crate) scenario: String,
+    pub(crate) out: Option<PathBuf>,
+    pub(crate) no_log: bool,
+    pub(crate) plots: Option<PathBuf>,
+    pub(crate) summary: Option<PathBuf>,
+    pub(crate) relaxation: Option<f64>,
+    pub(crate) allocator: Option<String>,
+    pub(crate) null_space: Option<tvmd_scenario::NullSpaceConfig>,
+    pub(crate) team: Option<String>,
+    pub(crate) precision: Option<String>,
+    pub(crate) pil: Option<String>,
+    pub(crate) live: Option<LiveOptions>,
+}
+
+/// The `--precision` argument (clap has checked the spelling; the parse names the field).
+pub fn precision_arg(p: Option<&str>) -> Result<Option<Precision>, CliError> {
+    Ok(p.map(str::parse).transpose()?)
+}
+
+pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
+    let precision = precision_arg(a.precision.as_deref())?;
+    let pil = a
+        .pil
+        .as_deref()
+        .map(str::parse::<PilTarget>)
+        .transpose()
+        .map_err(|e| SimError::Pil(Box::new(e)))?;
+    let scenario = Scenario::load(&a.scenario)?.with_overrides(&Overrides {
+        relaxation: a.relaxation,
+        allocator: a.allocator,
+        precision,
+        null_space: a.null_space,
+        team: a.team,
+    })?;
+    let mut spec = RunSpec::on_target(scenario, None, pil, precision)?;
+    let stem = file_stem(&spec.scenario.name);
+    let log = if a.no_log {
+        None
+    } else {
+        Some(
+            a.out
+                .unwrap_or_else(|| PathBuf::from(format!("out/{stem}.mcap"))),
+        )
+    };
+    let summary_path = a
+        .summary
+        .or_else(|| log.as_ref().map(|l| l.with_extension("summary.json")));
+    // Every output is checked, and its directory made, before the run starts.
+    let mut outputs: Vec<(String, &Path)> = Vec::new();
+    if let Some(l) = &log {
+        outputs.push(("the log (--out)".into(), l));
+    }
+    if let Some(p) = &summary_path {
+        outputs.push(("the summary (--summary)".into(), p));
+        create_parent(p, "write the summary")?;
+    }
+    let input = Path::new(&a.scenario);
+    let inputs: Vec<(String, &Path)> = if input.is_file() {
+        vec![("scenario file".into(), input)]
+    } else {
+        Vec::new()
+    };
+    check_outputs(&outputs, &inputs)?;
+    if let Some(dir) = &a.plots {
+        std::fs::create_dir_all(dir).map_err(LogError::file("create the figure directory", dir))?;
+    }
+    // Memory stays flat: the summary folds every tick, the log streams it, and only the
+    // figures need samples (a bounded, evenly spaced set).
+    spec.log.clone_from(&log);
+    spec.samples = plot_retention(a.plots.is_some());
+    let scenario = &spec.scenario;
+    catch_interrupts();
+    let bar = progress_bar(ticks_of(scenario), &scenario.name);
+    let mut tick = |_t: f64| bar.inc(1);
+    let mut on_listen = |address: std::net::SocketAddr| {
+        bar.suspend(|| {
+            println!("live:     ws://{address} (Foxglove: Open connection -> Foxglove WebSocket)");
+        });
+    };
+    let live = a.live.map(|options| LiveView {
+        options,
+        on_listen: &mut on_listen,
+    });
+    let flight = fly_live(&spec, live, Some(&mut tick), Some(&INTERRUPT));
+    bar.finish_and_clear();
+    let Flight { result, error } = flight?;
+    let report = RunReport {
+        scenario: &scenario.name,
+        relaxation: scenario.relaxation,
+        allocator: &scenario.allocator,
+        null_space: scenario.null_space.map(|n| n.to_string()),
+        controller_precision: scenario.controller_precision,
+        controller_target: &result.summary.controller_target,
+        hover_roll_limit: hover_roll_limit(scenario, scenario.relaxation).ok(),
+        summary: &result.summary,
+        paper: result.paper.clone(),
+        log: log.as_ref().map(|p| p.display().to_string()),
+    };
+    print_run(&report);
+    if let Some(p) = &summary_path {
+        write_json(p, &report)?;
+        println!("summary:  {}", p.display());
+    }
+    if let Some(l) = &log {
+        println!("log:      {} (open in Foxglove)", l.display());
+    }
+    // A failed flight still leaves its log and a summary of what was simulated.
+    if let Some(error) = error {
+        return Err(CliError::Sim(error));
+    }
+    if result.summary.interrupted {
+        return Err(CliError::Interrupted(format!(
+            "stopped at t = {:.3} s of {} s; the log and summary hold what was simulated",
+            result.summary.time, scenario.duration
+        )));
+    }
+    if let Some(dir) = &a.plots {
+        let series =
+            PlotSeries::from_samples(&scenario.name, Some(scenario.relaxation), &result.samples);
+        for p in plot::write_run_figures(&series, dir, &stem)? {
+            println!("figure:   {}", p.display());
+        }
+        print_stride(result.sample_stride);
+    }
+    Ok(())
+}
+
+/// The samples a command-line run keeps: a bounded set for figures, else none.
+pub fn plot_retention(plots: bool) -> SampleRetention {
+    if plots {
+        SampleRetention::AtMost(plot::PLOT_SAMPLES)
+    } else {
+        SampleRetention::None
+    }
+}
+
+/// Says when the figures show every `stride`-th controller tick only.
+pub fn print_stride(stride: usize) {
+    if stride > 1 {
+        println!(
+            "figures:  every {stride}th controller tick (at most {} samples per run)",
+            plot::PLOT_SAMPLES
+        );
+    }
+}
+
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> {
+    const ACTION: &str = "write the summary";
+    create_parent(path, ACTION)?;
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+        .map_err(LogError::file(ACTION, path))?;
+    Ok(())
+}
+

@@ -1,0 +1,160 @@
+//! The built-in scenarios ([`BUILTIN_NAMES`]): the paper's simulation and its variants.
+
+use std::f64::consts::PI;
+
+use super::{Failure, Scenario};
+use tvmd_plant::actuators::FailureKind;
+use tvmd_plant::physics::TeamBody;
+use tvmd_plant::reference::{PaperTilt, ReferenceConfig};
+use crate::ScenarioError;
+
+/// Names of the built-in scenarios, for [`Scenario::builtin`].
+pub const BUILTIN_NAMES: &[&str] = &[
+    "paper-tilt",
+    "relaxation-0.25",
+    "relaxation-0.5",
+    "relaxation-0.75",
+    "relaxation-1.0",
+    "relaxation-certified",
+    "paper-tilt-sigma-y-pi6",
+    "a4-con",
+    "a4-inc",
+    "agent-failure",
+    "a6-agent-failure",
+    // The scenario families (`families.rs`).
+    "hover",
+    "wind",
+    "payload",
+    "model-error",
+    "reference-jump",
+    "sine",
+    "figure-eight",
+    "initial-attitude-0.5",
+    "initial-attitude-1.0",
+    "initial-attitude-1.5",
+    "initial-attitude-2.0",
+    "initial-attitude-2.5",
+];
+
+impl Scenario {
+    /// A built-in scenario by name (see [`BUILTIN_NAMES`]).
+    pub fn builtin(name: &str) -> Result<Self, ScenarioError> {
+        let mut s = Scenario::default();
+        let with = |mut s: Scenario, description: &str| {
+            s.name = name.to_string();
+            s.description = description.to_string();
+            s
+        };
+        Ok(match name {
+            "paper-tilt" => s,
+            "relaxation-0.25" | "relaxation-0.5" | "relaxation-0.75" | "relaxation-1.0" => {
+                s.relaxation = match name {
+                    "relaxation-0.25" => 0.25,
+                    "relaxation-0.5" => 0.5,
+                    "relaxation-0.75" => 0.75,
+                    _ => 1.0,
+                };
+                let d = format!("Relaxation study: paper-tilt with s = {}", s.relaxation);
+                with(s, &d)
+            }
+            "relaxation-certified" => {
+                s.relaxation = s.certified_relaxation()?;
+                let d = format!(
+                    "Relaxation study: paper-tilt with the AFS atlas's certified s* = {}",
+                    s.relaxation
+                );
+                with(s, &d)
+            }
+            "paper-tilt-sigma-y-pi6" => {
+                s.limits.sigma_y = PI / 6.0;
+                with(
+                    s,
+                    "paper-tilt with sigma_y = pi/6: the planned roll saturates at exactly pi/12",
+                )
+            }
+            "a4-con" => {
+                s.team.preset = Some("a4-con".into());
+                with(s, "paper-tilt flown by the consistent team A4-Con")
+            }
+            "a4-inc" => {
+                s.team.preset = Some("a4-inc".into());
+                with(
+                    s,
+                    "paper-tilt flown by the inconsistent team A4-Inc (the paper's)",
+                )
+            }
+            "agent-failure" => {
+                s.initial_position = [0.0, 0.0, 0.0];
+                s.reference = ReferenceConfig::PaperTilt(PaperTilt {
+                    roll_peak: 0.0,
+                    ..PaperTilt::default()
+                });
+                s.failures = vec![Failure {
+                    agent: 0,
+                    time: 5.0,
+                    kind: FailureKind::NoThrust,
+                    controller_informed: true,
+                }];
+                with(
+                    s,
+                    "A4-Inc ascends and hovers at 1.5 m; agent 0 loses its thrust at t = 5 s \
+                     (controller informed); descent at 12 s",
+                )
+            }
+            "a6-agent-failure" => {
+                s.initial_position = [0.0, 0.0, 0.0];
+                s.reference = ReferenceConfig::PaperTilt(PaperTilt {
+                    roll_peak: 0.0,
+                    ..PaperTilt::default()
+                });
+                s.team.agents = Some(TeamBody::ring(6, 0.5, 0.7, true).agents);
+                s.failures = vec![Failure {
+                    agent: 0,
+                    time: 5.0,
+                    kind: FailureKind::NoThrust,
+                    controller_informed: true,
+                }];
+                with(
+                    s,
+                    "A6-Inc ring (radius 0.5 m, alternate quarter turns) ascends and hovers at \
+                     1.5 m; agent 0 loses its thrust at t = 5 s (controller informed); descent \
+                     at 12 s",
+                )
+            }
+            other => {
+                return super::families::family(other).ok_or_else(|| ScenarioError::UnknownScenario {
+                    name: other.to_string(),
+                    known: BUILTIN_NAMES.join(", "),
+                })
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_families_are_built_ins() {
+        for name in crate::families::FAMILY_NAMES {
+            assert!(BUILTIN_NAMES.contains(name), "{name}");
+        }
+    }
+
+    #[test]
+    fn builtins_validate_and_round_trip() {
+        for name in BUILTIN_NAMES {
+            let s = Scenario::builtin(name).unwrap();
+            s.validate().unwrap();
+            assert_eq!(&s.name, name);
+            let text = s.to_toml_string().unwrap();
+            let back = Scenario::from_toml_str(&text).unwrap();
+            assert_eq!(back, s, "round trip of {name}:\n{text}");
+        }
+        assert!(matches!(
+            Scenario::builtin("nope"),
+            Err(ScenarioError::UnknownScenario { .. })
+        ));
+    }
+}

@@ -1,0 +1,104 @@
+//! Scenarios: TOML files (serde) and built-ins.
+//!
+//! Every field has a default (the paper's simulation, scenario `paper-tilt`), so a file only
+//! states what differs. Unknown keys are rejected, and parse errors name the offending key
+//! (the message shows the key and its line). Semantic checks ([`Scenario::validate`]) name the
+//! field by its dotted path.
+//!
+//! ```toml
+//! name = "my-run"
+//! duration = 16.0
+//! controller_period = 0.01
+//! initial_position = [0.5, -0.5, 0.0]
+//! relaxation = 0.5
+//! allocator = "exact-boundary-redistribution" # "redistributed-pseudo-inverse", "clarabel", ...
+//! controller_precision = "f64"               # or "f32": the flight configuration
+//! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
+//! # null_space = "margin"                     # null-space stage after the allocator
+//!
+//! [physics]
+//! dt = 0.001
+//!
+//! [team]
+//! preset = "a4-inc"          # any of a3-con .. a10-inc, t10-con, t10-inc; or: agents = [{ position = [..], mass = 0.7, quarter_turns = 1 }, ..]
+//!
+//! [limits]
+//! sigma_x = 0.5235987755982988
+//! sigma_y = 0.7853981633974483
+//! # max_thrust defaults to 2 m_i g
+//!
+//! [gains]
+//! k_x = [0.4, 0.4, 1.0]
+//! k_r = [12.0, 12.0, 1.0]
+//! k_xi = [8.0, 8.0, 1.5, 0.8, 0.8, 2.0]
+//!
+//! [reference]
+//! kind = "paper-tilt"        # or "hover" with position = [..] and roll = ..
+//! ascent_height = 1.5
+//!
+//! [actuators]
+//! servo = { natural_frequency = 40.0, damping_ratio = 0.8, rate_limit = 6.0 }
+//! rotor_lag = { time_constant = 0.03 }
+//!
+//! [[failures]]
+//! agent = 0
+//! time = 5.0
+//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal"
+//! controller_informed = true
+//!
+//! [failure_response]
+//! on_hover_loss = "land"     # default "continue"; "land": fall level to the ground when the
+//! landing_acceleration = 1.0 # working agents are classified not hover-capable (m/s^2)
+//!
+//! [disturbances]
+//! wind = [0.5, 0.0, 0.0]
+//! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
+//! state_noise = { position = 0.01, velocity = 0.02, attitude = 0.005, angular_velocity = 0.01, seed = 7 }
+//!
+//! [success]                  # the verdict's bounds (see `SuccessBounds`)
+//! max_steady_state_position_error = 0.05
+//! # max_settling_time = 6.0
+//! ```
+//!
+//! Files: [`Scenario`] and its parts (team, controller, failures, disturbances, log, success
+//! bounds), the built-ins ([`BUILTIN_NAMES`], derived from the families [`FAMILY_NAMES`]),
+//! validation, [`Overrides`] and the optional null-space stage.
+
+#![warn(missing_docs)]
+
+mod air;
+mod builtin;
+mod certified;
+mod controller;
+mod disturbances;
+mod error;
+mod failures;
+mod families;
+mod log_settings;
+mod null_space;
+mod overrides;
+mod plant;
+mod scenario;
+mod success;
+mod team;
+mod validate;
+
+pub use air::{Air, Gust, DRAG_AREA_PER_AGENT};
+pub use builtin::BUILTIN_NAMES;
+pub use controller::{GainsConfig, Precision, ALLOCATOR_NAMES};
+pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise};
+pub use error::ScenarioError;
+pub use failures::{Failure, FailureResponse, OnHoverLoss};
+pub use families::{FAMILY_NAMES, HOVER_HEIGHT, RELEASE_HEIGHT};
+pub use log_settings::LogSettings;
+pub use null_space::{
+    NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
+};
+pub use overrides::Overrides;
+pub use plant::{Payload, PlantError};
+pub use scenario::{Scenario, MAX_SCENARIO_BYTES};
+pub use success::SuccessBounds;
+pub use team::{LimitsConfig, TeamSpec};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,142 @@
+//! Scenario parsing, loading and the built-ins.
+
+use super::*;
+use tvmd_plant::actuators::FailureKind;
+use tvmd_plant::ReferenceConfig;
+
+#[test]
+fn empty_file_is_paper_tilt() {
+    let s = Scenario::from_toml_str("").unwrap();
+    assert_eq!(s, Scenario::default());
+    assert_eq!(s.steps_per_control().unwrap(), 10);
+    assert!((s.max_thrust().unwrap() - 2.0 * 0.7 * 9.81).abs() < 1e-12);
+}
+
+#[test]
+fn wrong_type_names_the_field() {
+    let e = Scenario::from_toml_str("relaxation = \"half\"\n").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("relaxation"), "{msg}");
+    let e = Scenario::from_toml_str("[gains]\nk_x = [1.0, 2.0]\n").unwrap_err();
+    assert!(e.to_string().contains("k_x"), "{e}");
+    let e = Scenario::from_toml_str("[[failures]]\nagent = 0\ntime = 1.0\nkind = \"explode\"\n")
+        .unwrap_err();
+    assert!(e.to_string().contains("kind"), "{e}");
+}
+
+#[test]
+fn controller_precision_parses_round_trips_and_rejects_others() {
+    let s = Scenario::from_toml_str("controller_precision = \"f32\"\n").unwrap();
+    assert_eq!(s.controller_precision, Precision::F32);
+    let again = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again, s);
+    assert_eq!(Scenario::default().controller_precision, Precision::F64);
+    let e = Scenario::from_toml_str("controller_precision = \"f16\"\n").unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("controller_precision") && msg.contains("f32"),
+        "{msg}"
+    );
+    for p in Precision::ALL {
+        assert_eq!(p.as_str().parse::<Precision>().unwrap(), p);
+        assert_eq!(p.to_string(), p.as_str());
+    }
+    let e = "double".parse::<Precision>().unwrap_err();
+    assert!(
+        matches!(&e, ScenarioError::InvalidScenario { field, .. } if field == "controller_precision"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_key_is_rejected_by_name() {
+    let e = Scenario::from_toml_str("relaxaton = 0.5\n").unwrap_err();
+    assert!(e.to_string().contains("relaxaton"), "{e}");
+    let e = Scenario::from_toml_str("[physics]\nstep = 0.001\n").unwrap_err();
+    assert!(e.to_string().contains("step"), "{e}");
+    let e = Scenario::from_toml_str("[physics]\ndt = \"x\"\n").unwrap_err();
+    assert!(e.to_string().contains("physics.dt"), "{e}");
+}
+
+#[test]
+fn full_example_parses() {
+    let text = r#"
+name = "custom"
+duration = 3.0
+controller_period = 0.005
+relaxation = 1.0
+[physics]
+dt = 0.0005
+[team]
+agents = [
+  { position = [0.3, 0.0, 0.0], mass = 0.5, quarter_turns = 0 },
+  { position = [-0.3, 0.0, 0.0], mass = 0.5, quarter_turns = 3 },
+]
+navigator_mass = 0.2
+[limits]
+max_thrust = 12.0
+[reference]
+kind = "hover"
+position = [0.0, 0.0, 1.0]
+[actuators]
+servo = { natural_frequency = 40.0, damping_ratio = 0.8, rate_limit = 6.0 }
+rotor_lag = { time_constant = 0.03 }
+[[failures]]
+agent = 1
+time = 2.0
+kind = "stuck-gimbal"
+controller_informed = false
+[disturbances]
+wind = [0.5, 0.0, 0.0]
+external_wrench = { torque = [0.0, 0.0, 0.1], start = 1.0, end = 2.0 }
+state_noise = { position = 0.01, seed = 7 }
+"#;
+    let s = Scenario::from_toml_str(text).unwrap();
+    assert_eq!(s.steps_per_control().unwrap(), 10);
+    assert_eq!(s.team_body().unwrap().len(), 2);
+    assert_eq!(s.failures[0].kind, FailureKind::StuckGimbal);
+    assert!(!s.failures[0].controller_informed);
+    assert_eq!(s.disturbances.state_noise.unwrap().seed, 7);
+    assert_eq!(s.max_thrust().unwrap(), 12.0);
+    assert!(matches!(s.reference, ReferenceConfig::Hover { .. }));
+}
+
+#[test]
+fn load_takes_a_builtin_name_or_a_file() {
+    assert_eq!(
+        Scenario::load("a4-con").unwrap(),
+        Scenario::builtin("a4-con").unwrap()
+    );
+    assert!(matches!(
+        Scenario::load("nope"),
+        Err(ScenarioError::UnknownScenario { .. })
+    ));
+    let e = Scenario::load("missing-file.toml").unwrap_err();
+    assert!(matches!(&e, ScenarioError::File { .. }), "{e}");
+    assert!(e.to_string().contains("missing-file.toml"), "{e}");
+    // Not a regular file: refused before it is opened (a FIFO would block, /dev/zero
+    // never ends).
+    #[cfg(unix)]
+    {
+        let e = Scenario::from_file("/dev/zero").unwrap_err().to_string();
+        assert!(
+            e.contains("not a regular file") && e.contains("/dev/zero"),
+            "{e}"
+        );
+    }
+    let dir = std::env::temp_dir().join(format!("tvmd-sim-load-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A file without the .toml suffix is still a file.
+    let path = dir.join("scenario");
+    std::fs::write(&path, "name = \"from-file\"\nrelaxation = 1.0\n").unwrap();
+    let s = Scenario::load(path.to_str().unwrap()).unwrap();
+    assert_eq!((s.name.as_str(), s.relaxation), ("from-file", 1.0));
+    std::fs::write(&path, "[physics]\ndt = -1.0\n").unwrap();
+    let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("invalid scenario field `physics.dt`"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

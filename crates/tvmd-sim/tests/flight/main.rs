@@ -1,0 +1,16 @@
+//! Flights of the loop: the paper's scenario, the plant and actuators, failures, the samples and
+//! the summary (one test binary; each module a topic).
+
+#[path = "../common.rs"]
+mod common;
+
+mod closed_loop;
+mod coarse_step;
+mod flight_metrics;
+mod hover_failure;
+mod null_space;
+mod precision;
+mod recording;
+mod sample_retention;
+mod scenario_families;
+mod sim_loop;

@@ -1,0 +1,118 @@
+//! `tvmd-sim montecarlo SCENARIO --runs N --seed S`: the binary parses these arguments and
+//! prints what [`run`] returns.
+
+use std::path::PathBuf;
+
+use super::{fly_all, text_table, Distributions, ReportFiles, Study, StudyReport};
+use tvmd_scenario::Scenario;
+use crate::StudyError;
+
+/// Arguments of `tvmd-sim montecarlo`.
+#[derive(Debug, Clone)]
+pub struct MonteCarloRequest {
+    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file.
+    pub scenario: String,
+    /// Flights per team, allocator and model-error level.
+    pub runs: usize,
+    /// Seed of every draw (flight k of a group always draws the same errors).
+    pub seed: u64,
+    /// Catalogue teams, comma-separated (default: the scenario's).
+    pub teams: Vec<String>,
+    /// Allocators, comma-separated (default: the scenario's).
+    pub allocators: Vec<String>,
+    /// Model-error multipliers, comma-separated, one group each (default: 1).
+    pub model_error: Vec<f64>,
+    /// Mass error half-width (plant mass over the model's in `[1 - e, 1 + e]`).
+    pub mass: Option<f64>,
+    /// Inertia error half-width.
+    pub inertia: Option<f64>,
+    /// Centre-of-mass offset half-width per axis (m).
+    pub com_offset: Option<f64>,
+    /// Thrust efficiency loss half-width per agent (efficiency in `[1 - e, 1]`).
+    pub thrust_efficiency: Option<f64>,
+    /// Gimbal offset half-width per agent and axis (rad).
+    pub gimbal_offset: Option<f64>,
+    /// Initial horizontal offset half-width per axis (m).
+    pub initial_position: Option<f64>,
+    /// Largest initial tilt (rad, at most 2.5; the scenario must start in the air).
+    pub initial_tilt: Option<f64>,
+    /// Directory for `flights.csv`, `groups.csv` and the PNG figures (default:
+    /// `out/montecarlo/<scenario>`).
+    pub out: Option<PathBuf>,
+    /// Worker threads (default: every core).
+    pub jobs: Option<usize>,
+}
+
+impl MonteCarloRequest {
+    /// The study these arguments describe.
+    pub fn study(&self) -> Result<Study, StudyError> {
+        let scenario = Scenario::load(&self.scenario)?;
+        let d = Distributions::default();
+        let or = |v: Option<f64>, default: f64| v.unwrap_or(default);
+        Ok(Study {
+            runs: self.runs,
+            seed: self.seed,
+            teams: self.teams.clone(),
+            allocators: self.allocators.clone(),
+            model_errors: self.model_error.clone(),
+            distributions: Distributions {
+                model_error: d.model_error,
+                mass: or(self.mass, d.mass),
+                inertia: or(self.inertia, d.inertia),
+                com_offset: or(self.com_offset, d.com_offset),
+                thrust_efficiency: or(self.thrust_efficiency, d.thrust_efficiency),
+                gimbal_offset: or(self.gimbal_offset, d.gimbal_offset),
+                initial_position: or(self.initial_position, d.initial_position),
+                initial_tilt: or(self.initial_tilt, d.initial_tilt),
+            },
+            scenario,
+        })
+    }
+
+    /// The output directory.
+    pub fn out_dir(&self, study: &Study) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            PathBuf::from("out")
+                .join("montecarlo")
+                .join(tvmd_log::paths::file_stem(&study.scenario.name))
+        })
+    }
+}
+
+/// What a study printed and wrote.
+#[derive(Debug)]
+pub struct MonteCarloOutput {
+    /// The group table as text.
+    pub table: String,
+    /// Overall success rate.
+    pub success_rate: f64,
+    /// Flights flown.
+    pub flights: usize,
+    /// The files written.
+    pub files: ReportFiles,
+}
+
+/// Runs the study of `args`; `progress(done, total)` after each flight.
+pub fn run(
+    args: &MonteCarloRequest,
+    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
+) -> Result<MonteCarloOutput, StudyError> {
+    let study = args.study()?;
+    let specs = study.specs()?;
+    let total = specs.len();
+    let each = progress.map(|p| move |done: usize| p(done, total));
+    let rows = fly_all(
+        &specs,
+        args.jobs,
+        each.as_ref().map(|f| f as &(dyn Fn(usize) + Sync)),
+    )?;
+    let report = StudyReport::new(rows, Some(&args.out_dir(&study)))?;
+    Ok(MonteCarloOutput {
+        table: text_table(&report.groups),
+        success_rate: report.success_rate,
+        flights: report.flights.len(),
+        files: report
+            .files
+            .ok_or_else(|| StudyError::Internal("the report wrote no files".into()))?,
+    })
+}
