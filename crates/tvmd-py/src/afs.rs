@@ -9,9 +9,8 @@ use pyo3::types::PyTuple;
 use tvmd_core::gimbal::thrust_direction as core_thrust_direction;
 use tvmd_core::{project_force, AgentLimits, AttainableForceSpace, ForceProjection, GimbalCommand};
 
-use crate::convert::{count, matrix, scalar_or_array, scalars, shaped, vectors};
+use crate::convert::{count, matrix, relaxation_arg, scalar_or_array, scalars, shaped, vectors};
 use crate::errors::OrRaise;
-use crate::planner::relaxation_arg;
 use crate::record::record;
 
 /// A core AFS with the limits it was built from.

@@ -8,8 +8,8 @@ use pyo3::prelude::*;
 
 use tvmd_sim::afs_atlas::cli::{run, AfsArgs};
 
-use crate::convert::{count, indices};
-use crate::sim::{record_to_py, value_error};
+use crate::convert::{count, indices, record_to_py};
+use crate::errors::value_error;
 
 /// The atlas row of one catalogue team and failure mask. See the stub.
 #[pyfunction]

@@ -1,15 +1,26 @@
-//! Conversions at the Python boundary: array-likes in, NumPy arrays out (conventions in the
-//! stub `python/tvmd/_tvmd.pyi`). Nothing here panics: every shape is checked.
+//! The one conversion layer at the Python boundary: array-likes in, NumPy arrays out
+//! (conventions in the stub `python/tvmd/_tvmd.pyi`), and the parsers of the plain arguments
+//! (relaxation, iteration cap, null-space stage, sample retention, scenario). Nothing here
+//! panics: every shape is checked. It imports only [`crate::errors`].
+
+use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use numpy::ndarray::ArrayD;
 use numpy::{Element, PyArray1, PyArrayDyn, PyArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyFloat};
+use pyo3::types::{PyBool, PyFloat, PyString};
 use pyo3::{intern, IntoPyObjectExt};
 
-use tvmd_core::AgentCommand;
+use tvmd_core::{AgentCommand, Relaxation};
+use tvmd_sim::scenario::{NullSpaceConfig, Scenario};
+use tvmd_sim::sim::SampleRetention;
+
+use crate::errors::{sim_error, value_error, OrRaise, READ};
+
+/// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
+pub(crate) const CAPACITY: usize = 64;
 
 /// `(a, b, c)` as Python prints a shape.
 pub(crate) fn shape_str(shape: &[usize]) -> String {
@@ -268,4 +279,87 @@ pub(crate) fn commands_array<'py>(
     let values = commands.iter().take(n);
     let values = values.flat_map(|c| [c.eta_x, c.eta_y, c.thrust, c.omega]);
     shaped(py, values.collect(), &[n.min(commands.len()), 4])
+}
+
+/// A tvmd-sim record (serde) as Python objects: `json.loads` of its JSON (NaN becomes None).
+pub(crate) fn record_to_py<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    record: &T,
+) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(record)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot convert a tvmd-sim record: {e}")))?;
+    py.import(intern!(py, "json"))?
+        .call_method1(intern!(py, "loads"), (text,))
+}
+
+/// The iteration cap argument: default 64 (the core's), else in `0..=u32::MAX` (the core
+/// rejects 0).
+pub(crate) fn iteration_cap(value: Option<i64>) -> PyResult<u32> {
+    let Some(v) = value else { return Ok(64) };
+    u32::try_from(v).map_err(|_| {
+        PyValueError::new_err(format!("`max_iterations` must be in [1, 2**32), got {v}"))
+    })
+}
+
+/// The relaxation `s` from the keyword `relaxation` or its alias `s` (not both), else `default`.
+pub(crate) fn relaxation_arg(
+    relaxation: Option<f64>,
+    s: Option<f64>,
+    default: Option<f64>,
+) -> PyResult<Relaxation<f64>> {
+    let value = match (relaxation, s) {
+        (Some(_), Some(_)) => {
+            return Err(PyTypeError::new_err(
+                "give `relaxation` or its alias `s`, not both",
+            ))
+        }
+        (Some(v), None) | (None, Some(v)) => v,
+        (None, None) => {
+            default.ok_or_else(|| PyTypeError::new_err("missing required argument `relaxation`"))?
+        }
+    };
+    Relaxation::new(value).or_raise()
+}
+
+/// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
+pub(crate) fn null_space_arg(spec: Option<&str>) -> PyResult<Option<NullSpaceConfig>> {
+    let Some(spec) = spec else {
+        return Ok(None);
+    };
+    let config: NullSpaceConfig = spec
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("`null_space`: {e}")))?;
+    config.validate().map_err(value_error)?;
+    Ok(Some(config))
+}
+
+/// A `max_samples` argument: `None` keeps every tick, `n >= 0` at most `n` evenly spaced.
+pub(crate) fn retention_arg(max_samples: Option<i64>) -> PyResult<SampleRetention> {
+    let Some(n) = max_samples else {
+        return Ok(SampleRetention::All);
+    };
+    let n = usize::try_from(n).map_err(|_| {
+        PyValueError::new_err(format!("`max_samples` must be >= 0 or None, got {n}"))
+    })?;
+    Ok(SampleRetention::AtMost(n))
+}
+
+/// The scenario of a `scenario` argument: a `str` by the CLI's name-or-file rule
+/// (`Scenario::load`), an `os.PathLike` a file.
+pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        let s = s.to_cow()?;
+        return Scenario::load(&s).map_err(|e| sim_error(e, "", Some((READ, Path::new(&*s)))));
+    }
+    if obj.hasattr("__fspath__")? {
+        let path: PathBuf = obj.extract().map_err(|e| {
+            PyTypeError::new_err(format!("`{name}` is not a usable file path: {e}"))
+        })?;
+        return Scenario::from_file(&path).map_err(|e| sim_error(e, "", Some((READ, &path))));
+    }
+    let got = obj.get_type().name()?;
+    Err(PyTypeError::new_err(format!(
+        "`{name}` must be a built-in scenario name or a path to a TOML file (str or \
+         os.PathLike), got {got}"
+    )))
 }

@@ -10,7 +10,9 @@ use pyo3::types::PyDict;
 use tvmd_sim::runner;
 use tvmd_sim::sim::SampleRetention;
 
-use crate::sim::{run_items, sweep_run_specs, value_error, PySimResult, RunArgs, SimData};
+use crate::errors::value_error;
+use crate::runs::{run_items, sweep_run_specs, RunArgs};
+use crate::sim_result::{PySimResult, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
 #[pyfunction]

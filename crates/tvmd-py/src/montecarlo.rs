@@ -11,7 +11,8 @@ use tvmd_sim::montecarlo::{
 };
 use tvmd_sim::scenario::Scenario;
 
-use crate::sim::{record_to_py, scenario_arg, value_error};
+use crate::convert::{record_to_py, scenario_arg};
+use crate::errors::value_error;
 
 /// The study's flights as JSON specs. See the stub.
 #[pyfunction]

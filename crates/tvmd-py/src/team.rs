@@ -6,16 +6,15 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use tvmd_core::team::presets;
-use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};
+use tvmd_core::TeamConfig;
+use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, HoverCapability, Navigator};
 
 use crate::afs::PyAfs;
-use crate::controller::PyHoverCapability;
 use crate::convert::{array, check_finite, count, indices, int_array, matrix, opt_arg};
-use crate::convert::{shape_error, shape_str, shaped, table};
+use crate::convert::{shape_error, shape_str, shaped, table, CAPACITY};
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
 use crate::record::record;
-use crate::CAPACITY;
 
 /// Agent specs from the array arguments.
 fn agent_specs(
@@ -332,7 +331,24 @@ pub(crate) fn padded_forces(
     Ok(forces)
 }
 
-/// Registers `Team`.
+record! {
+    /// Whether the working agents can hold hover with a margin. See the stub.
+    "HoverCapability" in "tvmd" => PyHoverCapability(HoverCapability<f64>) |py, o| {
+        /// The hover wrench is strictly inside the working agents' attainable set.
+        capable => o.capable,
+        /// Smallest normalized slack of any working agent in the certifying allocation.
+        margin => o.margin,
+        /// The agent whose slack is `margin`, or None.
+        limiting_agent => o.limiting_agent,
+        /// The bound it is closest to: "max_thrust", "min_thrust", "gimbal_x" or "gimbal_y".
+        limit => o.limit.as_str(),
+        /// `m_C g` (N).
+        weight => o.weight,
+    }
+}
+
+/// Registers `Team` and its `HoverCapability`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PyTeam>()
+    m.add_class::<PyTeam>()?;
+    m.add_class::<PyHoverCapability>()
 }
