@@ -9,7 +9,7 @@ use tvmd_sim::scenario::NullSpaceConfig;
 use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};
 use crate::convert::{class_arg, commands_array, iteration_cap, matrix, null_space_arg};
-use crate::convert::{relaxation_arg, CAPACITY};
+use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, value_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains, PyLawOutput};
 use crate::planner::{planner, PyPlannerResult};
@@ -58,7 +58,7 @@ impl PyController {
         weights: Option<&Bound<'_, PyAny>>,
         regularization: Option<f64>,
         planner_tolerance: Option<f64>,
-        planner_max_iterations: Option<i64>,
+        planner_max_iterations: Option<Int>,
         s: Option<f64>,
         null_space: Option<&str>,
     ) -> PyResult<Self> {
@@ -81,7 +81,8 @@ impl PyController {
         let mask = failure_mask(&team, failed)?;
         let mut inner = Controller::new(team, settings, allocator).or_raise()?;
         inner.set_failures(mask).or_raise()?;
-        let max_iterations = iteration_cap(planner_max_iterations)?;
+        let max_iterations =
+            iteration_cap(planner_max_iterations.as_ref(), "planner_max_iterations")?;
         if planner_tolerance.is_some() || planner_max_iterations.is_some() {
             inner.set_planner(planner(relaxation, planner_tolerance, max_iterations)?);
         }

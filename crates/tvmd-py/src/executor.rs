@@ -10,8 +10,10 @@ use pyo3::types::PyDict;
 use tvmd_sim::runner;
 use tvmd_sim::sim::SampleRetention;
 
+use crate::convert::{retention_arg, Int};
 use crate::errors::value_error;
-use crate::runs::{run_items, sweep_run_specs, RunArgs};
+use crate::runs::RunArgs;
+use crate::runs::{run_items, sweep_run_specs};
 use crate::sim_result::{PySimResult, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
@@ -48,7 +50,7 @@ fn relaxation_sweep_runs<'py>(
     precision: Option<String>,
     mcap_dir: Option<PathBuf>,
     pil: Option<String>,
-    max_samples: Option<i64>,
+    max_samples: Option<Int>,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let args = RunArgs {
         scenario,
@@ -56,7 +58,7 @@ fn relaxation_sweep_runs<'py>(
         allocator,
         precision,
         pil,
-        max_samples,
+        samples: retention_arg(max_samples.as_ref(), "max_samples")?,
         ..RunArgs::default()
     };
     let specs = sweep_run_specs(relaxations, args, mcap_dir)?;

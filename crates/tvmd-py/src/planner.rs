@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use tvmd_core::{AttitudePlanner, PlannerOutput, Relaxation};
 
 use crate::afs::PyAfs;
-use crate::convert::{class_arg, finite, iteration_cap, matrix, relaxation_arg};
+use crate::convert::{class_arg, finite, iteration_cap, matrix, relaxation_arg, Int};
 use crate::errors::OrRaise;
 use crate::record::record;
 
@@ -34,11 +34,11 @@ impl PyAttitudePlanner {
     fn new(
         relaxation: Option<f64>,
         tolerance: Option<f64>,
-        max_iterations: Option<i64>,
+        max_iterations: Option<Int>,
         s: Option<f64>,
     ) -> PyResult<Self> {
         let relaxation = relaxation_arg(relaxation, s, None)?;
-        let max_iterations = iteration_cap(max_iterations)?;
+        let max_iterations = iteration_cap(max_iterations.as_ref(), "max_iterations")?;
         let inner = planner(relaxation, tolerance, max_iterations)?;
         Ok(Self {
             inner,

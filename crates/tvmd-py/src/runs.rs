@@ -13,7 +13,9 @@ use pyo3::types::{PyDict, PyString};
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::scenario::{Overrides, Precision, Scenario};
+use tvmd_sim::sim::SampleRetention;
 
+use crate::convert::Int;
 use crate::convert::{null_space_arg, retention_arg, scalars, scenario_arg, shape_error};
 use crate::errors::{sim_error, value_error, WRITE};
 use crate::sim_result::{PySimResult, SimData};
@@ -46,7 +48,8 @@ pub(crate) struct RunArgs<'a, 'py> {
     pub(crate) null_space: Option<String>,
     pub(crate) precision: Option<String>,
     pub(crate) pil: Option<String>,
-    pub(crate) max_samples: Option<i64>,
+    /// The converted `max_samples` ([`retention_arg`]).
+    pub(crate) samples: SampleRetention,
     pub(crate) team: Option<String>,
 }
 
@@ -77,10 +80,9 @@ impl RunArgs<'_, '_> {
             team: self.team,
         };
         overrides.apply(&mut scenario).map_err(value_error)?;
-        let samples = retention_arg(self.max_samples)?;
         let spec = RunSpec::on_target(scenario, self.mcap, pil, precision);
         let mut spec = spec.map_err(value_error)?;
-        spec.samples = samples;
+        spec.samples = self.samples;
         Ok(spec)
     }
 }
@@ -129,6 +131,8 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         }
     }
     let scenario = dict.get_item("scenario")?;
+    let max_samples = opt::<Int>(dict, &name, "max_samples")?;
+    let samples = retention_arg(max_samples.as_ref(), &format!("{name}['max_samples']"))?;
     RunArgs {
         scenario: scenario.as_ref(),
         toml: opt(dict, &name, "toml")?,
@@ -138,7 +142,7 @@ fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         null_space: opt(dict, &name, "null_space")?,
         precision: opt(dict, &name, "precision")?,
         pil: opt(dict, &name, "pil")?,
-        max_samples: opt(dict, &name, "max_samples")?,
+        samples,
         team: opt(dict, &name, "team")?,
     }
     .spec(&format!("{name}['scenario']"))
@@ -182,23 +186,27 @@ pub(crate) fn sweep_run_specs(
     Ok(specs)
 }
 
+/// The error prefix of run `k` of a `run_many` batch.
+pub(crate) fn batch_label(k: usize, spec: &RunSpec) -> String {
+    format!("runs[{k}] ({}): ", spec.scenario.name)
+}
+
+/// The error prefix of a run of a relaxation study.
+pub(crate) fn sweep_label(spec: &RunSpec) -> String {
+    format!(
+        "s = {} ({}): ",
+        spec.scenario.relaxation, spec.scenario.name
+    )
+}
+
 /// Runs the specs on tvmd-sim's worker pool with the GIL released; the first failure in input
 /// order is raised, its message prefixed with `label(k)`.
 pub(crate) fn run_specs(
     py: Python<'_>,
     specs: Vec<RunSpec>,
-    jobs: Option<i64>,
+    jobs: Option<usize>,
     label: impl Fn(usize, &RunSpec) -> String,
 ) -> PyResult<Vec<PySimResult>> {
-    let jobs = jobs
-        .map(|j| {
-            let error = || PyValueError::new_err(format!("`jobs` must be >= 1, got {j}"));
-            usize::try_from(j)
-                .ok()
-                .filter(|j| *j >= 1)
-                .ok_or_else(error)
-        })
-        .transpose()?;
     runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
     let outcomes = run_interruptibly(py, specs, jobs)?;
     let results = outcomes.into_iter().enumerate();

@@ -11,8 +11,10 @@ use pyo3::prelude::*;
 
 use tvmd_sim::scenario::{Scenario, BUILTIN_NAMES};
 
+use crate::convert::{jobs_arg, retention_arg, Int};
 use crate::errors::value_error;
-use crate::runs::{run_items, run_specs, sweep_run_specs, RunArgs};
+use crate::runs::RunArgs;
+use crate::runs::{batch_label, run_items, run_specs, sweep_label, sweep_run_specs};
 use crate::sim_result::PySimResult;
 
 /// The names of the built-in scenarios.
@@ -44,9 +46,10 @@ fn run(
     precision: Option<String>,
     pil: Option<String>,
     null_space: Option<String>,
-    max_samples: Option<i64>,
+    max_samples: Option<Int>,
     team: Option<String>,
 ) -> PyResult<PySimResult> {
+    let samples = retention_arg(max_samples.as_ref(), "max_samples")?;
     let spec = RunArgs {
         scenario,
         toml,
@@ -56,7 +59,7 @@ fn run(
         null_space,
         precision,
         pil,
-        max_samples,
+        samples,
         team,
     }
     .spec("scenario")?;
@@ -71,12 +74,10 @@ fn run(
 fn run_many(
     py: Python<'_>,
     runs: &Bound<'_, PyAny>,
-    jobs: Option<i64>,
+    jobs: Option<Int>,
 ) -> PyResult<Vec<PySimResult>> {
     let specs = run_items(runs)?;
-    run_specs(py, specs, jobs, |k, s| {
-        format!("runs[{k}] ({}): ", s.scenario.name)
-    })
+    run_specs(py, specs, jobs_arg(jobs.as_ref())?, batch_label)
 }
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
@@ -91,23 +92,22 @@ fn relaxation_sweep(
     allocator: Option<String>,
     precision: Option<String>,
     mcap_dir: Option<PathBuf>,
-    jobs: Option<i64>,
+    jobs: Option<Int>,
     pil: Option<String>,
-    max_samples: Option<i64>,
+    max_samples: Option<Int>,
 ) -> PyResult<Vec<PySimResult>> {
+    let jobs = jobs_arg(jobs.as_ref())?;
     let args = RunArgs {
         scenario,
         toml,
         allocator,
         precision,
         pil,
-        max_samples,
+        samples: retention_arg(max_samples.as_ref(), "max_samples")?,
         ..RunArgs::default()
     };
     let specs = sweep_run_specs(relaxations, args, mcap_dir)?;
-    run_specs(py, specs, jobs, |_, s| {
-        format!("s = {} ({}): ", s.scenario.relaxation, s.scenario.name)
-    })
+    run_specs(py, specs, jobs, |_, s| sweep_label(s))
 }
 
 /// Adds the documentation and the run functions to the `sim` submodule.

@@ -11,7 +11,7 @@ use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, HoverCapabilit
 
 use crate::afs::PyAfs;
 use crate::convert::{array, check_finite, count, indices, int_array, matrix, opt_arg};
-use crate::convert::{shape_error, shape_str, shaped, table, CAPACITY};
+use crate::convert::{shape_error, shape_str, shaped, table, Int, CAPACITY};
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
 use crate::record::record;
@@ -96,8 +96,8 @@ pub(crate) fn failure_mask(
 ) -> PyResult<FailureMask<CAPACITY>> {
     let mut mask = FailureMask::none();
     for index in indices(failed, "failed")? {
-        let agent = usize::try_from(index)
-            .ok()
+        let agent = index
+            .get::<usize>()
             .filter(|i| *i < team.len())
             .ok_or_else(|| {
                 ConfigError::new_err(format!(
@@ -251,7 +251,7 @@ record! {
     #[staticmethod]
     #[pyo3(signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY))]
     fn ring(
-        n: i64,
+        n: Int,
         radius: f64,
         inconsistent: bool,
         sigma_x: f64,
@@ -259,7 +259,7 @@ record! {
         max_thrust: f64,
     ) -> PyResult<Self> {
         let limits = AgentLimits::new(sigma_x, sigma_y, max_thrust).or_raise()?;
-        Self::wrap(presets::ring(count(n, "n")?, radius, inconsistent, limits))
+        Self::wrap(presets::ring(count(&n, "n")?, radius, inconsistent, limits))
     }
 
     /// `M(Xi)` (6, 3n) of eq. (4); columns of failed agents are zero.

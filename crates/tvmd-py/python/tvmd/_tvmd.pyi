@@ -7,7 +7,9 @@ built module by ``mypy.stubtest`` (``tests/test_stubs.py``).
 Conventions: ``f64`` throughout, at most ``CAPACITY`` = 64 agents. Array inputs may be NumPy
 arrays of any real dtype, nested lists or Python numbers (integers are converted; booleans,
 complex numbers, strings and objects raise ``TypeError``). Wrong shapes raise ``ValueError``
-naming the argument and the expected shape; NaN/inf inputs raise ``ValueError``; the core's
+naming the argument and the expected shape; NaN/inf inputs raise ``ValueError``; an integer
+argument (any ``int`` or NumPy integer) outside its valid range raises ``ValueError`` naming the
+argument and the range (never ``OverflowError``); the core's
 configuration and input errors become ``ConfigError`` / ``InputError`` (both ``ValueError``s)
 with the core's message. No code path panics.
 """

@@ -1,0 +1,120 @@
+"""Arguments at the binding layer (issue 43): integer ranges, the defaults that ``inspect`` and
+``help()`` show, and errors that name the argument (or the batch item) they are about.
+
+* Every integer argument of every public callable, out of its range (negative, beyond 64 bits,
+  beyond 128 bits), raises ``ValueError`` naming the argument and its valid range, never
+  ``OverflowError`` with a message of the binding's internals.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import tvmd
+import tvmd.sim as sim
+
+A4 = tvmd.Team.a4_inc()
+SHORT = "duration = 1.0\n"
+BIG = 2**200  # beyond every Rust integer type
+
+# ---------------------------------------------------------------------------
+# Integer arguments (issue 43, item 8)
+# ---------------------------------------------------------------------------
+
+U64 = r">= 0 and <= 2\*\*64 - 1"
+U32_ITER = r">= 1 and <= 2\*\*32 - 1"
+JOBS = r">= 1 and <= 2\*\*64 - 1"
+
+# (call taking the bad value, the argument's name as the message gives it, its range)
+INTEGER_ARGUMENTS = [
+    (lambda v: sim.monte_carlo("hover", runs=2, seed=v), "seed", U64),
+    (lambda v: sim.monte_carlo_specs("hover", runs=v), "runs", JOBS),
+    (lambda v: sim.monte_carlo(toml=SHORT, runs=1, jobs=v), "jobs", JOBS),
+    (lambda v: sim.monte_carlo_fly([], jobs=v), "jobs", JOBS),
+    (lambda v: sim.run("hover", max_samples=v), "max_samples", U64),
+    (lambda v: sim.run_many(["hover"], jobs=v), "jobs", JOBS),
+    (lambda v: sim.run_many([{"scenario": "hover", "max_samples": v}]), r"runs\[0\]\['max_samples'\]", U64),
+    (lambda v: sim.relaxation_sweep([0.5], "hover", jobs=v), "jobs", JOBS),
+    (lambda v: sim.relaxation_sweep([0.5], "hover", max_samples=v), "max_samples", U64),
+    (lambda v: tvmd.Controller(A4, planner_max_iterations=v), "planner_max_iterations", U32_ITER),
+    (lambda v: tvmd.AttitudePlanner(0.5, max_iterations=v), "max_iterations", U32_ITER),
+    (lambda v: tvmd.AttainableForceSpace(v, 0, 0.5, 0.5, 10.0), "n", U64),
+    (lambda v: tvmd.AttainableForceSpace(4, v, 0.5, 0.5, 10.0), "n_x", U64),
+    (lambda v: tvmd.Team.ring(v, 1.0, True), "n", U64),
+    (lambda v: tvmd.afs_atlas("a4-inc", directions=v), "directions", ">= 4 and <= 3600"),
+    (lambda v: tvmd.afs_atlas("a4-inc", certify_heights=v), "certify_heights", ">= 2 and <= 200"),
+    (lambda v: tvmd.afs_atlas("a4-inc", failed=[v]), "failed", U64),
+]  # fmt: skip
+IDS = [f"{k}-{name}" for k, (_, name, _) in enumerate(INTEGER_ARGUMENTS)]
+
+
+@pytest.mark.parametrize("value", [-1, 2**70, -(2**70), 10**20, BIG, -BIG])
+@pytest.mark.parametrize("call, name, valid", INTEGER_ARGUMENTS, ids=IDS)
+def test_out_of_range_integers_raise_value_error_naming_argument_and_range(call, name, valid, value):
+    with pytest.raises(ValueError) as info:
+        call(value)
+    assert not isinstance(info.value, OverflowError)
+    message = str(info.value)
+    assert re.search(rf"`{name}` must be {valid}, got {value}$", message), message
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: sim.monte_carlo("hover", runs=2, seed=-1),
+        lambda: sim.run("hover", max_samples=2**70),
+        lambda: tvmd.Controller(A4, planner_max_iterations=10**20),
+    ],
+    ids=["seed", "max_samples", "planner_max_iterations"],
+)
+def test_issue_examples_are_value_errors(call):
+    with pytest.raises(ValueError, match="must be >="):
+        call()
+
+
+def test_failure_indices_beyond_64_bits_are_config_errors():
+    with pytest.raises(tvmd.ConfigError, match=f"agent {2**70},"):
+        A4.effectiveness(failed=[2**70])
+    with pytest.raises(tvmd.ConfigError, match=f"agent {-BIG},"):
+        tvmd.Controller(A4, failed=[-BIG])
+
+
+def test_integer_arguments_take_numpy_integers_and_refuse_floats():
+    assert tvmd.Team.ring(np.int64(5), 0.5, True).n == 5
+    assert tvmd.AttitudePlanner(0.5, max_iterations=np.uint32(7)).max_iterations == 7
+    with pytest.raises(TypeError):
+        tvmd.Team.ring(5.0, 0.5, True)
+    with pytest.raises(TypeError):
+        sim.monte_carlo_specs("hover", runs=2, seed=1.5)
+    with pytest.raises(TypeError):
+        tvmd.afs_atlas("a4-inc", directions="36")
+    # The largest seed is valid.
+    assert len(sim.monte_carlo_specs(toml=SHORT, runs=1, seed=2**64 - 1)) == 1
+    # 0 is left to the core, whose ConfigError names its field.
+    with pytest.raises(tvmd.ConfigError, match="planner.max_iterations"):
+        tvmd.Controller(A4, planner_max_iterations=0)
+
+
+# ---------------------------------------------------------------------------
+# afs_atlas names `certify_heights` (issue 43, item 10)
+# ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", [1, 0, 201])
+def test_afs_atlas_certify_heights_is_named_with_its_range(value):
+    with pytest.raises(ValueError) as info:
+        tvmd.afs_atlas("a4-inc", certify_heights=value)
+    message = str(info.value)
+    assert message == f"`certify_heights` must be >= 2 and <= 200, got {value}"
+    assert "range" not in message and "HeightRange" not in message
+
+
+def test_afs_atlas_certify_heights_bounds_are_valid():
+    for value in (2, 200):
+        row = tvmd.afs_atlas("a4-inc", heights=[1.0], directions=4, certify_heights=value)
+        assert row["team"] == "a4-inc"
+
+
