@@ -2,7 +2,6 @@
 
 use pyo3::prelude::*;
 
-use tvmd_core::team::presets;
 use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, NullSpaceReport};
 use tvmd_sim::scenario::NullSpaceConfig;
 
@@ -44,7 +43,7 @@ pub struct PyController {
 #[pymethods]
 impl PyController {
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,

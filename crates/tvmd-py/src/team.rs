@@ -248,8 +248,13 @@ record! {
     }
 
     /// `n` agents of 0.7 kg on a circle of `radius` (m).
+    // Python shows a default only if it is a literal: the core's values (the paper's agents)
+    // are the defaults, their digits the text signature (the tests compare the two).
     #[staticmethod]
-    #[pyo3(signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY))]
+    #[pyo3(
+        signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY),
+        text_signature = "(n, radius, inconsistent, sigma_x=0.5235987755982989, sigma_y=0.7853981633974483, max_thrust=13.734)"
+    )]
     fn ring(
         n: Int,
         radius: f64,
@@ -299,13 +304,13 @@ record! {
     }
 
     /// The rigid-body parameters of the control law.
-    #[pyo3(signature = (gravity = presets::GRAVITY))]
+    #[pyo3(signature = (gravity = 9.81))]
     fn plant(&self, gravity: f64) -> PyResult<PyPlant> {
         PyPlant::create(self.inner.mass(), self.inner.inertia(), gravity)
     }
 
     /// Whether the working agents can hold hover with a margin. See the stub.
-    #[pyo3(signature = (failed = None, gravity = presets::GRAVITY))]
+    #[pyo3(signature = (failed = None, gravity = 9.81))]
     fn hover_capability(
         &self,
         failed: Option<&Bound<'_, PyAny>>,

@@ -4,10 +4,14 @@
 * Every integer argument of every public callable, out of its range (negative, beyond 64 bits,
   beyond 128 bits), raises ``ValueError`` naming the argument and its valid range, never
   ``OverflowError`` with a message of the binding's internals.
+* No public callable shows ``Ellipsis`` as a default; the defaults shown are the ones used
+  (passing them back gives the same result).
 """
 
 from __future__ import annotations
 
+import inspect
+import math
 import re
 
 import numpy as np
@@ -96,6 +100,73 @@ def test_integer_arguments_take_numpy_integers_and_refuse_floats():
     # 0 is left to the core, whose ConfigError names its field.
     with pytest.raises(tvmd.ConfigError, match="planner.max_iterations"):
         tvmd.Controller(A4, planner_max_iterations=0)
+
+
+# ---------------------------------------------------------------------------
+# Defaults shown by inspect / help() (issue 43, item 9)
+# ---------------------------------------------------------------------------
+
+
+def _public_callables():
+    for module in (tvmd, sim):
+        for name in module.__all__:
+            obj = getattr(module, name)
+            if inspect.isclass(obj):
+                yield f"{module.__name__}.{name}", obj
+                for attr, member in vars(obj).items():
+                    if callable(member) and not attr.startswith("_"):
+                        yield f"{module.__name__}.{name}.{attr}", getattr(obj, attr)
+            elif callable(obj):
+                yield f"{module.__name__}.{name}", obj
+
+
+def test_no_default_is_ellipsis():
+    shown = []
+    for qualname, obj in _public_callables():
+        try:
+            signature = inspect.signature(obj)
+        except ValueError:
+            continue  # no text signature (a record class without a constructor)
+        for p in signature.parameters.values():
+            if p.default is Ellipsis:
+                shown.append(f"{qualname}({p.name})")
+    assert not shown, shown
+
+
+def _default(obj, name):
+    return inspect.signature(obj).parameters[name].default
+
+
+@pytest.mark.parametrize(
+    "obj",
+    [tvmd.Controller, tvmd.Plant, tvmd.Team.plant, tvmd.Team.hover_capability],
+    ids=["Controller", "Plant", "Team.plant", "Team.hover_capability"],
+)
+def test_gravity_defaults_are_standard_gravity(obj):
+    assert _default(obj, "gravity") == tvmd.GRAVITY == 9.81
+    assert "gravity=9.81" in (obj.__text_signature__ or "")
+
+
+def test_shown_defaults_are_the_defaults_used():
+    ring = inspect.signature(tvmd.Team.ring).parameters
+    shown = {name: ring[name].default for name in ("sigma_x", "sigma_y", "max_thrust")}
+    # The paper's agents: pi/6, pi/4 and 2 m_i g.
+    ring6 = tvmd.Team.ring(6, 0.5, True)
+    assert shown == {"sigma_x": ring6.sigma_x, "sigma_y": ring6.sigma_y, "max_thrust": ring6.max_thrust}
+    assert shown["sigma_x"] == pytest.approx(math.pi / 6, rel=1e-15)
+    assert shown["sigma_y"] == math.pi / 4 and shown["max_thrust"] == 2 * 0.7 * tvmd.GRAVITY
+    assert repr(tvmd.Team.ring(6, 0.5, True, **shown)) == repr(ring6)
+    g = _default(tvmd.Team.plant, "gravity")
+    assert repr(A4.plant(gravity=g)) == repr(A4.plant())
+    assert A4.hover_capability(gravity=g).to_dict() == A4.hover_capability().to_dict()
+    assert repr(tvmd.Plant(2.0, np.eye(3), gravity=g)) == repr(tvmd.Plant(2.0, np.eye(3)))
+    kw = {name: _default(tvmd.Controller, name) for name in ("gravity", "period", "allocator")}
+    assert repr(tvmd.Controller(A4, **kw)) == repr(tvmd.Controller(A4))
+    assert tvmd.Controller(A4, **kw).gravity == tvmd.Controller(A4).gravity
+    atlas = inspect.signature(tvmd.afs_atlas).parameters
+    assert (atlas["directions"].default, atlas["certify_heights"].default) == (36, 9)
+    specs = inspect.signature(sim.monte_carlo_specs).parameters
+    assert (specs["runs"].default, specs["seed"].default) == (100, 0)
 
 
 # ---------------------------------------------------------------------------
