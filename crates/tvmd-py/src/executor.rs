@@ -13,7 +13,7 @@ use tvmd_sim::sim::SampleRetention;
 use crate::convert::{retention_arg, Int};
 use crate::errors::value_error;
 use crate::runs::RunArgs;
-use crate::runs::{run_items, sweep_run_specs};
+use crate::runs::{batch_label, run_item, run_items, run_specs, sweep_label, sweep_run_specs};
 use crate::sim_result::{PySimResult, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
@@ -33,6 +33,30 @@ fn check_runs(runs: &Bound<'_, PyAny>) -> PyResult<usize> {
     let specs = run_items(runs)?;
     runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
     Ok(specs.len())
+}
+
+/// Flies item `index` of a `run_many` batch (or, with `sweep`, of a relaxation study's runs) as
+/// one executor task; a failure is named as the threads name it (`runs[index] (name): ...`).
+#[pyfunction]
+#[pyo3(name = "_run_item")]
+#[pyo3(signature = (item, index, *, sweep = false))]
+fn run_one_item(
+    py: Python<'_>,
+    item: &Bound<'_, PyAny>,
+    index: usize,
+    sweep: bool,
+) -> PyResult<PySimResult> {
+    let spec = run_item(item, index)?;
+    let label = |_: usize, spec: &tvmd_sim::runner::RunSpec| {
+        if sweep {
+            sweep_label(spec)
+        } else {
+            batch_label(index, spec)
+        }
+    };
+    run_specs(py, vec![spec], Some(1), label)?
+        .pop()
+        .ok_or_else(|| pyo3::exceptions::PyRuntimeError::new_err("tvmd-sim returned no result"))
 }
 
 /// The runs of a relaxation study as `run_many` items (TOML text, log, target, retention), for
@@ -85,6 +109,7 @@ fn relaxation_sweep_runs<'py>(
 pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(sim_result_from_state, sim)?)?;
     sim.add_function(wrap_pyfunction!(check_runs, sim)?)?;
+    sim.add_function(wrap_pyfunction!(run_one_item, sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep_runs, sim)?)?;
     Ok(())
 }

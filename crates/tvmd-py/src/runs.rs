@@ -87,8 +87,9 @@ impl RunArgs<'_, '_> {
     }
 }
 
-/// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments.
-fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
+/// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments; `k` its
+/// index, which errors name.
+pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
     let name = format!("runs[{k}]");
     let Ok(dict) = item.cast::<PyDict>() else {
         if item.is_instance_of::<PyString>() || item.hasattr("__fspath__")? {

@@ -6,13 +6,16 @@
   ``OverflowError`` with a message of the binding's internals.
 * No public callable shows ``Ellipsis`` as a default; the defaults shown are the ones used
   (passing them back gives the same result).
+* ``run_many`` / ``relaxation_sweep`` on an executor name the failing item as the threads do.
 """
 
 from __future__ import annotations
 
 import inspect
 import math
+import os
 import re
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -189,3 +192,39 @@ def test_afs_atlas_certify_heights_bounds_are_valid():
         assert row["team"] == "a4-inc"
 
 
+# ---------------------------------------------------------------------------
+# run_many on an executor names the failing item (issue 43, item 5)
+# ---------------------------------------------------------------------------
+
+
+def _message(call):
+    with pytest.raises(OSError) as info:
+        call()
+    return str(info.value)
+
+
+def test_run_many_on_an_executor_names_the_failing_item(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    runs = [{"toml": SHORT}, {"toml": SHORT}, {"toml": SHORT, "mcap": blocker / "x.mcap"}]
+    threads = _message(lambda: sim.run_many(runs))
+    with ThreadPoolExecutor(2) as pool:
+        there = _message(lambda: sim.run_many(runs, executor=pool))
+    assert "runs[2] (paper-tilt): cannot write the MCAP log" in threads
+    assert there == threads
+
+
+def test_relaxation_sweep_on_an_executor_names_the_failing_run(tmp_path):
+    kw = dict(toml=SHORT, mcap_dir=tmp_path, max_samples=0)
+    first = sim.relaxation_sweep([0.5, 1.0], **kw)
+    for r in first:
+        os.remove(r.mcap_path)
+    # The second run's log cannot be written once it flies: a link to a path under a file.
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    os.symlink(blocker / "x.mcap", first[1].mcap_path)
+    threads = _message(lambda: sim.relaxation_sweep([0.5, 1.0], **kw))
+    with ThreadPoolExecutor(2) as pool:
+        there = _message(lambda: sim.relaxation_sweep([0.5, 1.0], **kw, executor=pool))
+    assert "s = 1 (paper-tilt-s1): cannot write the MCAP log" in threads
+    assert there == threads
