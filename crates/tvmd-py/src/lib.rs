@@ -5,9 +5,12 @@
 //! one error mapping) and call the core. The Python API is documented in the stubs
 //! `python/tvmd/_tvmd.pyi` and `sim.pyi`.
 //!
-//! Modules import one way (no circle): `errors` and `record` import no module of the crate,
-//! `convert` only `errors`; the core areas build up `afs` -> `planner`, `law`, `team` ->
-//! `allocation` -> `controller`; the simulator `sim_result` -> `runs` -> `sim`, `executor`.
+//! Modules import one way (no circle; `a <- b` reads "b imports a"): `errors` and `record`
+//! import no module of the crate, `convert` only `errors`, and every other module imports
+//! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
+//! `afs, allocation, law, planner, team <- controller`, and for the simulator
+//! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert` and
+//! `errors`. This file imports every module and no module imports it.
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,
