@@ -9,9 +9,10 @@ use pyo3::types::PyTuple;
 use tvmd_core::gimbal::thrust_direction as core_thrust_direction;
 use tvmd_core::{project_force, AgentLimits, AttainableForceSpace, ForceProjection, GimbalCommand};
 
-use crate::convert::{count, matrix, scalar_or_array, scalars, shaped, vectors};
+use crate::convert::{
+    count, matrix, relaxation_arg, scalar_or_array, scalars, shaped, vectors, Int,
+};
 use crate::errors::OrRaise;
-use crate::planner::relaxation_arg;
 use crate::record::record;
 
 /// A core AFS with the limits it was built from.
@@ -66,8 +67,8 @@ record! {
     methods {
         #[new]
         #[pyo3(signature = (n, n_x, sigma_x, sigma_y, max_thrust))]
-        fn new(n: i64, n_x: i64, sigma_x: f64, sigma_y: f64, max_thrust: f64) -> PyResult<Self> {
-            let (n, n_x) = (count(n, "n")?, count(n_x, "n_x")?);
+        fn new(n: Int, n_x: Int, sigma_x: f64, sigma_y: f64, max_thrust: f64) -> PyResult<Self> {
+            let (n, n_x) = (count(&n, "n")?, count(&n_x, "n_x")?);
             let afs = AttainableForceSpace::new(n, n_x, sigma_x, sigma_y, max_thrust).or_raise()?;
             let inner = AfsData {
                 afs,

@@ -12,11 +12,10 @@ use tvmd_core::{AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllo
 use tvmd_core::{ConfigError, ConfigField, GimbalCommand, RateLimits};
 
 use crate::convert::{arg, array, check_finite, class_arg, finite, finite_scalar, matrix};
-use crate::convert::{shape_error, shaped};
-use crate::errors::{config_error, OrRaise};
+use crate::convert::{shape_error, shaped, CAPACITY};
+use crate::errors::{config_error, ConfigError as PyConfigError, OrRaise};
 use crate::record::record;
 use crate::team::{failure_mask, PyTeam};
-use crate::CAPACITY;
 
 /// Names of the allocators this build provides (the core's one table).
 pub(crate) const ALLOCATORS: &[&str] = AnyAllocator::<f64, CAPACITY>::NAMES;
@@ -152,9 +151,7 @@ pub(crate) fn allocate(
         (Some(_), None) => return Err(PyValueError::new_err("`rate_limits` needs `dt`")),
         (Some(rates), Some(dt)) => {
             if finite_scalar(dt, "dt")? <= 0.0 {
-                return Err(crate::errors::ConfigError::new_err(
-                    "`dt` must be positive and finite",
-                ));
+                return Err(PyConfigError::new_err("`dt` must be positive and finite"));
             }
             let previous = match previous {
                 Some(p) => previous_commands(p, n)?,

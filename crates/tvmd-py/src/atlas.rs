@@ -8,21 +8,29 @@ use pyo3::prelude::*;
 
 use tvmd_sim::afs_atlas::cli::{run, AfsArgs};
 
-use crate::convert::{count, indices};
-use crate::sim::{record_to_py, value_error};
+use crate::convert::{count, indices, record_to_py, Int};
+use crate::errors::value_error;
+
+/// Directions per cross-section: tvmd-sim's bounds (`afs_atlas::report::atlas_entry`).
+const DIRECTIONS: (i128, i128) = (4, 3600);
+/// Heights of the certification grid: tvmd-sim's bounds (`HeightRange::heights`).
+const CERTIFY_HEIGHTS: (i128, i128) = (2, 200);
 
 /// The atlas row of one catalogue team and failure mask. See the stub.
 #[pyfunction]
-#[pyo3(signature = (team, *, failed = None, heights = None, directions = 36, relaxation = 1.0, certify_heights = 9, torque = None, plots = None))]
+#[pyo3(
+    signature = (team, *, failed = None, heights = None, directions = Int::of(36), relaxation = 1.0, certify_heights = Int::of(9), torque = None, plots = None),
+    text_signature = "(team, *, failed=None, heights=None, directions=36, relaxation=1.0, certify_heights=9, torque=None, plots=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn afs_atlas<'py>(
     py: Python<'py>,
     team: &str,
     failed: Option<&Bound<'py, PyAny>>,
     heights: Option<Vec<f64>>,
-    directions: i64,
+    directions: Int,
     relaxation: f64,
-    certify_heights: i64,
+    certify_heights: Int,
     torque: Option<[f64; 3]>,
     plots: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -32,17 +40,21 @@ fn afs_atlas<'py>(
         ));
     }
     let failed = indices(failed, "failed")?
-        .into_iter()
+        .iter()
         .map(|i| count(i, "failed"))
         .collect::<PyResult<Vec<usize>>>()?;
+    let (lo, hi) = DIRECTIONS;
+    let directions = directions.to("directions", lo, hi)?;
+    let (lo, hi) = CERTIFY_HEIGHTS;
+    let certify_heights = certify_heights.to("certify_heights", lo, hi)?;
     let args = AfsArgs {
         team: team.to_string(),
         failed,
         each_failure: false,
         heights: heights.unwrap_or_else(|| vec![0.5, 1.0, 1.5]),
-        directions: count(directions, "directions")?,
+        directions,
         relaxation,
-        certify_heights: count(certify_heights, "certify_heights")?,
+        certify_heights,
         torque: torque.unwrap_or_default().to_vec(),
         plots,
         json: None,

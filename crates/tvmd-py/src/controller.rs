@@ -2,22 +2,18 @@
 
 use pyo3::prelude::*;
 
-use tvmd_core::team::presets;
-use tvmd_core::{
-    AnyAllocator, ControlOutput, Controller, ControllerSettings, HoverCapability, NullSpaceReport,
-};
+use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, NullSpaceReport};
 use tvmd_sim::scenario::NullSpaceConfig;
 
 use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};
-use crate::convert::{class_arg, commands_array, matrix};
-use crate::errors::{cycle_error, OrRaise};
+use crate::convert::{class_arg, commands_array, iteration_cap, matrix, null_space_arg};
+use crate::convert::{relaxation_arg, Int, CAPACITY};
+use crate::errors::{cycle_error, value_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains, PyLawOutput};
-use crate::planner::{iteration_cap, planner, relaxation_arg, PyPlannerResult};
+use crate::planner::{planner, PyPlannerResult};
 use crate::record::record;
-use crate::sim::{null_space_arg, value_error};
-use crate::team::{failure_mask, PyTeam};
-use crate::CAPACITY;
+use crate::team::{failure_mask, PyHoverCapability, PyTeam};
 
 /// The controller borrowed for a call; a clear error if another thread holds it (only possible
 /// from code that re-enters the controller while it runs, as the GIL serializes the calls).
@@ -47,7 +43,7 @@ pub struct PyController {
 #[pymethods]
 impl PyController {
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = presets::GRAVITY, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,
@@ -61,7 +57,7 @@ impl PyController {
         weights: Option<&Bound<'_, PyAny>>,
         regularization: Option<f64>,
         planner_tolerance: Option<f64>,
-        planner_max_iterations: Option<i64>,
+        planner_max_iterations: Option<Int>,
         s: Option<f64>,
         null_space: Option<&str>,
     ) -> PyResult<Self> {
@@ -84,7 +80,8 @@ impl PyController {
         let mask = failure_mask(&team, failed)?;
         let mut inner = Controller::new(team, settings, allocator).or_raise()?;
         inner.set_failures(mask).or_raise()?;
-        let max_iterations = iteration_cap(planner_max_iterations)?;
+        let max_iterations =
+            iteration_cap(planner_max_iterations.as_ref(), "planner_max_iterations")?;
         if planner_tolerance.is_some() || planner_max_iterations.is_some() {
             inner.set_planner(planner(relaxation, planner_tolerance, max_iterations)?);
         }
@@ -145,7 +142,10 @@ impl PyController {
                 };
                 Ok(PyStepOutput { inner })
             }
-            Err(error) => Err(cycle_error(py, &error, n)),
+            Err(error) => {
+                let commands = commands_array(py, &error.commands, n);
+                Err(cycle_error(py, &error, commands))
+            }
         }
     }
 
@@ -248,22 +248,6 @@ pub(crate) struct StepData {
 }
 
 record! {
-    /// Whether the working agents can hold hover with a margin. See the stub.
-    "HoverCapability" in "tvmd" => PyHoverCapability(HoverCapability<f64>) |py, o| {
-        /// The hover wrench is strictly inside the working agents' attainable set.
-        capable => o.capable,
-        /// Smallest normalized slack of any working agent in the certifying allocation.
-        margin => o.margin,
-        /// The agent whose slack is `margin`, or None.
-        limiting_agent => o.limiting_agent,
-        /// The bound it is closest to: "max_thrust", "min_thrust", "gimbal_x" or "gimbal_y".
-        limit => o.limit.as_str(),
-        /// `m_C g` (N).
-        weight => o.weight,
-    }
-}
-
-record! {
     /// Everything one `Controller.step` computed, nested like the core's `ControlOutput`.
     "StepOutput" in "tvmd" => PyStepOutput(StepData) |py, o| {
         /// The planner's result (eqs. 9-11).
@@ -311,7 +295,6 @@ record! {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyController>()?;
     m.add_class::<PyStepOutput>()?;
-    m.add_class::<PyHoverCapability>()?;
     m.add_class::<PyNullSpaceReport>()?;
     Ok(())
 }

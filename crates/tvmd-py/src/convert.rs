@@ -1,15 +1,26 @@
-//! Conversions at the Python boundary: array-likes in, NumPy arrays out (conventions in the
-//! stub `python/tvmd/_tvmd.pyi`). Nothing here panics: every shape is checked.
+//! The one conversion layer at the Python boundary: array-likes in, NumPy arrays out
+//! (conventions in the stub `python/tvmd/_tvmd.pyi`), and the parsers of the plain arguments
+//! (relaxation, iteration cap, null-space stage, sample retention, scenario). Nothing here
+//! panics: every shape is checked. It imports only [`crate::errors`].
+
+use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use numpy::ndarray::ArrayD;
 use numpy::{Element, PyArray1, PyArrayDyn, PyArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyFloat};
+use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 use pyo3::{intern, IntoPyObjectExt};
 
-use tvmd_core::AgentCommand;
+use tvmd_core::{AgentCommand, Relaxation};
+use tvmd_sim::scenario::{NullSpaceConfig, Scenario};
+use tvmd_sim::sim::SampleRetention;
+
+use crate::errors::{sim_error, value_error, OrRaise, READ};
+
+/// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
+pub(crate) const CAPACITY: usize = 64;
 
 /// `(a, b, c)` as Python prints a shape.
 pub(crate) fn shape_str(shape: &[usize]) -> String {
@@ -186,7 +197,7 @@ pub(crate) fn scalars(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>,
 }
 
 /// Failure indices: `None` or an iterable of agent indices (ints, not booleans).
-pub(crate) fn indices(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Vec<i64>> {
+pub(crate) fn indices(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Vec<Int>> {
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(Vec::new());
     };
@@ -198,7 +209,7 @@ pub(crate) fn indices(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Ve
     iter.map(|item| {
         let item = item?;
         let not_int = item.is_instance_of::<PyBool>() || item.is_instance_of::<PyFloat>();
-        match item.extract::<i64>() {
+        match item.extract::<Int>() {
             Ok(index) if !not_int => Ok(index),
             _ => Err(PyTypeError::new_err(format!(
                 "`{name}` must list agent indices (ints), got {}",
@@ -220,10 +231,103 @@ pub(crate) fn class_arg<'a, 'py, T: pyo3::PyClass>(
     })
 }
 
+/// The largest `usize`, as the bound of a count argument.
+pub(crate) const USIZE_MAX: i128 = usize::MAX as i128;
+
+/// A Python integer argument of any size: an `int` or anything with `__index__` (a NumPy
+/// integer, a bool), read without overflow; floats, strings and the rest raise `TypeError`.
+/// [`Int::to`] converts it, the one range check of every integer argument.
+#[derive(Clone, Debug)]
+pub(crate) struct Int {
+    /// The value, saturated to the `i128` range.
+    value: i128,
+    /// The value as Python prints it when it is beyond `i128` (`value` saturated).
+    big: Option<String>,
+}
+
+impl Int {
+    /// An argument's default.
+    pub(crate) const fn of(value: i64) -> Self {
+        Self {
+            value: value as i128,
+            big: None,
+        }
+    }
+
+    /// The value as `T`, if it is one.
+    pub(crate) fn get<T: TryFrom<i128>>(&self) -> Option<T> {
+        self.big
+            .is_none()
+            .then(|| T::try_from(self.value).ok())
+            .flatten()
+    }
+
+    /// The value as `T` if it lies in `[min, max]` (a range within `T`'s), else a `ValueError`
+    /// naming the argument `name` and the range.
+    pub(crate) fn to<T: TryFrom<i128>>(&self, name: &str, min: i128, max: i128) -> PyResult<T> {
+        self.get::<i128>()
+            .filter(|v| (min..=max).contains(v))
+            .and_then(|v| T::try_from(v).ok())
+            .ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "`{name}` must be >= {} and <= {}, got {self}",
+                    bound(min),
+                    bound(max)
+                ))
+            })
+    }
+}
+
+impl std::fmt::Display for Int {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.big {
+            Some(text) => f.write_str(text),
+            None => write!(f, "{}", self.value),
+        }
+    }
+}
+
+/// A range bound as Python would write it: `2**64 - 1` rather than its digits.
+fn bound(x: i128) -> String {
+    let (sign, magnitude) = (if x < 0 { "-" } else { "" }, x.unsigned_abs());
+    if magnitude >= 1 << 20 {
+        if magnitude.is_power_of_two() {
+            return format!("{sign}2**{}", magnitude.trailing_zeros());
+        }
+        if (magnitude + 1).is_power_of_two() && sign.is_empty() {
+            return format!("2**{} - 1", (magnitude + 1).trailing_zeros());
+        }
+    }
+    x.to_string()
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Int {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let py = obj.py();
+        let int = match obj.cast::<PyInt>() {
+            Ok(int) => int.to_owned().into_any(),
+            Err(_) => py
+                .import(intern!(py, "operator"))?
+                .call_method1(intern!(py, "index"), (obj,))?,
+        };
+        match int.extract::<i128>() {
+            Ok(value) => Ok(Self { value, big: None }),
+            Err(_) => {
+                let negative = int.lt(0)?;
+                Ok(Self {
+                    value: if negative { i128::MIN } else { i128::MAX },
+                    big: Some(int.str()?.to_string()),
+                })
+            }
+        }
+    }
+}
+
 /// A non-negative count argument.
-pub(crate) fn count(value: i64, name: &str) -> PyResult<usize> {
-    usize::try_from(value)
-        .map_err(|_| PyValueError::new_err(format!("`{name}` must be >= 0, got {value}")))
+pub(crate) fn count(value: &Int, name: &str) -> PyResult<usize> {
+    value.to(name, 0, USIZE_MAX)
 }
 
 /// An array of `shape` from row-major values.
@@ -268,4 +372,91 @@ pub(crate) fn commands_array<'py>(
     let values = commands.iter().take(n);
     let values = values.flat_map(|c| [c.eta_x, c.eta_y, c.thrust, c.omega]);
     shaped(py, values.collect(), &[n.min(commands.len()), 4])
+}
+
+/// A tvmd-sim record (serde) as Python objects: `json.loads` of its JSON (NaN becomes None).
+pub(crate) fn record_to_py<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    record: &T,
+) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(record)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot convert a tvmd-sim record: {e}")))?;
+    py.import(intern!(py, "json"))?
+        .call_method1(intern!(py, "loads"), (text,))
+}
+
+/// The iteration cap argument `name`: default 64 (the core's), else in `[1, 2**32 - 1]`; 0 is
+/// left to the core, whose `ConfigError` names its field.
+pub(crate) fn iteration_cap(value: Option<&Int>, name: &str) -> PyResult<u32> {
+    match value {
+        None => Ok(64),
+        Some(v) if v.get::<u32>() == Some(0) => Ok(0),
+        Some(v) => v.to(name, 1, u32::MAX.into()),
+    }
+}
+
+/// The relaxation `s` from the keyword `relaxation` or its alias `s` (not both), else `default`.
+pub(crate) fn relaxation_arg(
+    relaxation: Option<f64>,
+    s: Option<f64>,
+    default: Option<f64>,
+) -> PyResult<Relaxation<f64>> {
+    let value = match (relaxation, s) {
+        (Some(_), Some(_)) => {
+            return Err(PyTypeError::new_err(
+                "give `relaxation` or its alias `s`, not both",
+            ))
+        }
+        (Some(v), None) | (None, Some(v)) => v,
+        (None, None) => {
+            default.ok_or_else(|| PyTypeError::new_err("missing required argument `relaxation`"))?
+        }
+    };
+    Relaxation::new(value).or_raise()
+}
+
+/// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
+pub(crate) fn null_space_arg(spec: Option<&str>) -> PyResult<Option<NullSpaceConfig>> {
+    let Some(spec) = spec else {
+        return Ok(None);
+    };
+    let config: NullSpaceConfig = spec
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("`null_space`: {e}")))?;
+    config.validate().map_err(value_error)?;
+    Ok(Some(config))
+}
+
+/// A `max_samples` argument (named `name`): `None` keeps every tick, `n >= 0` at most `n`
+/// evenly spaced.
+pub(crate) fn retention_arg(max_samples: Option<&Int>, name: &str) -> PyResult<SampleRetention> {
+    match max_samples {
+        None => Ok(SampleRetention::All),
+        Some(n) => count(n, name).map(SampleRetention::AtMost),
+    }
+}
+
+/// A `jobs` argument: `None` (every core) or a worker count >= 1.
+pub(crate) fn jobs_arg(jobs: Option<&Int>) -> PyResult<Option<usize>> {
+    jobs.map(|j| j.to("jobs", 1, USIZE_MAX)).transpose()
+}
+
+/// The scenario of a `scenario` argument: a `str` by the CLI's name-or-file rule
+/// (`Scenario::load`), an `os.PathLike` a file.
+pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        let s = s.to_cow()?;
+        return Scenario::load(&s).map_err(|e| sim_error(e, "", Some((READ, Path::new(&*s)))));
+    }
+    if obj.hasattr("__fspath__")? {
+        let path: PathBuf = obj.extract().map_err(|e| {
+            PyTypeError::new_err(format!("`{name}` is not a usable file path: {e}"))
+        })?;
+        return Scenario::from_file(&path).map_err(|e| sim_error(e, "", Some((READ, &path))));
+    }
+    let got = obj.get_type().name()?;
+    Err(PyTypeError::new_err(format!(
+        "`{name}` must be a built-in scenario name or a path to a TOML file (str or \
+         os.PathLike), got {got}"
+    )))
 }

@@ -10,7 +10,11 @@ use pyo3::types::PyDict;
 use tvmd_sim::runner;
 use tvmd_sim::sim::SampleRetention;
 
-use crate::sim::{run_items, sweep_run_specs, value_error, PySimResult, RunArgs, SimData};
+use crate::convert::{retention_arg, Int};
+use crate::errors::value_error;
+use crate::runs::RunArgs;
+use crate::runs::{batch_label, run_item, run_items, run_specs, sweep_label, sweep_run_specs};
+use crate::sim_result::{PySimResult, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
 #[pyfunction]
@@ -31,6 +35,30 @@ fn check_runs(runs: &Bound<'_, PyAny>) -> PyResult<usize> {
     Ok(specs.len())
 }
 
+/// Flies item `index` of a `run_many` batch (or, with `sweep`, of a relaxation study's runs) as
+/// one executor task; a failure is named as the threads name it (`runs[index] (name): ...`).
+#[pyfunction]
+#[pyo3(name = "_run_item")]
+#[pyo3(signature = (item, index, *, sweep = false))]
+fn run_one_item(
+    py: Python<'_>,
+    item: &Bound<'_, PyAny>,
+    index: usize,
+    sweep: bool,
+) -> PyResult<PySimResult> {
+    let spec = run_item(item, index)?;
+    let label = |_: usize, spec: &tvmd_sim::runner::RunSpec| {
+        if sweep {
+            sweep_label(spec)
+        } else {
+            batch_label(index, spec)
+        }
+    };
+    run_specs(py, vec![spec], Some(1), label)?
+        .pop()
+        .ok_or_else(|| pyo3::exceptions::PyRuntimeError::new_err("tvmd-sim returned no result"))
+}
+
 /// The runs of a relaxation study as `run_many` items (TOML text, log, target, retention), for
 /// `relaxation_sweep(executor=...)`.
 #[pyfunction]
@@ -46,7 +74,7 @@ fn relaxation_sweep_runs<'py>(
     precision: Option<String>,
     mcap_dir: Option<PathBuf>,
     pil: Option<String>,
-    max_samples: Option<i64>,
+    max_samples: Option<Int>,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let args = RunArgs {
         scenario,
@@ -54,7 +82,7 @@ fn relaxation_sweep_runs<'py>(
         allocator,
         precision,
         pil,
-        max_samples,
+        samples: retention_arg(max_samples.as_ref(), "max_samples")?,
         ..RunArgs::default()
     };
     let specs = sweep_run_specs(relaxations, args, mcap_dir)?;
@@ -81,6 +109,7 @@ fn relaxation_sweep_runs<'py>(
 pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(sim_result_from_state, sim)?)?;
     sim.add_function(wrap_pyfunction!(check_runs, sim)?)?;
+    sim.add_function(wrap_pyfunction!(run_one_item, sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep_runs, sim)?)?;
     Ok(())
 }

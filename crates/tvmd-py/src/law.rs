@@ -278,7 +278,7 @@ record! {
     }
     methods {
         #[new]
-        #[pyo3(signature = (mass, inertia, gravity = tvmd_core::team::presets::GRAVITY))]
+        #[pyo3(signature = (mass, inertia, gravity = 9.81))]
         fn new(mass: f64, inertia: &Bound<'_, PyAny>, gravity: f64) -> PyResult<Self> {
             Self::create(mass, arg(inertia, "inertia")?, gravity)
         }

@@ -1,7 +1,16 @@
 //! Python bindings of [`tvmd_core`] and `tvmd-sim` (PyO3 + rust-numpy): the extension module
-//! `tvmd._tvmd`, one Rust module per core area, each with a `register` function; the simulator
-//! is the submodule `_tvmd.sim`. The bindings only convert types at the boundary and call the
-//! core. The Python API is documented in the stubs `python/tvmd/_tvmd.pyi` and `sim.pyi`.
+//! `tvmd._tvmd`, one Rust module per core area, each with a `register` function called from
+//! here, the one registration point; the simulator is the submodule `_tvmd.sim`. The bindings
+//! only convert types at the boundary ([`convert`], the one conversion layer; [`errors`], the
+//! one error mapping) and call the core. The Python API is documented in the stubs
+//! `python/tvmd/_tvmd.pyi` and `sim.pyi`.
+//!
+//! Modules import one way (no circle; `a <- b` reads "b imports a"): `errors` and `record`
+//! import no module of the crate, `convert` only `errors`, and every other module imports
+//! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
+//! `afs, allocation, law, planner, team <- controller`, and for the simulator
+//! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert` and
+//! `errors`. This file imports every module and no module imports it.
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -26,11 +35,12 @@ mod law;
 mod montecarlo;
 mod planner;
 mod record;
+mod runs;
 mod sim;
+mod sim_result;
 mod team;
 
-/// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
-pub const CAPACITY: usize = 64;
+use convert::CAPACITY;
 
 /// The Python extension module `tvmd._tvmd`.
 #[pymodule]
@@ -48,7 +58,12 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     law::register(m)?;
     allocation::register(m)?;
     controller::register(m)?;
-    sim::register(m)?;
     atlas::register(m)?;
-    Ok(())
+    // The submodule `tvmd._tvmd.sim`.
+    let sim = PyModule::new(py, "tvmd.sim")?;
+    sim::register(&sim)?;
+    sim_result::register(&sim)?;
+    executor::register(&sim)?;
+    montecarlo::register(&sim)?;
+    m.add_submodule(&sim)
 }

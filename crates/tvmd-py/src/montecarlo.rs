@@ -11,17 +11,21 @@ use tvmd_sim::montecarlo::{
 };
 use tvmd_sim::scenario::Scenario;
 
-use crate::sim::{record_to_py, scenario_arg, value_error};
+use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
+use crate::errors::value_error;
 
 /// The study's flights as JSON specs. See the stub.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, runs = 100, seed = 0, teams = None, allocators = None, model_errors = None, distributions = None))]
+#[pyo3(
+    signature = (scenario = None, *, toml = None, runs = Int::of(100), seed = Int::of(0), teams = None, allocators = None, model_errors = None, distributions = None),
+    text_signature = "(scenario=None, *, toml=None, runs=100, seed=0, teams=None, allocators=None, model_errors=None, distributions=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn monte_carlo_specs(
     scenario: Option<&Bound<'_, PyAny>>,
     toml: Option<String>,
-    runs: i64,
-    seed: u64,
+    runs: Int,
+    seed: Int,
     teams: Option<Vec<String>>,
     allocators: Option<Vec<String>>,
     model_errors: Option<Vec<f64>>,
@@ -37,8 +41,8 @@ fn monte_carlo_specs(
         (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
         (None, None) => Scenario::builtin("paper-tilt").map_err(value_error)?,
     };
-    let runs = usize::try_from(runs)
-        .map_err(|_| PyValueError::new_err(format!("`runs` must be >= 1, got {runs}")))?;
+    let runs = runs.to("runs", 1, USIZE_MAX)?;
+    let seed = seed.to("seed", 0, u64::MAX.into())?;
     let distributions = match distributions.filter(|d| !d.is_none()) {
         None => Distributions::default(),
         Some(d) => {
@@ -78,14 +82,8 @@ fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
 /// Flies the JSON specs on threads (GIL released), rows as JSON in input order. See the stub.
 #[pyfunction]
 #[pyo3(signature = (specs, *, jobs = None))]
-fn monte_carlo_fly(
-    py: Python<'_>,
-    specs: Vec<String>,
-    jobs: Option<usize>,
-) -> PyResult<Vec<String>> {
-    if jobs == Some(0) {
-        return Err(PyValueError::new_err("`jobs` must be >= 1 or None"));
-    }
+fn monte_carlo_fly(py: Python<'_>, specs: Vec<String>, jobs: Option<Int>) -> PyResult<Vec<String>> {
+    let jobs = jobs_arg(jobs.as_ref())?;
     let specs = specs
         .iter()
         .map(|s| FlightSpec::from_json(s))

@@ -1,43 +1,13 @@
 //! `tvmd.AttitudePlanner` (eqs. 9-11) and its `PlannerResult`.
 
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use tvmd_core::{AttitudePlanner, PlannerOutput, Relaxation};
 
 use crate::afs::PyAfs;
-use crate::convert::{class_arg, finite, matrix};
+use crate::convert::{class_arg, finite, iteration_cap, matrix, relaxation_arg, Int};
 use crate::errors::OrRaise;
 use crate::record::record;
-
-/// The iteration cap argument: default 64 (the core's), else in `0..=u32::MAX` (the core
-/// rejects 0).
-pub(crate) fn iteration_cap(value: Option<i64>) -> PyResult<u32> {
-    let Some(v) = value else { return Ok(64) };
-    u32::try_from(v).map_err(|_| {
-        PyValueError::new_err(format!("`max_iterations` must be in [1, 2**32), got {v}"))
-    })
-}
-
-/// The relaxation `s` from the keyword `relaxation` or its alias `s` (not both), else `default`.
-pub(crate) fn relaxation_arg(
-    relaxation: Option<f64>,
-    s: Option<f64>,
-    default: Option<f64>,
-) -> PyResult<Relaxation<f64>> {
-    let value = match (relaxation, s) {
-        (Some(_), Some(_)) => {
-            return Err(PyTypeError::new_err(
-                "give `relaxation` or its alias `s`, not both",
-            ))
-        }
-        (Some(v), None) | (None, Some(v)) => v,
-        (None, None) => {
-            default.ok_or_else(|| PyTypeError::new_err("missing required argument `relaxation`"))?
-        }
-    };
-    Relaxation::new(value).or_raise()
-}
 
 /// A planner with the core's default tolerance unless `tolerance` is given.
 pub(crate) fn planner(
@@ -64,11 +34,11 @@ impl PyAttitudePlanner {
     fn new(
         relaxation: Option<f64>,
         tolerance: Option<f64>,
-        max_iterations: Option<i64>,
+        max_iterations: Option<Int>,
         s: Option<f64>,
     ) -> PyResult<Self> {
         let relaxation = relaxation_arg(relaxation, s, None)?;
-        let max_iterations = iteration_cap(max_iterations)?;
+        let max_iterations = iteration_cap(max_iterations.as_ref(), "max_iterations")?;
         let inner = planner(relaxation, tolerance, max_iterations)?;
         Ok(Self {
             inner,

@@ -6,16 +6,15 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use tvmd_core::team::presets;
-use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, Navigator, TeamConfig};
+use tvmd_core::TeamConfig;
+use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, HoverCapability, Navigator};
 
 use crate::afs::PyAfs;
-use crate::controller::PyHoverCapability;
 use crate::convert::{array, check_finite, count, indices, int_array, matrix, opt_arg};
-use crate::convert::{shape_error, shape_str, shaped, table};
+use crate::convert::{shape_error, shape_str, shaped, table, Int, CAPACITY};
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
 use crate::record::record;
-use crate::CAPACITY;
 
 /// Agent specs from the array arguments.
 fn agent_specs(
@@ -97,8 +96,8 @@ pub(crate) fn failure_mask(
 ) -> PyResult<FailureMask<CAPACITY>> {
     let mut mask = FailureMask::none();
     for index in indices(failed, "failed")? {
-        let agent = usize::try_from(index)
-            .ok()
+        let agent = index
+            .get::<usize>()
             .filter(|i| *i < team.len())
             .ok_or_else(|| {
                 ConfigError::new_err(format!(
@@ -249,10 +248,15 @@ record! {
     }
 
     /// `n` agents of 0.7 kg on a circle of `radius` (m).
+    // Python shows a default only if it is a literal: the core's values (the paper's agents)
+    // are the defaults, their digits the text signature (the tests compare the two).
     #[staticmethod]
-    #[pyo3(signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY))]
+    #[pyo3(
+        signature = (n, radius, inconsistent, sigma_x = std::f64::consts::FRAC_PI_6, sigma_y = std::f64::consts::FRAC_PI_4, max_thrust = 2.0 * presets::PAPER_AGENT_MASS * presets::GRAVITY),
+        text_signature = "(n, radius, inconsistent, sigma_x=0.5235987755982989, sigma_y=0.7853981633974483, max_thrust=13.734)"
+    )]
     fn ring(
-        n: i64,
+        n: Int,
         radius: f64,
         inconsistent: bool,
         sigma_x: f64,
@@ -260,7 +264,7 @@ record! {
         max_thrust: f64,
     ) -> PyResult<Self> {
         let limits = AgentLimits::new(sigma_x, sigma_y, max_thrust).or_raise()?;
-        Self::wrap(presets::ring(count(n, "n")?, radius, inconsistent, limits))
+        Self::wrap(presets::ring(count(&n, "n")?, radius, inconsistent, limits))
     }
 
     /// `M(Xi)` (6, 3n) of eq. (4); columns of failed agents are zero.
@@ -300,13 +304,13 @@ record! {
     }
 
     /// The rigid-body parameters of the control law.
-    #[pyo3(signature = (gravity = presets::GRAVITY))]
+    #[pyo3(signature = (gravity = 9.81))]
     fn plant(&self, gravity: f64) -> PyResult<PyPlant> {
         PyPlant::create(self.inner.mass(), self.inner.inertia(), gravity)
     }
 
     /// Whether the working agents can hold hover with a margin. See the stub.
-    #[pyo3(signature = (failed = None, gravity = presets::GRAVITY))]
+    #[pyo3(signature = (failed = None, gravity = 9.81))]
     fn hover_capability(
         &self,
         failed: Option<&Bound<'_, PyAny>>,
@@ -332,7 +336,24 @@ pub(crate) fn padded_forces(
     Ok(forces)
 }
 
-/// Registers `Team`.
+record! {
+    /// Whether the working agents can hold hover with a margin. See the stub.
+    "HoverCapability" in "tvmd" => PyHoverCapability(HoverCapability<f64>) |py, o| {
+        /// The hover wrench is strictly inside the working agents' attainable set.
+        capable => o.capable,
+        /// Smallest normalized slack of any working agent in the certifying allocation.
+        margin => o.margin,
+        /// The agent whose slack is `margin`, or None.
+        limiting_agent => o.limiting_agent,
+        /// The bound it is closest to: "max_thrust", "min_thrust", "gimbal_x" or "gimbal_y".
+        limit => o.limit.as_str(),
+        /// `m_C g` (N).
+        weight => o.weight,
+    }
+}
+
+/// Registers `Team` and its `HoverCapability`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PyTeam>()
+    m.add_class::<PyTeam>()?;
+    m.add_class::<PyHoverCapability>()
 }

@@ -53,7 +53,7 @@ def test_afs_atlas_rejects_bad_arguments():
         tvmd.afs_atlas("a4-inc", failed=[-1])
     with pytest.raises(ValueError, match="directions"):
         tvmd.afs_atlas("a4-inc", directions=-3)
-    with pytest.raises(ValueError, match="range"):
+    with pytest.raises(ValueError, match="`certify_heights` must be >= 2 and <= 200"):
         tvmd.afs_atlas("a4-inc", certify_heights=1)
     with pytest.raises(ValueError, match="heights"):
         tvmd.afs_atlas("a4-inc", heights=[math.inf])

@@ -7,7 +7,9 @@ built module by ``mypy.stubtest`` (``tests/test_stubs.py``).
 Conventions: ``f64`` throughout, at most ``CAPACITY`` = 64 agents. Array inputs may be NumPy
 arrays of any real dtype, nested lists or Python numbers (integers are converted; booleans,
 complex numbers, strings and objects raise ``TypeError``). Wrong shapes raise ``ValueError``
-naming the argument and the expected shape; NaN/inf inputs raise ``ValueError``; the core's
+naming the argument and the expected shape; NaN/inf inputs raise ``ValueError``; an integer
+argument (any ``int`` or NumPy integer) outside its valid range raises ``ValueError`` naming the
+argument and the range (never ``OverflowError``); the core's
 configuration and input errors become ``ConfigError`` / ``InputError`` (both ``ValueError``s)
 with the core's message. No code path panics.
 """
@@ -169,9 +171,9 @@ class Team:
         n: int,
         radius: float,
         inconsistent: bool,
-        sigma_x: float = ...,
-        sigma_y: float = ...,
-        max_thrust: float = ...,
+        sigma_x: float = 0.5235987755982989,
+        sigma_y: float = 0.7853981633974483,
+        max_thrust: float = 13.734,
     ) -> "Team":
         """``n`` agents of the paper's mass (0.7 kg) on a circle of ``radius`` (m) in the x-y plane,
         agent ``i`` at phase ``2 pi i / n``; every second agent turned a quarter turn when
@@ -246,9 +248,9 @@ class Team:
         Raises:
             ConfigError: every agent failed, or a failure index the team does not have.
         """
-    def plant(self, gravity: float = ...) -> "Plant":
+    def plant(self, gravity: float = 9.81) -> "Plant":
         """The rigid-body parameters of the control law."""
-    def hover_capability(self, failed: _Failed = None, gravity: float = ...) -> "HoverCapability":
+    def hover_capability(self, failed: _Failed = None, gravity: float = 9.81) -> "HoverCapability":
         """Whether the working agents can hold hover at ``gravity`` with a margin (see
         ``HoverCapability``). A mask that leaves ``M`` rank-deficient is classified not capable.
 
@@ -651,7 +653,7 @@ class Plant:
 
     FIELDS: ClassVar[Tuple[str, ...]]
 
-    def __new__(cls, mass: float, inertia: ArrayLike, gravity: float = ...) -> "Plant": ...
+    def __new__(cls, mass: float, inertia: ArrayLike, gravity: float = 9.81) -> "Plant": ...
     @property
     def mass(self) -> float:
         """``m_C`` (kg)."""
@@ -933,7 +935,7 @@ class Controller:
         team: Team,
         gains: Optional[Gains] = None,
         relaxation: Optional[float] = None,
-        gravity: float = ...,
+        gravity: float = 9.81,
         period: float = 0.01,
         allocator: AllocatorName = "exact-boundary-redistribution",
         rate_limits: Optional[ArrayLike] = None,

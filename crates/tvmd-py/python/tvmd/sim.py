@@ -73,15 +73,21 @@ scenario_toml = _sim.scenario_toml
 _sim_result_from_state = _sim._sim_result_from_state
 
 
-def _run_one(item):
-    # Module-level, so executors pickle it by reference (``tvmd.sim._run_one``).
-    return _sim.run_many([item], jobs=1)[0]
+def _run_one(item, index):
+    # Module-level, so executors pickle it by reference (``tvmd.sim._run_one``). A failure
+    # names ``runs[index]``, as the threads do.
+    return _sim._run_item(item, index)
 
 
-def _on_executor(items, jobs, executor):
+def _run_swept(item, index):
+    # As ``_run_one`` for a relaxation study's run: a failure names its ``s``, as the threads do.
+    return _sim._run_item(item, index, sweep=True)
+
+
+def _on_executor(items, jobs, executor, fly):
     if jobs is not None:
         raise ValueError("give `jobs` (threads here) or `executor`, not both")
-    return list(executor.map(_run_one, items))
+    return list(executor.map(fly, items, range(len(items))))
 
 
 def run_many(runs, *, jobs=None, executor=None):
@@ -90,7 +96,7 @@ def run_many(runs, *, jobs=None, executor=None):
         return _sim.run_many(runs, jobs=jobs)
     items = runs if isinstance(runs, (str, dict)) else list(runs)
     _sim._check_runs(items)
-    return _on_executor(items, jobs, executor)
+    return _on_executor(items, jobs, executor, _run_one)
 
 
 def relaxation_sweep(
@@ -118,7 +124,7 @@ def relaxation_sweep(
     if executor is None:
         return _sim.relaxation_sweep(relaxations, scenario, jobs=jobs, **kw)
     items = _sim._relaxation_sweep_runs(relaxations, scenario, **kw)
-    return _on_executor(items, jobs, executor)
+    return _on_executor(items, jobs, executor, _run_swept)
 
 __all__ = [
     "SimResult",

@@ -7,7 +7,8 @@ Scenarios are loaded (the CLI's name-or-file rule), overridden and run by ``tvmd
 one worker pool; runs release the GIL and come back in input order.
 
 Errors: a scenario, TOML text or override that cannot be used raises ``ValueError`` (the message
-is tvmd-sim's, naming the field), wrong argument types ``TypeError``, I/O errors ``OSError`` (its
+is tvmd-sim's, naming the field), as does an integer argument outside its valid range (the
+message names the argument and the range), wrong argument types ``TypeError``, I/O errors ``OSError`` (its
 errno subclass, e.g. ``FileNotFoundError``, with the file name), a run that fails while flying
 (divergence, controller error) ``RuntimeError``. A panic inside tvmd-sim is raised as
 ``RuntimeError`` too, never as ``PanicException``.

@@ -1,0 +1,255 @@
+//! The batch machinery `tvmd.sim`'s functions share: a run's keyword arguments as a checked
+//! `RunSpec` ([`RunArgs`]), the items of a `run_many` batch, the runs of a relaxation study, and
+//! the batch flown on tvmd-sim's pool with the GIL released ([`run_specs`]). Both `sim` (the
+//! threads) and `executor` (one run per task) build on it.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+
+use tvmd_sim::control::pil::PilTarget;
+use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
+use tvmd_sim::scenario::{Overrides, Precision, Scenario};
+use tvmd_sim::sim::SampleRetention;
+
+use crate::convert::Int;
+use crate::convert::{null_space_arg, retention_arg, scalars, scenario_arg, shape_error};
+use crate::errors::{sim_error, value_error, WRITE};
+use crate::sim_result::{PySimResult, SimData};
+
+/// The default scenario of `run` and `relaxation_sweep`.
+const DEFAULT_SCENARIO: &str = "paper-tilt";
+
+/// The keys a `run_many` dict may hold (the keyword arguments of `run`).
+const RUN_KEYS: &[&str] = &[
+    "scenario",
+    "team",
+    "toml",
+    "mcap",
+    "relaxation",
+    "allocator",
+    "precision",
+    "pil",
+    "null_space",
+    "max_samples",
+];
+
+/// The arguments of one run, as `run` takes them.
+#[derive(Default)]
+pub(crate) struct RunArgs<'a, 'py> {
+    pub(crate) scenario: Option<&'a Bound<'py, PyAny>>,
+    pub(crate) toml: Option<String>,
+    pub(crate) mcap: Option<PathBuf>,
+    pub(crate) relaxation: Option<f64>,
+    pub(crate) allocator: Option<String>,
+    pub(crate) null_space: Option<String>,
+    pub(crate) precision: Option<String>,
+    pub(crate) pil: Option<String>,
+    /// The converted `max_samples` ([`retention_arg`]).
+    pub(crate) samples: SampleRetention,
+    pub(crate) team: Option<String>,
+}
+
+impl RunArgs<'_, '_> {
+    /// Loads the scenario, applies the overrides and validates the result.
+    pub(crate) fn spec(self, scenario_name: &str) -> PyResult<RunSpec> {
+        let mut scenario = match (self.scenario.filter(|s| !s.is_none()), self.toml) {
+            (Some(_), Some(_)) => {
+                return Err(PyValueError::new_err(
+                    "give either `scenario` (a name or a file) or `toml` (TOML text), not both",
+                ))
+            }
+            (Some(s), None) => scenario_arg(s, scenario_name)?,
+            (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
+            (None, None) => Scenario::builtin(DEFAULT_SCENARIO).map_err(value_error)?,
+        };
+        let precision = self.precision.as_deref().map(str::parse::<Precision>);
+        let precision = precision.transpose().map_err(value_error)?;
+        let pil = self.pil.as_deref().map(str::parse::<PilTarget>);
+        let pil = pil
+            .transpose()
+            .map_err(|e| PyValueError::new_err(format!("`pil`: {e}")))?;
+        let overrides = Overrides {
+            relaxation: self.relaxation,
+            allocator: self.allocator,
+            precision,
+            null_space: null_space_arg(self.null_space.as_deref())?,
+            team: self.team,
+        };
+        overrides.apply(&mut scenario).map_err(value_error)?;
+        let spec = RunSpec::on_target(scenario, self.mcap, pil, precision);
+        let mut spec = spec.map_err(value_error)?;
+        spec.samples = self.samples;
+        Ok(spec)
+    }
+}
+
+/// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments; `k` its
+/// index, which errors name.
+pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
+    let name = format!("runs[{k}]");
+    let Ok(dict) = item.cast::<PyDict>() else {
+        if item.is_instance_of::<PyString>() || item.hasattr("__fspath__")? {
+            let scenario = Some(item);
+            return RunArgs {
+                scenario,
+                ..RunArgs::default()
+            }
+            .spec(&name);
+        }
+        let got = item.get_type().name()?;
+        return Err(PyTypeError::new_err(format!(
+            "`{name}` must be a scenario name, a path to a TOML file or a dict of `run` keyword \
+             arguments ({}), got {got}",
+            RUN_KEYS.join(", ")
+        )));
+    };
+    for key in dict.keys() {
+        let key_str: String = key.extract().map_err(|_| {
+            PyTypeError::new_err(format!("`{name}` keys must be strings, got {key}"))
+        })?;
+        if !RUN_KEYS.contains(&key_str.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "`{name}` has the unknown key '{key_str}' (known: {})",
+                RUN_KEYS.join(", ")
+            )));
+        }
+    }
+    fn opt<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+        dict: &Bound<'py, PyDict>,
+        name: &str,
+        key: &str,
+    ) -> PyResult<Option<T>> {
+        match dict.get_item(key)? {
+            Some(v) if !v.is_none() => v.extract::<T>().map(Some).map_err(|e| {
+                let e: PyErr = e.into();
+                PyTypeError::new_err(format!("`{name}['{key}']`: {}", e.value(dict.py())))
+            }),
+            _ => Ok(None),
+        }
+    }
+    let scenario = dict.get_item("scenario")?;
+    let max_samples = opt::<Int>(dict, &name, "max_samples")?;
+    let samples = retention_arg(max_samples.as_ref(), &format!("{name}['max_samples']"))?;
+    RunArgs {
+        scenario: scenario.as_ref(),
+        toml: opt(dict, &name, "toml")?,
+        mcap: opt(dict, &name, "mcap")?,
+        relaxation: opt(dict, &name, "relaxation")?,
+        allocator: opt(dict, &name, "allocator")?,
+        null_space: opt(dict, &name, "null_space")?,
+        precision: opt(dict, &name, "precision")?,
+        pil: opt(dict, &name, "pil")?,
+        samples,
+        team: opt(dict, &name, "team")?,
+    }
+    .spec(&format!("{name}['scenario']"))
+}
+
+/// The runs of a `run_many` batch, each loaded and validated ([`run_item`]).
+pub(crate) fn run_items(runs: &Bound<'_, PyAny>) -> PyResult<Vec<RunSpec>> {
+    if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
+        return Err(PyTypeError::new_err(
+            "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
+        ));
+    }
+    runs.try_iter()
+        .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?
+        .enumerate()
+        .map(|(k, item)| run_item(&item?, k))
+        .collect()
+}
+
+/// The runs of a relaxation study as `relaxation_sweep` takes them: `args`' scenario once per
+/// relaxation (default 0.25, 0.5, 0.75, 1), each with `args`' target and sample retention.
+pub(crate) fn sweep_run_specs(
+    relaxations: Option<&Bound<'_, PyAny>>,
+    args: RunArgs<'_, '_>,
+    mcap_dir: Option<PathBuf>,
+) -> PyResult<Vec<RunSpec>> {
+    let values = match relaxations.filter(|r| !r.is_none()) {
+        Some(r) => match scalars(r, "relaxations")? {
+            (values, shape) if shape.len() == 1 => values,
+            (_, shape) => return Err(shape_error("relaxations", "(k,)", &shape)),
+        },
+        None => vec![0.25, 0.5, 0.75, 1.0],
+    };
+    let base = args.spec("scenario")?;
+    let mut specs =
+        sweep_specs(&base.scenario, &values, mcap_dir.as_deref()).map_err(value_error)?;
+    for spec in &mut specs {
+        spec.pil = base.pil;
+        spec.samples = base.samples;
+    }
+    Ok(specs)
+}
+
+/// The error prefix of run `k` of a `run_many` batch.
+pub(crate) fn batch_label(k: usize, spec: &RunSpec) -> String {
+    format!("runs[{k}] ({}): ", spec.scenario.name)
+}
+
+/// The error prefix of a run of a relaxation study.
+pub(crate) fn sweep_label(spec: &RunSpec) -> String {
+    format!(
+        "s = {} ({}): ",
+        spec.scenario.relaxation, spec.scenario.name
+    )
+}
+
+/// Runs the specs on tvmd-sim's worker pool with the GIL released; the first failure in input
+/// order is raised, its message prefixed with `label(k)`.
+pub(crate) fn run_specs(
+    py: Python<'_>,
+    specs: Vec<RunSpec>,
+    jobs: Option<usize>,
+    label: impl Fn(usize, &RunSpec) -> String,
+) -> PyResult<Vec<PySimResult>> {
+    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    let outcomes = run_interruptibly(py, specs, jobs)?;
+    let results = outcomes.into_iter().enumerate();
+    results
+        .map(|(k, RunOutcome { spec, result })| match result {
+            Ok(result) => Ok(PySimResult {
+                inner: SimData::new(spec, result),
+            }),
+            Err(e) => {
+                let log = spec.log.as_deref().map(|l| (WRITE, l));
+                Err(sim_error(e, &label(k, &spec), log))
+            }
+        })
+        .collect()
+}
+
+/// How often a waiting batch looks for Python signals (Ctrl-C).
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// Runs the batch on tvmd-sim's pool while this thread, GIL released, checks for Python signals
+/// every [`SIGNAL_POLL`]: on `KeyboardInterrupt` (or any signal handler's exception) the
+/// flights stop at their next controller tick (logs finalised), and the exception is raised.
+fn run_interruptibly(
+    py: Python<'_>,
+    specs: Vec<RunSpec>,
+    jobs: Option<usize>,
+) -> PyResult<Vec<RunOutcome>> {
+    let cancel = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let batch = scope.spawn(|| runner::run_many_until(specs, jobs, None, Some(&cancel)));
+        while !batch.is_finished() {
+            py.detach(|| std::thread::sleep(SIGNAL_POLL));
+            if let Err(signal) = py.check_signals() {
+                cancel.store(true, Ordering::Relaxed);
+                // The flights stop within one controller tick; join them so that their logs
+                // are complete when the exception reaches the caller.
+                let _ = py.detach(|| batch.join());
+                return Err(signal);
+            }
+        }
+        batch
+            .join()
+            .map_err(|_| PyRuntimeError::new_err("tvmd-sim: the batch thread panicked"))
+    })
+}
