@@ -38,8 +38,8 @@ impl Saturation {
         wrench_norm: T,
     ) -> Self {
         let tolerance = T::default_epsilon().sqrt() * wrench_norm.max(T::one());
-        // A NaN error counts as short (`!(x <= tol)`).
-        let short = !(wrench_error <= tolerance);
+        // A NaN error counts as short.
+        let short = wrench_error > tolerance || !wrench_error.is_finite();
         Self {
             force: t_tf < T::one() || t_eta < T::one() || unreachable || short,
             torque: short,
