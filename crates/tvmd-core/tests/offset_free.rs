@@ -290,3 +290,49 @@ fn the_authors_scaled_gains_are_faster_than_the_paper_reading() {
     println!("horizontal error at 4 s: paper reading {paper:.3} m, team-scaled {scaled:.3} m");
     assert!(scaled < 0.5 * paper, "{paper} {scaled}");
 }
+
+#[test]
+fn the_planned_rates_reduce_the_attitude_lag_behind_a_moving_planned_attitude() {
+    // Stage B of paper-tilt from hover: the reference roll peaks at pi/3, beyond what the
+    // team can hold, so the planner's R_d moves (and saturates). The attitude error against
+    // R_d over 4-10 s, with the reference's Omega_d = 0 and with the planned rates.
+    let lag = |attitude_rate| {
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let settings = ControllerSettings {
+            attitude_rate,
+            ..ControllerSettings::paper()
+        };
+        let mut c = Controller::new(team, settings, RedistributedPseudoInverse).unwrap();
+        let truth = Truth {
+            mass: c.team().mass(),
+            inertia: c.team().inertia(),
+            gravity: 9.81,
+            force: Vector3::zeros(),
+            torque: Vector3::zeros(),
+        };
+        let mut body = Body::at(hover());
+        let mut worst = 0.0f64;
+        for k in 0..1000 {
+            let t = 1.0 + f64::from(k) * 0.01;
+            let phi = if (4.0..=10.0).contains(&t) {
+                std::f64::consts::PI / 6.0 * (1.0 + ((t - 7.0) * std::f64::consts::PI / 3.0).cos())
+            } else {
+                0.0
+            };
+            let mut r = Reference::hover(hover());
+            r.attitude = tvmd_core::rotation::roll(phi);
+            let out = c.step(&body.state(), &r).unwrap();
+            if t >= 4.5 {
+                worst = worst.max(out.law.e_r.norm());
+            }
+            for _ in 0..10 {
+                body = flight::rk4(&body, &truth, &out.allocation.wrench, 0.001);
+            }
+        }
+        worst
+    };
+    let without = lag(None);
+    let with = lag(Some(tvmd_core::AttitudeRateFilter::new(20.0, 5.0).unwrap()));
+    println!("largest |e_R| against R_d over 4.5-11 s: reference rates {without:.2e}, planned rates {with:.2e}");
+    assert!(with < 0.7 * without, "{without} {with}");
+}
