@@ -6,68 +6,28 @@ use nalgebra::Vector3;
 /// The roll `R_x(phi)`, at its old path (now in [`crate::rotation`]).
 pub use crate::rotation::roll;
 
-use crate::admissible::{admissible_sets, AdmissibleSet, RateLimits};
+mod guard;
+mod settings;
+
+pub use settings::ControllerSettings;
+
+use crate::admissible::{admissible_sets, AdmissibleSet};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::allocation::{
-    Allocation, AllocationRequest, Allocator, NullSpaceReport, NullSpaceStage,
-};
+use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceReport};
+use crate::anti_windup::Saturation;
+use crate::attitude_rate::{AttitudeRateState, PlannedRates};
 use crate::command::{invert, AgentCommand};
 use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, ConfigField, InputError};
+use crate::error::{ConfigError, InputError};
 use crate::hover::{hover_capability, HoverCapability};
 use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
-use crate::planner::{AttitudePlanner, PlannerOutput};
+use crate::linalg::norm;
+use crate::offset_free::{Compensation, CycleRecord, OffsetFreeState};
+use crate::planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 use crate::projection::{project_force_in, ForceProjection};
-use crate::real::{count, lit, to_f64, Real};
+use crate::real::Real;
 use crate::team::{FailureMask, TeamConfig};
-
-/// Settings of a [`Controller`] besides the team and the allocator.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ControllerSettings<T: Real> {
-    /// Gains of eq. (12).
-    pub gains: Gains<T>,
-    /// AFS relaxation `s` of the planner.
-    pub relaxation: Relaxation<T>,
-    /// `g` (m/s^2).
-    pub gravity: T,
-    /// Control period `dt` (s), used by the rate limits.
-    pub period: T,
-    /// Optional gimbal rate limits (the rate-constrained allocation).
-    pub rate_limits: Option<RateLimits<T>>,
-    /// Optional null-space stage run after the allocator ([`NullSpaceStage`]; `None`: the
-    /// allocator's forces are used as they are, and [`ControlOutput::null_space`] is
-    /// [`NullSpaceReport::off`]).
-    pub null_space: Option<NullSpaceStage<T>>,
-}
-
-impl<T: Real> ControllerSettings<T> {
-    /// The paper's settings: its gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s, no rate limits,
-    /// no null-space stage.
-    pub fn paper() -> Self {
-        Self {
-            gains: Gains::paper(),
-            relaxation: Relaxation::new(lit(0.5)).unwrap_or(Relaxation::none()),
-            gravity: lit(crate::team::presets::GRAVITY),
-            period: lit(0.01),
-            rate_limits: None,
-            null_space: None,
-        }
-    }
-
-    /// Gains, relaxation and rate limits are valid by construction (private fields); only the
-    /// two plain numbers are checked here.
-    fn validate(&self) -> Result<(), ConfigError> {
-        for (value, field) in [
-            (self.gravity, ConfigField::Gravity),
-            (self.period, ConfigField::Period),
-        ] {
-            if !value.is_finite() || value <= T::zero() {
-                return Err(ConfigError::Parameter { field });
-            }
-        }
-        Ok(())
-    }
-}
+use guard::{check_range, first_non_finite, input_limit};
 
 /// Every quantity of one control period.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,11 +76,18 @@ impl<T: Real, const N: usize> core::fmt::Display for CycleError<T, N> {
 impl<T: Real, const N: usize> std::error::Error for CycleError<T, N> {}
 
 /// The full-pose controller of a team: configuration, gains, planner relaxation, allocator,
-/// failure mask and the previous command. One [`Controller::step`] per control period.
+/// failure mask, the previous command and, when configured, the offset-free state and the
+/// planned-rate filter. One [`Controller::step`] per control period.
 #[derive(Clone, Debug)]
 pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     team: TeamConfig<T, N>,
     settings: ControllerSettings<T>,
+    /// The law's gains: `settings.gains` resolved by `settings.gain_schedule` for the team.
+    gains: Gains<T>,
+    /// The offset-free state (inert when `settings.offset_free` is `None`).
+    offset_free: OffsetFreeState<T>,
+    /// The planned-rate filter (`None` when `settings.attitude_rate` is).
+    attitude_rate: Option<AttitudeRateState<T>>,
     plant: Plant<T>,
     planner: AttitudePlanner<T>,
     allocator: A,
@@ -148,16 +115,32 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         settings.validate()?;
         // Also rejects a gravity whose weight m_C g overflows.
         let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
+        let gains =
+            settings
+                .gain_schedule
+                .resolve(&settings.gains, team.mass(), &team.inertia())?;
         let failures = FailureMask::none();
         let afs = team.afs(&failures)?;
         let effectiveness = team.effectiveness(&failures);
         let mut allocator = allocator;
         allocator.configure(&effectiveness);
-        let input_limit = input_limit(&team, &settings);
+        let input_limit = input_limit(&team, &gains, settings.gravity);
+        let offset_free = OffsetFreeState::new(
+            settings.offset_free.as_ref(),
+            settings.period,
+            afs.max_force(),
+        );
+        let attitude_rate = match settings.attitude_rate {
+            Some(filter) => Some(AttitudeRateState::new(filter, settings.period)?),
+            None => None,
+        };
         let admissible = AdmissibleSet::from_limits(team.limits());
         let hover = hover_capability(&effectiveness, &admissible, plant.weight());
         Ok(Self {
             input_limit,
+            gains,
+            offset_free,
+            attitude_rate,
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
             afs,
@@ -205,6 +188,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.allocator.configure(&self.effectiveness);
         self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
         self.failures = failures;
+        self.offset_free.set_force_bound(self.afs.max_force());
         Ok(self.hover)
     }
 
@@ -221,11 +205,50 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.planner = planner;
     }
 
-    /// Forgets the previous command (rate limits restart from a centred gimbal) and whatever the
-    /// allocator kept from earlier periods ([`Allocator::reset`]).
+    /// Forgets the previous command (rate limits restart from a centred gimbal), whatever the
+    /// allocator kept from earlier periods ([`Allocator::reset`]), the offset-free state (zero
+    /// estimate or integral) and the planned-rate filter (at rest). The landed flag
+    /// ([`Self::set_landed`]) is the caller's input and is kept.
     pub fn reset(&mut self) {
         self.previous = [AgentCommand::idle(); N];
         self.allocator.reset();
+        self.offset_free.reset();
+        if let Some(rates) = &mut self.attitude_rate {
+            rates.reset();
+        }
+    }
+
+    /// Tells the controller whether the team stands on the ground (the caller's contact or
+    /// landing detector). While landed the offset-free state is cleared and held at zero: the
+    /// ground's reaction is not a disturbance to compensate, and nothing integrates against
+    /// it; after take-off (`false`) it starts again from zero. No effect on anything else, and
+    /// none without [`ControllerSettings::offset_free`].
+    pub fn set_landed(&mut self, landed: bool) {
+        self.offset_free.set_landed(landed);
+    }
+
+    /// Whether the landed hold is on ([`Self::set_landed`]).
+    pub fn landed(&self) -> bool {
+        self.offset_free.landed()
+    }
+
+    /// The wrench the offset-free state adds to the next period's request (before it measures
+    /// that period): force in `{I}`, torque in `{C}`; zero when off or landed. The observer's
+    /// estimate of the disturbance is its negative.
+    pub fn offset_free_compensation(&self) -> Compensation<T> {
+        self.offset_free.compensation()
+    }
+
+    /// The planned attitude's rates of the last period (`None` without
+    /// [`ControllerSettings::attitude_rate`]).
+    pub fn planned_rates(&self) -> Option<PlannedRates<T>> {
+        self.attitude_rate.as_ref().map(AttitudeRateState::rates)
+    }
+
+    /// The law's gains: [`ControllerSettings::gains`] resolved for the team by
+    /// [`ControllerSettings::gain_schedule`].
+    pub fn gains(&self) -> &Gains<T> {
+        &self.gains
     }
 
     /// The team.
@@ -332,9 +355,19 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         };
         state.validate().map_err(reject)?;
         reference.validate().map_err(reject)?;
-        self.check_range(state, reference).map_err(reject)?;
-        let gains = &self.settings.gains;
-        let u_fr = force_request(&self.plant, gains, state, reference);
+        check_range(self.input_limit, state, reference).map_err(reject)?;
+        let gains = &self.gains;
+        let mut u_fr = force_request(&self.plant, gains, state, reference);
+        // Offset-free: the compensation joins the request before the projection and the
+        // planner (skipped entirely when off, so the paper's cycle is bit for bit unchanged).
+        let compensation = if self.offset_free.is_on() {
+            self.offset_free.begin(&self.plant, state);
+            let c = self.offset_free.compensation();
+            u_fr += state.attitude.transpose() * c.force;
+            Some(c)
+        } else {
+            None
+        };
         let projection = project_force_in(&self.full_cone, &u_fr);
         let f_r = state.attitude * u_fr * projection.t_tf;
         // `reference.attitude` passed `reference.validate()` above.
@@ -342,15 +375,32 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             .planner
             .plan_in_valid_attitude(&self.planner_cone, &reference.attitude, &f_r)
             .map_err(reject)?;
-        let law = control_wrench(
+        // The planned attitude's rates replace the reference's when the filter is on.
+        let planned = self.attitude_rate.as_mut().map(|f| f.update(&planner.r_d));
+        let rated;
+        let law_reference = match planned {
+            Some(rates) => {
+                rated = Reference {
+                    angular_velocity: rates.omega_d,
+                    angular_acceleration: rates.omega_d_dot,
+                    ..*reference
+                };
+                &rated
+            }
+            None => reference,
+        };
+        let mut law = control_wrench(
             &self.plant,
             gains,
             state,
-            reference,
+            law_reference,
             &planner.r_d,
             &u_fr,
             &projection.gain(),
         );
+        if let Some(c) = &compensation {
+            add_torque(&mut law, &c.torque);
+        }
         let sets = self.admissible_sets();
         let request = AllocationRequest {
             effectiveness: &self.effectiveness,
@@ -396,107 +446,33 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             return Err(reject(InputError::Overflow { field }));
         }
         self.previous = commands;
+        if compensation.is_some() {
+            let saturation = Saturation::from_cycle(
+                output.projection.t_tf,
+                output.projection.t_eta,
+                output.planner.status == PlannerStatus::Unreachable,
+                output.allocation.wrench_error,
+                norm(&output.law.u_d),
+            );
+            let record = CycleRecord {
+                e_x: output.law.e_x,
+                e_r: output.law.e_r,
+                wrench: output.allocation.wrench,
+                saturation,
+            };
+            self.offset_free.end(&self.plant, state, &record);
+        }
         Ok(output)
     }
+}
 
-    /// [`InputError::OutOfRange`] for the first vector input with a component beyond
-    /// [`Self::input_limit`].
-    fn check_range(
-        &self,
-        state: &RigidState<T>,
-        reference: &Reference<T>,
-    ) -> Result<(), InputError> {
-        for (v, field) in [
-            (&state.position, "state.position"),
-            (&state.angular_velocity, "state.angular_velocity"),
-            (&state.velocity, "state.velocity"),
-            (&reference.position, "reference.position"),
-            (&reference.velocity, "reference.velocity"),
-            (&reference.acceleration, "reference.acceleration"),
-            (&reference.angular_velocity, "reference.angular_velocity"),
-            (
-                &reference.angular_acceleration,
-                "reference.angular_acceleration",
-            ),
-        ] {
-            if v.iter().any(|x| x.abs() > self.input_limit) {
-                return Err(InputError::OutOfRange {
-                    field,
-                    limit: to_f64(self.input_limit),
-                });
-            }
+/// Adds the offset-free torque to `u_tau_r` in `u_r` and `u_d` (`K_f` leaves the torque part
+/// as it is, eq. 12).
+fn add_torque<T: Real>(law: &mut LawOutput<T>, torque: &Vector3<T>) {
+    for (k, t) in torque.iter().enumerate() {
+        if let (Some(r), Some(d)) = (law.u_r.get_mut(k), law.u_d.get_mut(k)) {
+            *r += *t;
+            *d += *t;
         }
-        Ok(())
     }
-}
-
-/// `B` of [`Controller::input_limit`].
-fn input_limit<T: Real, const N: usize>(
-    team: &TeamConfig<T, N>,
-    settings: &ControllerSettings<T>,
-) -> T {
-    let row = |k: &nalgebra::Matrix3<T>| k.amax() * lit(3.0);
-    let gains = &settings.gains;
-    let mass = team.mass();
-    let quadratic = [
-        row(&team.inertia()),
-        row(&gains.k_x()),
-        row(&gains.k_omega()),
-        row(&gains.k_v()),
-        mass,
-    ]
-    .iter()
-    .fold(T::one(), |m, x| m.max(*x));
-    let linear = [
-        quadratic,
-        row(&gains.k_r()),
-        mass * settings.gravity,
-        count::<T>(team.len()) * team.limits().max_thrust(),
-    ]
-    .iter()
-    .fold(T::one(), |m, x| m.max(*x));
-    let max = T::max_value().unwrap_or_else(T::one);
-    (max / linear).min((max / quadratic).sqrt()) / lit(64.0)
-}
-
-/// The first output field with a non-finite number (the cycle's safety net). Cheap: each part
-/// sums `x * 0`, which is NaN exactly when some `x` is not finite (one multiply-add per number).
-fn first_non_finite<T: Real, const N: usize>(out: &ControlOutput<T, N>) -> Option<&'static str> {
-    let zero = T::zero();
-    let probe = |values: &[T]| values.iter().fold(zero, |acc, x| acc + *x * zero) == zero;
-    let commands = out.commands.iter().fold(zero, |acc, c| {
-        acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * zero
-    }) == zero;
-    let forces = out
-        .allocation
-        .forces
-        .iter()
-        .fold(zero, |acc, f| acc + (f.x + f.y + f.z) * zero)
-        == zero;
-    let law = &out.law;
-    if !commands {
-        return Some("output.commands");
-    }
-    if !forces
-        || !probe(out.allocation.wrench.as_slice())
-        || !probe(&[out.allocation.e_f, out.allocation.wrench_error])
-    {
-        return Some("output.allocation");
-    }
-    if !probe(out.planner.r_d.as_slice()) || !probe(&[out.planner.theta]) {
-        return Some("output.planner");
-    }
-    if !probe(out.projection.force.as_slice()) || !probe(out.f_r.as_slice()) {
-        return Some("output.projection");
-    }
-    if !probe(law.u_r.as_slice())
-        || !probe(law.u_d.as_slice())
-        || !probe(law.e_xi.as_slice())
-        || !probe(law.e_r.as_slice())
-        || !probe(law.e_x.as_slice())
-        || !probe(&[law.v_r, law.v_x])
-    {
-        return Some("output.law");
-    }
-    None
 }

@@ -95,6 +95,20 @@ pub enum ConfigField {
     NullSpaceIterations,
     /// The null-space stage's inward tilt.
     NullSpaceTilt,
+    /// A closed-loop natural frequency of [`crate::NaturalGains`].
+    NaturalFrequency,
+    /// A closed-loop damping ratio of [`crate::NaturalGains`].
+    DampingRatio,
+    /// A gain of [`crate::IntegralAction`].
+    IntegralGain,
+    /// A bandwidth of [`crate::DisturbanceObserver`].
+    ObserverBandwidth,
+    /// The torque bound of the offset-free state ([`crate::OffsetFree`]).
+    OffsetFreeTorqueBound,
+    /// The bandwidth of [`crate::AttitudeRateFilter`].
+    AttitudeRateBandwidth,
+    /// The rate bound of [`crate::AttitudeRateFilter`].
+    AttitudeRateLimit,
 }
 
 impl ConfigField {
@@ -134,8 +148,30 @@ impl ConfigField {
             Self::ClarabelTolerance => "clarabel.tolerance",
             Self::NullSpaceIterations => "null_space.iterations",
             Self::NullSpaceTilt => "null_space.tilt",
+            Self::NaturalFrequency => "gains.natural_frequency",
+            Self::DampingRatio => "gains.damping_ratio",
+            Self::IntegralGain => "offset_free.integral_gain",
+            Self::ObserverBandwidth => "offset_free.bandwidth",
+            Self::OffsetFreeTorqueBound => "offset_free.max_torque",
+            Self::AttitudeRateBandwidth => "attitude_rate.bandwidth",
+            Self::AttitudeRateLimit => "attitude_rate.max_rate",
         }
     }
+}
+
+/// `value` when it is finite and positive; else [`ConfigError::NonFinite`] or
+/// [`ConfigError::Parameter`] naming `field` (the one check of the settings' plain numbers).
+pub(crate) fn positive<T: nalgebra::RealField + Copy>(
+    value: T,
+    field: ConfigField,
+) -> Result<T, ConfigError> {
+    if !value.is_finite() {
+        return Err(ConfigError::NonFinite { field });
+    }
+    if value <= T::zero() {
+        return Err(ConfigError::Parameter { field });
+    }
+    Ok(value)
 }
 
 impl fmt::Display for ConfigField {

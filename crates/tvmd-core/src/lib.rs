@@ -20,6 +20,11 @@
 //! degraded team when its failure mask is set (can the working agents hold hover, and with
 //! what margin).
 //!
+//! Beyond the paper, each optional and off in [`ControllerSettings::paper`]: offset-free
+//! tracking ([`offset_free`]: a [`disturbance`] observer or [`integral`] action, under
+//! [`anti_windup`]), gains that fit any team ([`gain_schedule`], [`natural_gains`]) and the
+//! planned attitude's rates ([`attitude_rate`]).
+//!
 //! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
 //! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
 //! (e.g. [`projection`] and [`planner`] import [`afs`]; [`allocation`] imports [`admissible`]
@@ -48,17 +53,24 @@ pub use nalgebra;
 pub mod admissible;
 pub mod afs;
 pub mod allocation;
+pub mod anti_windup;
+pub mod attitude_rate;
 pub mod command;
 pub mod controller;
 mod definite;
+pub mod disturbance;
 pub mod effectiveness;
 pub mod error;
 pub mod failure;
+pub mod gain_schedule;
 pub mod gimbal;
 pub mod hover;
+pub mod integral;
 pub mod law;
 pub mod limits;
 mod linalg;
+pub mod natural_gains;
+pub mod offset_free;
 pub mod planner;
 pub mod projection;
 pub mod real;
@@ -74,15 +86,22 @@ pub use allocation::{
 };
 #[cfg(feature = "clarabel")]
 pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};
+pub use anti_windup::Saturation;
+pub use attitude_rate::{AttitudeRateFilter, PlannedRates};
 pub use command::AgentCommand;
 pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
+pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
 pub use failure::FailureMask;
+pub use gain_schedule::GainSchedule;
 pub use gimbal::GimbalCommand;
 pub use hover::{HoverCapability, HoverLimit};
+pub use integral::IntegralAction;
 pub use law::{Gains, LawOutput, Reference, RigidState};
 pub use limits::{AgentLimits, RateLimits};
+pub use natural_gains::NaturalGains;
+pub use offset_free::{Compensation, OffsetFree};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 pub use projection::{project_force, project_force_in, ForceProjection};
 pub use real::Real;

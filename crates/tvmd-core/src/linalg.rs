@@ -40,6 +40,21 @@ pub(crate) fn normalize<T: Real, const D: usize>(v: &SVector<T, D>) -> SVector<T
     u / u.norm()
 }
 
+/// `v` scaled onto the ball `||v|| <= bound` when it lies outside (its direction kept); zero
+/// for a non-finite `v` or a non-finite norm, so the result is always finite for a finite
+/// `bound >= 0`. The one clamp of the offset-free state and the planned rates.
+pub(crate) fn clamp_norm<T: Real, const D: usize>(v: &SVector<T, D>, bound: T) -> SVector<T, D> {
+    let n = norm(v);
+    if !n.is_finite() {
+        return SVector::zeros();
+    }
+    if n <= bound {
+        return *v;
+    }
+    // `bound / n < 1`; the product cannot overflow.
+    v * (bound / n)
+}
+
 /// Whether a sum of squares `s` is finite and at least `MIN_POSITIVE / eps`: then no square
 /// that matters to `sqrt(s)` to round-off was subnormal, and none overflowed.
 pub(crate) fn plain_is_exact<T: Real>(s: T) -> bool {

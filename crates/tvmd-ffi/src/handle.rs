@@ -204,6 +204,9 @@ fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
         period: config.period,
         rate_limits,
         null_space: None,
+        gain_schedule: tvmd_core::GainSchedule::AsGiven,
+        offset_free: None,
+        attitude_rate: None,
     };
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,

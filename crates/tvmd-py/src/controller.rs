@@ -75,6 +75,9 @@ impl PyController {
             period,
             rate_limits: rate_limits_arg(rate_limits)?,
             null_space: stage,
+            gain_schedule: tvmd_core::GainSchedule::AsGiven,
+            offset_free: None,
+            attitude_rate: None,
         };
         let allocator = make_allocator(allocator, weights, regularization, team.len())?;
         let mask = failure_mask(&team, failed)?;

@@ -132,6 +132,9 @@ impl CoreConfig {
             period: self.period,
             rate_limits,
             null_space: None,
+            gain_schedule: tvmd_core::GainSchedule::AsGiven,
+            offset_free: None,
+            attitude_rate: None,
         };
         let alloc = AnyAllocator::from_name(self.allocator_name(), &Default::default())?;
         Controller::new(team, settings, alloc)

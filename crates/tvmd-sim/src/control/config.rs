@@ -133,6 +133,9 @@ pub fn controller_settings<T: CoreFloat>(
             .as_ref()
             .map(|n| n.stage::<T>())
             .transpose()?,
+        gain_schedule: tvmd_core::GainSchedule::AsGiven,
+        offset_free: None,
+        attitude_rate: None,
     })
 }
 

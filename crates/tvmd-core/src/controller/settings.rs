@@ -1,0 +1,75 @@
+//! [`ControllerSettings`]: everything a [`crate::Controller`] is configured with besides the
+//! team and the allocator.
+
+use crate::afs::Relaxation;
+use crate::allocation::NullSpaceStage;
+use crate::attitude_rate::AttitudeRateFilter;
+use crate::error::{ConfigError, ConfigField};
+use crate::gain_schedule::GainSchedule;
+use crate::law::Gains;
+use crate::limits::RateLimits;
+use crate::offset_free::OffsetFree;
+use crate::real::{lit, Real};
+
+/// Settings of a [`crate::Controller`] besides the team and the allocator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControllerSettings<T: Real> {
+    /// Gains of eq. (12) (used as [`Self::gain_schedule`] says).
+    pub gains: Gains<T>,
+    /// AFS relaxation `s` of the planner.
+    pub relaxation: Relaxation<T>,
+    /// `g` (m/s^2).
+    pub gravity: T,
+    /// Control period `dt` (s), used by the rate limits, the offset-free state and the planned
+    /// rates.
+    pub period: T,
+    /// Optional gimbal rate limits (the rate-constrained allocation).
+    pub rate_limits: Option<RateLimits<T>>,
+    /// Optional null-space stage run after the allocator ([`NullSpaceStage`]; `None`: the
+    /// allocator's forces are used as they are, and [`crate::ControlOutput::null_space`] is
+    /// [`crate::NullSpaceReport::off`]).
+    pub null_space: Option<NullSpaceStage<T>>,
+    /// How [`Self::gains`] become the law's gains for the team: [`GainSchedule::AsGiven`]
+    /// (the paper), [`GainSchedule::TeamScaled`] (the authors' MATLAB) or
+    /// [`GainSchedule::Natural`] (closed-loop frequencies; `docs/method.md`).
+    pub gain_schedule: GainSchedule<T>,
+    /// Optional offset-free action ([`OffsetFree`]: a disturbance observer or an integral),
+    /// added to the request before the planner; `None`: the paper's law.
+    pub offset_free: Option<OffsetFree<T>>,
+    /// Optional filter of the planned attitude's rates ([`AttitudeRateFilter`]): when set, the
+    /// law's `Omega_d`, `Omega_d_dot` are those of the planner's `R_d` in place of the
+    /// reference's; `None`: the reference's (the paper).
+    pub attitude_rate: Option<AttitudeRateFilter<T>>,
+}
+
+impl<T: Real> ControllerSettings<T> {
+    /// The paper's settings: its gains as given, `s = 0.5`, `g = 9.81`, `dt = 0.01` s, no rate
+    /// limits, no null-space stage, no offset-free action, the reference's `Omega_d`.
+    pub fn paper() -> Self {
+        Self {
+            gains: Gains::paper(),
+            relaxation: Relaxation::new(lit(0.5)).unwrap_or(Relaxation::none()),
+            gravity: lit(crate::team::presets::GRAVITY),
+            period: lit(0.01),
+            rate_limits: None,
+            null_space: None,
+            gain_schedule: GainSchedule::AsGiven,
+            offset_free: None,
+            attitude_rate: None,
+        }
+    }
+
+    /// Gains, relaxation, rate limits, the offset-free action and the rate filter are valid by
+    /// construction (private fields); only the two plain numbers are checked here.
+    pub(crate) fn validate(&self) -> Result<(), ConfigError> {
+        for (value, field) in [
+            (self.gravity, ConfigField::Gravity),
+            (self.period, ConfigField::Period),
+        ] {
+            if !value.is_finite() || value <= T::zero() {
+                return Err(ConfigError::Parameter { field });
+            }
+        }
+        Ok(())
+    }
+}

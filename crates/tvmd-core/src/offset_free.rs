@@ -1,0 +1,211 @@
+//! Offset-free tracking beyond the paper: an estimate of the unmodelled wrench
+//! ([`DisturbanceObserver`]) or an integral of the tracking errors ([`IntegralAction`]), added
+//! to the requested wrench before the planner and the force projection (eqs. 9-13), with
+//! anti-windup and a landed hold (`docs/method.md#beyond-the-paper-offset-free-tracking`).
+
+use nalgebra::{Vector3, Vector6};
+
+use crate::anti_windup::Saturation;
+use crate::disturbance::{DisturbanceObserver, ObserverState};
+use crate::integral::{IntegralAction, IntegralState};
+use crate::law::{Plant, RigidState};
+use crate::real::Real;
+
+/// Which offset-free action the controller runs (`None` in
+/// [`crate::ControllerSettings::offset_free`]: the paper's law, no state).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OffsetFree<T: Real> {
+    /// The disturbance observer (the recommended one: `docs/method.md`).
+    Observer(DisturbanceObserver<T>),
+    /// Integral action on `e_x` and `e_R`.
+    Integral(IntegralAction<T>),
+}
+
+/// The wrench the offset-free state adds to the request this period.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Compensation<T: Real> {
+    /// Force (N) in `{I}`; the request adds `R^T force` to `u_fr`.
+    pub force: Vector3<T>,
+    /// Torque (N m) in `{C}`, added to `u_tau_r`.
+    pub torque: Vector3<T>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind<T: Real> {
+    Off,
+    Observer(ObserverState<T>),
+    Integral(IntegralState<T>),
+}
+
+/// The offset-free state of a controller: the estimator or integral, the force bound (the
+/// AFS's capacity `n sigma_Tf` of the working agents) and the landed hold.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OffsetFreeState<T: Real> {
+    kind: Kind<T>,
+    force_bound: T,
+    landed: bool,
+}
+
+impl<T: Real> OffsetFreeState<T> {
+    /// The state for `settings` (off for `None`), a control period `dt` (validated by the
+    /// caller) and a force bound (N, finite and non-negative).
+    pub fn new(settings: Option<&OffsetFree<T>>, period: T, force_bound: T) -> Self {
+        let kind = match settings {
+            None => Kind::Off,
+            Some(OffsetFree::Observer(o)) => Kind::Observer(ObserverState::new(*o, period)),
+            Some(OffsetFree::Integral(i)) => Kind::Integral(IntegralState::new(*i, period)),
+        };
+        Self {
+            kind,
+            force_bound,
+            landed: false,
+        }
+    }
+
+    /// Whether an offset-free action is configured.
+    pub fn is_on(&self) -> bool {
+        !matches!(self.kind, Kind::Off)
+    }
+
+    /// Whether the landed hold is on ([`Self::set_landed`]).
+    pub fn landed(&self) -> bool {
+        self.landed
+    }
+
+    /// The force bound (N).
+    pub fn force_bound(&self) -> T {
+        self.force_bound
+    }
+
+    /// The wrench to add to this period's request (zero when off or landed).
+    pub fn compensation(&self) -> Compensation<T> {
+        let (force, torque) = match &self.kind {
+            _ if self.landed => (Vector3::zeros(), Vector3::zeros()),
+            Kind::Off => (Vector3::zeros(), Vector3::zeros()),
+            Kind::Observer(o) => o.compensation(),
+            Kind::Integral(i) => i.compensation(),
+        };
+        Compensation { force, torque }
+    }
+
+    /// Clears the state (zero estimate or integral, no observer sample); the landed flag,
+    /// which is the caller's input, is kept.
+    pub fn reset(&mut self) {
+        match &mut self.kind {
+            Kind::Off => {}
+            Kind::Observer(o) => o.reset(),
+            Kind::Integral(i) => i.reset(),
+        }
+    }
+
+    /// The landed hold: while `true` the state is cleared and held at zero (ground contact is
+    /// not a disturbance to compensate, and nothing integrates on the ground); on `false` it
+    /// starts again from zero.
+    pub fn set_landed(&mut self, landed: bool) {
+        if landed {
+            self.reset();
+        }
+        self.landed = landed;
+    }
+
+    /// A new force bound (a failure changed the team's capacity): the force part is clamped
+    /// onto it, the rest kept.
+    pub fn set_force_bound(&mut self, force_bound: T) {
+        self.force_bound = force_bound;
+        match &mut self.kind {
+            Kind::Off => {}
+            Kind::Observer(o) => o.rebound(force_bound),
+            Kind::Integral(i) => i.rebound(force_bound),
+        }
+    }
+
+    /// Start of a period: the observer measures the last period (nothing for the integral, or
+    /// when landed).
+    pub fn begin(&mut self, plant: &Plant<T>, state: &RigidState<T>) {
+        if self.landed {
+            return;
+        }
+        if let Kind::Observer(o) = &mut self.kind {
+            o.measure(plant, state, self.force_bound);
+        }
+    }
+
+    /// End of a period whose commands were sent: the integral integrates `e_x`, `e_R`; the
+    /// observer records the state and the allocated wrench. Nothing when landed.
+    pub fn end(&mut self, plant: &Plant<T>, state: &RigidState<T>, cycle: &CycleRecord<T>) {
+        if self.landed {
+            return;
+        }
+        match &mut self.kind {
+            Kind::Off => {}
+            Kind::Observer(o) => o.record(plant, state, &cycle.wrench, cycle.saturation),
+            Kind::Integral(i) => {
+                i.update(&cycle.e_x, &cycle.e_r, cycle.saturation, self.force_bound)
+            }
+        }
+    }
+}
+
+/// What [`OffsetFreeState::end`] needs of a period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CycleRecord<T: Real> {
+    /// `e_x` (m, `{I}`).
+    pub e_x: Vector3<T>,
+    /// `e_R` (rad, `{C}`).
+    pub e_r: Vector3<T>,
+    /// The allocated wrench `M f` (`{C}`).
+    pub wrench: Vector6<T>,
+    /// What the team could not deliver this period.
+    pub saturation: Saturation,
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use nalgebra::Matrix3;
+
+    fn record(e: f64) -> CycleRecord<f64> {
+        CycleRecord {
+            e_x: Vector3::new(e, 0.0, 0.0),
+            e_r: Vector3::new(0.0, e, 0.0),
+            wrench: Vector6::zeros(),
+            saturation: Saturation::NONE,
+        }
+    }
+
+    #[test]
+    fn off_is_inert_and_landed_holds_zero() {
+        let plant = Plant::new(2.0, Matrix3::identity(), 9.81).unwrap();
+        let state = RigidState::at_rest(Vector3::zeros());
+        let mut off = OffsetFreeState::<f64>::new(None, 0.01, 50.0);
+        off.begin(&plant, &state);
+        off.end(&plant, &state, &record(1.0));
+        assert!(!off.is_on());
+        assert_eq!(off.compensation(), Compensation::default());
+
+        let action = IntegralAction::new([1.0; 3], [1.0; 3], 1.0).unwrap();
+        let mut s = OffsetFreeState::new(Some(&OffsetFree::Integral(action)), 0.01, 50.0);
+        s.end(&plant, &state, &record(1.0));
+        assert!(s.compensation().force.x < 0.0);
+        s.set_landed(true);
+        assert_eq!(s.compensation(), Compensation::default());
+        for _ in 0..100 {
+            s.begin(&plant, &state);
+            s.end(&plant, &state, &record(1.0));
+        }
+        s.set_landed(false);
+        assert_eq!(s.compensation(), Compensation::default());
+        s.end(&plant, &state, &record(1.0));
+        assert!((s.compensation().force.x + 0.01).abs() < 1e-15);
+        // A smaller capacity clamps the kept state.
+        for _ in 0..10_000 {
+            s.end(&plant, &state, &record(1.0));
+        }
+        assert!((s.compensation().force.norm() - 50.0).abs() < 1e-9);
+        s.set_force_bound(10.0);
+        assert!(s.compensation().force.norm() <= 10.0 * (1.0 + 1e-12));
+        s.reset();
+        assert_eq!(s.compensation(), Compensation::default());
+    }
+}
