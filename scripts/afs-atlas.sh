@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=$(mktemp -d)
-cargo run --release -q -p tvmd-sim -- afs all --each-failure --plots "$out/png" --json docs/afs-atlas.json > "$out/table.md"
+cargo run --release -q -p tvmd-cli -- afs all --each-failure --plots "$out/png" --json docs/afs-atlas.json > "$out/table.md"
 mkdir -p docs/figures/afs
 for f in a4-inc a6-inc; do cp "$out/png/$f.png" docs/figures/afs/; done
 python3 - "$out/table.md" <<'PY'

@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-cargo build --release --locked -p tvmd-sim --bin tvmd-sim
+cargo build --release --locked -p tvmd-cli --bin tvmd-sim
 target_dir="$(cargo metadata --format-version 1 --no-deps \
   | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')"
 exec "${target_dir:-target}/release/tvmd-sim" run paper-tilt \

@@ -68,7 +68,7 @@ done
 
 # Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
 # tvmd-pil firmware, built above with the target tests) on both boards, compared with the
-# in-process f32 flight (crates/tvmd-sim/tests/pil.rs, #[ignore]d in plain cargo test).
+# in-process f32 flight (crates/tvmd-sim/tests/pil/main.rs, #[ignore]d in plain cargo test).
 echo "==> processor in the loop (tvmd-sim --pil cortex-m4, cortex-m7)"
 pil_elf=$(realpath "$target_dir/thumbv7em-none-eabihf/release/tvmd-pil")
 TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored --nocapture || {

@@ -54,15 +54,15 @@ python3 scripts/architecture.py --check
 
 step "cargo clippy -D warnings (default features, then with clarabel)"
 cargo clippy --workspace --all-targets -- -D warnings
-cargo clippy -p tvmd-core -p tvmd -p tvmd-sim -p tvmd-py --all-targets \
-  --features tvmd-core/clarabel,tvmd/clarabel,tvmd-sim/clarabel,tvmd-py/clarabel -- -D warnings
+cargo clippy -p tvmd-core -p tvmd -p tvmd-sim -p tvmd-studies -p tvmd-cli -p tvmd-py --all-targets \
+  --features tvmd-core/clarabel,tvmd/clarabel,tvmd-sim/clarabel,tvmd-studies/clarabel,tvmd-cli/clarabel,tvmd-py/clarabel -- -D warnings
 
 step "cargo test (workspace)"
 cargo test --workspace
 
 step "cargo test --features clarabel (the constrained allocator; the paper scenario flown with it)"
 cargo test -p tvmd-core --features clarabel
-cargo test -p tvmd-sim --features clarabel --test closed_loop
+cargo test -p tvmd-sim --features clarabel --test flight closed_loop::
 
 step "randomized control cycle: 1,000,000 steps per type (f32, f64), then 200,000 per type with clarabel"
 # Optimized build (ci profile); prints the counts (steps, Ok, each error variant, rejected teams).

@@ -16,8 +16,8 @@ use nalgebra::Vector3;
 use rapier3d_f64::prelude::{ColliderBuilder, IntegrationParameters, RigidBodyBuilder};
 use rapier3d_f64::{math as rm, pipeline::PhysicsWorld};
 use tvmd_plant::physics::{ExtraWrench, PhysicsWorld as TvmdWorld, PlantState};
-use tvmd_sim::runner::{fly, run_many, worker_count, RunSpec};
 use tvmd_scenario::Scenario;
+use tvmd_sim::runner::{fly, run_many, worker_count, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::GRAVITY;
 

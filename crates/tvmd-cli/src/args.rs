@@ -178,7 +178,6 @@ pub enum Command {
     },
 }
 
-
 /// Arguments of `tvmd-sim afs`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct AfsArgs {

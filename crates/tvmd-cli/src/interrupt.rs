@@ -19,4 +19,3 @@ pub fn catch_interrupts() {
         }
     });
 }
-

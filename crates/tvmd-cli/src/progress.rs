@@ -26,4 +26,3 @@ pub fn progress_bar(ticks: u64, message: &str) -> ProgressBar {
 pub fn ticks_of(s: &Scenario) -> u64 {
     (s.duration / s.controller_period).ceil().max(1.0) as u64
 }
-

@@ -10,7 +10,9 @@ pub fn frame_transform(t: f64, position: &Vector3<f64>, rotation: &Matrix3<f64>)
         parent_frame_id: "world".into(),
         child_frame_id: "team".into(),
         translation: Some(fg_vector(position)),
-        rotation: Some(fg_quaternion(&tvmd_plant::math::rotation_quaternion(rotation))),
+        rotation: Some(fg_quaternion(&tvmd_plant::math::rotation_quaternion(
+            rotation,
+        ))),
     }
 }
 
@@ -50,4 +52,3 @@ pub fn fg_quaternion(q: &UnitQuaternion<f64>) -> Quaternion {
         w: q.w,
     }
 }
-

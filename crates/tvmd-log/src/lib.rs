@@ -30,6 +30,7 @@
 
 #![warn(missing_docs)]
 
+mod channels;
 mod convert;
 mod error;
 mod kind;
@@ -40,11 +41,12 @@ mod run_log;
 pub mod scene;
 pub mod writer;
 
+pub use channels::{LogChannels, LogMessage};
 pub use convert::{fg_quaternion, fg_vector, frame_transform, nanos, timestamp};
 pub use error::LogError;
 pub use kind::LogKind;
 pub use live::{LiveOptions, LiveServer};
-pub use run_log::{LogChannels, LogMessage, RunLog};
+pub use run_log::RunLog;
 pub use writer::{LogJob, QUEUE_JOBS};
 
 /// Name of the metadata record holding the scenario of a run: keys `name`, `relaxation`,

@@ -7,83 +7,14 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
-use foxglove::messages::{FrameTransform, SceneUpdate};
-use foxglove::{Channel, Context, Encode, McapWriterHandle};
+use foxglove::{Context, McapWriterHandle};
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::writer::{LogWriter, Written};
-use crate::{frame_transform, proto, LiveOptions, LiveServer, LogError, LogKind};
-
-/// One typed channel per topic, all in the log's context.
-pub(crate) struct Channels {
-    state: Channel<proto::State>,
-    reference: Channel<proto::Reference>,
-    planner: Channel<proto::Planner>,
-    control: Channel<proto::Control>,
-    allocation: Channel<proto::Allocation>,
-    actuators: Channel<proto::Actuators>,
-    lyapunov: Channel<proto::Lyapunov>,
-    hover: Channel<proto::Hover>,
-    tf: Channel<FrameTransform>,
-    scene: Channel<SceneUpdate>,
-}
-
-impl Channels {
-    fn new(ctx: &Arc<Context>) -> Self {
-        fn build<T: Encode>(ctx: &Arc<Context>, kind: LogKind) -> Channel<T> {
-            ctx.channel_builder(kind.topic()).build()
-        }
-        Self {
-            state: build(ctx, LogKind::State),
-            reference: build(ctx, LogKind::Reference),
-            planner: build(ctx, LogKind::Planner),
-            control: build(ctx, LogKind::Control),
-            allocation: build(ctx, LogKind::Allocation),
-            actuators: build(ctx, LogKind::Actuators),
-            lyapunov: build(ctx, LogKind::Lyapunov),
-            hover: build(ctx, LogKind::Hover),
-            tf: build(ctx, LogKind::FrameTransform),
-            scene: build(ctx, LogKind::Scene),
-        }
-    }
-}
-
-/// A message the log can write: which channel it goes to.
-pub trait LogMessage: Encode + Send + Sized + 'static {
-    /// Its kind.
-    const KIND: LogKind;
-    #[doc(hidden)]
-    fn log(&self, channels: &LogChannels, nanos: u64);
-}
-
-/// The channels of a [`RunLog`], owned by its writer thread: a [`LogJob`] writes through them.
-pub struct LogChannels {
-    pub(crate) channels: Channels,
-    pub(crate) written: Written,
-}
-
-macro_rules! log_message {
-    ($ty:ty, $kind:ident, $field:ident) => {
-        impl LogMessage for $ty {
-            const KIND: LogKind = LogKind::$kind;
-            fn log(&self, channels: &LogChannels, nanos: u64) {
-                channels.channels.$field.log_with_time(self, nanos);
-            }
-        }
-    };
-}
-
-log_message!(proto::State, State, state);
-log_message!(proto::Reference, Reference, reference);
-log_message!(proto::Planner, Planner, planner);
-log_message!(proto::Control, Control, control);
-log_message!(proto::Allocation, Allocation, allocation);
-log_message!(proto::Actuators, Actuators, actuators);
-log_message!(proto::Lyapunov, Lyapunov, lyapunov);
-log_message!(proto::Hover, Hover, hover);
-log_message!(FrameTransform, FrameTransform, tf);
-log_message!(SceneUpdate, Scene, scene);
+use crate::channels::Channels;
+use crate::channels::Written;
+use crate::writer::LogWriter;
+use crate::{frame_transform, LiveOptions, LiveServer, LogChannels, LogError, LogMessage};
 
 type McapFile = McapWriterHandle<BufWriter<File>>;
 
@@ -275,7 +206,7 @@ impl Drop for RunLog {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{nanos, timestamp};
+    use crate::{nanos, proto, timestamp, LogKind};
 
     #[test]
     fn kinds_name_their_topics_and_schemas_once() {
@@ -305,4 +236,3 @@ mod tests {
         log.finish().unwrap();
     }
 }
-

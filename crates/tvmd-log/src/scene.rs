@@ -5,9 +5,9 @@ use foxglove::messages::{
 };
 use nalgebra::{UnitQuaternion, Vector3};
 
+use crate::LogError;
 use crate::{fg_quaternion, fg_vector, timestamp, RunLog};
 use tvmd_plant::TeamBody;
-use crate::LogError;
 
 fn color(r: f64, g: f64, b: f64) -> Option<Color> {
     Some(Color { r, g, b, a: 1.0 })

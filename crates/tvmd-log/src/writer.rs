@@ -10,12 +10,10 @@
 //! back instead of growing memory.
 //! Jobs run in the order they were queued, so the file's message order is the loop's.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, SyncSender};
-use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use crate::{nanos, LogChannels, LogMessage};
+use crate::LogChannels;
 use crate::LogError;
 
 /// A unit of work for the writer thread: builds messages from the values it owns and writes
@@ -27,14 +25,6 @@ pub type LogJob = Box<dyn FnOnce(&mut LogChannels) + Send + 'static>;
 /// this is 3,200 ticks (32 s of a 100 Hz flight, a few MB) at most; a live run's jobs are one
 /// tick each and never queue up, as the run is paced to the wall clock.
 pub const QUEUE_JOBS: usize = 64;
-
-impl LogChannels {
-    /// Writes `msg` at simulation time `t` (s) on its channel.
-    pub fn write<M: LogMessage>(&mut self, t: f64, msg: &M) {
-        msg.log(self, nanos(t));
-        self.written.fetch_add(1, Ordering::Relaxed);
-    }
-}
 
 /// The writer thread and its queue.
 pub(super) struct LogWriter {
@@ -78,9 +68,6 @@ impl LogWriter {
         })
     }
 }
-
-/// The count of messages written, shared by the writer thread and its log.
-pub(super) type Written = Arc<AtomicU64>;
 
 #[cfg(test)]
 mod tests {

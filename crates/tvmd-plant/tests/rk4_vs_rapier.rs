@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use tvmd_plant::math::rotation_distance;
 use tvmd_plant::physics::{ExtraWrench, PhysicsConfig, PhysicsWorld, PlantState, TeamBody};
 use tvmd_plant::rk4::{BodyWrench, RigidBodyParams, Rk4Body};
-use tvmd_sim::GRAVITY;
+use tvmd_plant::GRAVITY;
 
 /// Body-frame force of agent `i` at time `t`: thrust a little above its weight share plus
 /// sinusoidal lateral components, different for every agent so that torques arise.

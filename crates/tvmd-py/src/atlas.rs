@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use tvmd_sim::afs_atlas::cli::{run, AfsArgs};
+use tvmd_studies::afs_atlas::{run, AtlasRequest};
 
 use crate::convert::{count, indices, record_to_py, Int};
 use crate::errors::value_error;
@@ -47,7 +47,7 @@ fn afs_atlas<'py>(
     let directions = directions.to("directions", lo, hi)?;
     let (lo, hi) = CERTIFY_HEIGHTS;
     let certify_heights = certify_heights.to("certify_heights", lo, hi)?;
-    let args = AfsArgs {
+    let args = AtlasRequest {
         team: team.to_string(),
         failed,
         each_failure: false,

@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 
 use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, NullSpaceReport};
-use tvmd_sim::scenario::NullSpaceConfig;
+use tvmd_scenario::NullSpaceConfig;
 
 use crate::afs::{PyAfs, PyForceProjection};
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};

@@ -14,7 +14,7 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 use pyo3::{intern, IntoPyObjectExt};
 
 use tvmd_core::{AgentCommand, Relaxation};
-use tvmd_sim::scenario::{NullSpaceConfig, Scenario};
+use tvmd_scenario::{NullSpaceConfig, Scenario};
 use tvmd_sim::sim::SampleRetention;
 
 use crate::errors::{sim_error, value_error, OrRaise, READ};

@@ -6,7 +6,11 @@ use std::path::Path;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
+use tvmd_log::LogError;
+use tvmd_plant::PhysicsError;
+use tvmd_scenario::ScenarioError;
 use tvmd_sim::SimError;
+use tvmd_studies::StudyError;
 
 pyo3::create_exception!(
     tvmd,
@@ -79,15 +83,100 @@ pub(crate) const READ: &str = "cannot read the scenario file";
 /// What was done with the file an I/O error names: writing a run's log.
 pub(crate) const WRITE: &str = "cannot write the MCAP log";
 
-/// The Python exception of a tvmd-sim error, the message prefixed with `context`; an I/O error
-/// names `file` (an `OSError` of the errno's subclass when the OS gave one).
-pub(crate) fn sim_error(error: SimError, context: &str, file: Option<(&str, &Path)>) -> PyErr {
-    let (message, errno) = match &error {
-        SimError::Io(io) => {
+/// How the Python layer raises an error of the simulator's crates.
+pub(crate) enum ErrorKind<'a> {
+    /// An I/O error without a known file.
+    Io(&'a std::io::Error),
+    /// An I/O error on a named file.
+    File(&'a std::io::Error, &'a Path),
+    /// Stopped by Ctrl-C / a signal.
+    Interrupted,
+    /// A log could not be written or read back.
+    Log,
+    /// A bad argument, scenario or team.
+    Value,
+    /// Anything else.
+    Runtime,
+}
+
+/// The simulator crates' errors, each classified once for the Python mapping.
+pub(crate) trait SimErrorKind: std::fmt::Display {
+    /// How this error is raised.
+    fn kind(&self) -> ErrorKind<'_>;
+}
+
+impl SimErrorKind for PhysicsError {
+    fn kind(&self) -> ErrorKind<'_> {
+        match self {
+            PhysicsError::InvalidTeam(_) | PhysicsError::InvalidScenario { .. } => ErrorKind::Value,
+            _ => ErrorKind::Runtime,
+        }
+    }
+}
+
+impl SimErrorKind for LogError {
+    fn kind(&self) -> ErrorKind<'_> {
+        match self {
+            LogError::Io(io) => ErrorKind::Io(io),
+            LogError::File { source, path, .. } => ErrorKind::File(source, path),
+            LogError::Mcap(_) | LogError::LogRead(_) | LogError::LogFinished => ErrorKind::Log,
+            LogError::PathClash(_) | LogError::InvalidArgument { .. } => ErrorKind::Value,
+            LogError::Foxglove(_) => ErrorKind::Runtime,
+        }
+    }
+}
+
+impl SimErrorKind for ScenarioError {
+    fn kind(&self) -> ErrorKind<'_> {
+        match self {
+            ScenarioError::File { source, path, .. } => ErrorKind::File(source, path),
+            ScenarioError::Physics(e) => e.kind(),
+            _ => ErrorKind::Value,
+        }
+    }
+}
+
+impl SimErrorKind for SimError {
+    fn kind(&self) -> ErrorKind<'_> {
+        match self {
+            SimError::Scenario(e) => e.kind(),
+            SimError::Physics(e) => e.kind(),
+            SimError::Log(e) => e.kind(),
+            SimError::Interrupted => ErrorKind::Interrupted,
+            SimError::InvalidScenario { .. } => ErrorKind::Value,
+            _ => ErrorKind::Runtime,
+        }
+    }
+}
+
+impl SimErrorKind for StudyError {
+    fn kind(&self) -> ErrorKind<'_> {
+        match self {
+            StudyError::Sim(e) => e.kind(),
+            StudyError::Scenario(e) => e.kind(),
+            StudyError::Log(e) => e.kind(),
+            StudyError::Physics(e) => e.kind(),
+            StudyError::Io(io) => ErrorKind::Io(io),
+            StudyError::File { source, path, .. } => ErrorKind::File(source, path),
+            StudyError::InvalidTeam(_) | StudyError::InvalidArgument { .. } => ErrorKind::Value,
+            _ => ErrorKind::Runtime,
+        }
+    }
+}
+
+/// The Python exception of a simulator error, the message prefixed with `context`; an I/O
+/// error names `file` (an `OSError` of the errno's subclass when the OS gave one).
+pub(crate) fn sim_error<E: SimErrorKind>(
+    error: E,
+    context: &str,
+    file: Option<(&str, &Path)>,
+) -> PyErr {
+    let (message, errno) = match error.kind() {
+        ErrorKind::Io(io) => {
             let what = file.map_or("I/O error", |(what, _)| what);
             (format!("{context}{what}: {io}"), io.raw_os_error())
         }
-        SimError::File { source, path, .. } => {
+        ErrorKind::File(source, path) => {
             let message = format!("{context}{error}");
             let path = path.display().to_string();
             return match source.raw_os_error() {
@@ -95,19 +184,10 @@ pub(crate) fn sim_error(error: SimError, context: &str, file: Option<(&str, &Pat
                 None => PyOSError::new_err(message),
             };
         }
-        SimError::Interrupted => return PyKeyboardInterrupt::new_err(format!("{context}{error}")),
-        SimError::Mcap(_) | SimError::LogRead(_) | SimError::LogFinished => {
-            (format!("{context}{error}"), None)
-        }
-        SimError::PathClash(_)
-        | SimError::InvalidArgument { .. }
-        | SimError::InvalidTeam(_)
-        | SimError::InvalidScenario { .. }
-        | SimError::ScenarioParse { .. }
-        | SimError::UnknownScenario { .. } => {
-            return PyValueError::new_err(format!("{context}{error}"))
-        }
-        _ => return PyRuntimeError::new_err(format!("{context}{error}")),
+        ErrorKind::Interrupted => return PyKeyboardInterrupt::new_err(format!("{context}{error}")),
+        ErrorKind::Log => (format!("{context}{error}"), None),
+        ErrorKind::Value => return PyValueError::new_err(format!("{context}{error}")),
+        ErrorKind::Runtime => return PyRuntimeError::new_err(format!("{context}{error}")),
     };
     match (errno, file.map(|(_, path)| path.display().to_string())) {
         (Some(errno), Some(path)) => PyOSError::new_err((errno, message, path)),
@@ -118,7 +198,7 @@ pub(crate) fn sim_error(error: SimError, context: &str, file: Option<(&str, &Pat
 }
 
 /// A tvmd-sim error without a file.
-pub(crate) fn value_error(error: SimError) -> PyErr {
+pub(crate) fn value_error<E: SimErrorKind>(error: E) -> PyErr {
     sim_error(error, "", None)
 }
 

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use tvmd_sim::montecarlo::{
+use tvmd_scenario::Scenario;
+use tvmd_studies::montecarlo::{
     fly_all, fly_flight, Distributions, FlightRow, FlightSpec, Study, StudyReport,
 };
-use tvmd_sim::scenario::Scenario;
 
 use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
 use crate::errors::value_error;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 
-use tvmd_sim::scenario::{Scenario, BUILTIN_NAMES};
+use tvmd_scenario::{Scenario, BUILTIN_NAMES};
 
 use crate::convert::{jobs_arg, retention_arg, Int};
 use crate::errors::value_error;

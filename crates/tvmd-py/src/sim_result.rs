@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 
-use tvmd_sim::actuators::ActuatorCommand;
+use tvmd_plant::actuators::ActuatorCommand;
+use tvmd_scenario::Scenario;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::RunSpec;
-use tvmd_sim::scenario::Scenario;
 use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
 
 use crate::convert::{record_to_py, shaped};
@@ -19,7 +19,7 @@ use crate::record::record;
 /// A scenario in a `SimResult`'s pickle: its TOML (every field, validated on the way back).
 mod scenario_as_toml {
     use serde::{Deserialize, Deserializer, Serializer};
-    use tvmd_sim::scenario::Scenario;
+    use tvmd_scenario::Scenario;
 
     pub(super) fn serialize<S: Serializer>(s: &Scenario, out: S) -> Result<S::Ok, S::Error> {
         let text = s.to_toml_string().map_err(serde::ser::Error::custom)?;

@@ -3,7 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::validate::{check_magnitude, check_nonneg, check_pos, check_range, invalid};
+use crate::checks::{check_magnitude, check_nonneg, check_pos, check_range};
+use crate::error::invalid;
 use crate::ScenarioError;
 
 /// Largest wind or gust speed (m/s).

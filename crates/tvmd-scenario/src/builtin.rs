@@ -3,10 +3,10 @@
 use std::f64::consts::PI;
 
 use super::{Failure, Scenario};
+use crate::ScenarioError;
 use tvmd_plant::actuators::FailureKind;
 use tvmd_plant::physics::TeamBody;
 use tvmd_plant::reference::{PaperTilt, ReferenceConfig};
-use crate::ScenarioError;
 
 /// Names of the built-in scenarios, for [`Scenario::builtin`].
 pub const BUILTIN_NAMES: &[&str] = &[
@@ -122,9 +122,11 @@ impl Scenario {
                 )
             }
             other => {
-                return super::families::family(other).ok_or_else(|| ScenarioError::UnknownScenario {
-                    name: other.to_string(),
-                    known: BUILTIN_NAMES.join(", "),
+                return super::families::family(other).ok_or_else(|| {
+                    ScenarioError::UnknownScenario {
+                        name: other.to_string(),
+                        known: BUILTIN_NAMES.join(", "),
+                    }
                 })
             }
         })

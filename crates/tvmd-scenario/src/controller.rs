@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validate::invalid;
+use crate::error::invalid;
 use crate::ScenarioError;
 
 /// Allocator names this build runs (the core's table, [`tvmd_core::AnyAllocator::NAMES`]); a

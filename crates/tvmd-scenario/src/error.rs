@@ -63,3 +63,11 @@ impl ScenarioError {
         }
     }
 }
+
+/// A [`ScenarioError::InvalidScenario`] naming `field`.
+pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> ScenarioError {
+    ScenarioError::InvalidScenario {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}

@@ -69,6 +69,7 @@
 mod air;
 mod builtin;
 mod certified;
+mod checks;
 mod controller;
 mod disturbances;
 mod error;

@@ -12,7 +12,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 use tvmd_core::{NullSpaceObjective, NullSpaceStage, Real};
 
-use super::validate::invalid;
+use crate::error::invalid;
 use crate::ScenarioError;
 
 /// Default iteration cap of the stage.

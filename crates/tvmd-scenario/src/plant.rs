@@ -4,7 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::validate::{check_magnitude, check_nonneg, check_range, invalid};
+use crate::checks::{check_magnitude, check_nonneg, check_range};
+use crate::error::invalid;
 use crate::ScenarioError;
 
 /// Largest mass or inertia scale of the plant against the model.

@@ -6,8 +6,11 @@ use serde::{Deserialize, Serialize};
 use tvmd_plant::actuators::{ActuatorModel, SaturationLimits};
 use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
-use crate::validate::invalid;
-use crate::*;
+use crate::error::invalid;
+use crate::{
+    Disturbances, Failure, FailureResponse, GainsConfig, LimitsConfig, LogSettings,
+    NullSpaceConfig, Payload, PlantError, Precision, ScenarioError, SuccessBounds, TeamSpec,
+};
 
 /// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
 pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;

@@ -2,9 +2,9 @@
 //! [`FlightOutput`] (commands and [`Diagnostics`]). The loop (module `sim`) calls it; the tvmd
 //! adapter (module `control`) and test controllers implement it.
 
-use tvmd_plant::actuators::ActuatorCommand;
 use crate::diagnostics::Diagnostics;
 use crate::error::BoxedError;
+use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceSample;
 

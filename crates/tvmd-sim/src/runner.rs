@@ -14,15 +14,15 @@ use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
+use crate::sim::summary::Verdict;
+use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
+use crate::sink::TickSink;
+use crate::tick_log::McapSink;
+use crate::SimError;
 use tvmd_log::{LiveOptions, RunLog, METADATA_SCENARIO};
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceSample;
 use tvmd_scenario::{Precision, Scenario};
-use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
-use crate::sim::summary::Verdict;
-use crate::sink::TickSink;
-use crate::tick_log::McapSink;
-use crate::SimError;
 
 /// A controller that reports the time of every call to a callback (for progress bars).
 pub struct WithProgress<'a> {
@@ -179,7 +179,9 @@ pub fn fly_live(
         Some(p) => sim.run_until(&mut WithProgress::new(&mut controller, p), sink, cancel),
         None => sim.run_until(&mut controller, sink, cancel),
     };
-    let finished = log.as_mut().map_or(Ok(()), |l| l.finish().map_err(SimError::from));
+    let finished = log
+        .as_mut()
+        .map_or(Ok(()), |l| l.finish().map_err(SimError::from));
     let (mut result, error) = match (run, finished) {
         (Ok(result), Ok(())) => (result, None),
         (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),

@@ -65,4 +65,3 @@ pub struct Tick {
     /// True failure flags.
     pub failed: Vec<bool>,
 }
-

@@ -7,17 +7,17 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use tvmd_plant::actuators::ActuatorCommand;
 use crate::diagnostics::{
     AllocationDiagnostics, ControlDiagnostics, HoverDiagnostics, PlannerDiagnostics,
 };
+use crate::sink::{LoggedTick, Tick, TickSink};
+use crate::SimError;
 use tvmd_log::proto::{self, Vec3};
 use tvmd_log::scene::team_scene;
 use tvmd_log::RunLog;
 use tvmd_log::{frame_transform, LogChannels, LogMessage};
+use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::math::{from_rows, roll_pitch_yaw, rotation_quaternion};
-use crate::sink::{LoggedTick, Tick, TickSink};
-use crate::SimError;
 
 /// Ticks a batch holds before it goes to the writer thread when nobody watches live: 0.5 s of a
 /// 100 Hz flight. Handing over every tick woke the writer 1,600 times in a 16 s flight; each
@@ -49,11 +49,7 @@ pub struct TickBatch {
 impl TickBatch {
     /// A batch sized for `log`: one tick when it serves a live view, else [`BATCH_TICKS`].
     pub fn for_log(log: &RunLog) -> Self {
-        let size = if log.live().is_some() {
-            1
-        } else {
-            BATCH_TICKS
-        };
+        let size = if log.live().is_some() { 1 } else { BATCH_TICKS };
         Self {
             ticks: Vec::with_capacity(size),
             size,

@@ -2,13 +2,11 @@
 
 use tvmd_core::nalgebra::{Matrix3, Vector3};
 use tvmd_core::{
-    AgentLimits, AgentSpec, AnyAllocator, ConfigError,
-    Controller, ControllerSettings, Gains, Navigator, RateLimits,
-    Relaxation, TeamConfig,
+    AgentLimits, AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings, Gains,
+    Navigator, RateLimits, Relaxation, TeamConfig,
 };
 
-use crate::{Reader, Writer, WireController, AGENTS, ALLOCATOR_NAME_BYTES};
-
+use crate::{Reader, WireController, Writer, AGENTS, ALLOCATOR_NAME_BYTES};
 
 /// Everything the simulator's f32 controller is built from, each value already rounded to f32
 /// exactly as the simulator rounds it (module `config`): the team (agent positions, quarter
@@ -140,4 +138,3 @@ impl CoreConfig {
         Controller::new(team, settings, alloc)
     }
 }
-

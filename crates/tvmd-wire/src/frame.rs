@@ -1,6 +1,5 @@
 //! Processor-in-the-loop frames.
 
-
 // Processor-in-the-loop frames: `FRAME_MAGIC`, kind (u16), sequence number (u16), payload
 // length in bytes (u32, a multiple of 4, at most `MAX_PAYLOAD_BYTES`), the payload, and the
 // CRC-32 of everything after the magic. Each host frame gets exactly one reply echoing its

@@ -27,7 +27,6 @@ pub use words::{Reader, Writer};
 
 use tvmd_core::{AnyAllocator, ControlOutput, Controller};
 
-
 /// Agent capacity of the controller on both sides (the simulator's `MAX_AGENTS`).
 pub const AGENTS: usize = 16;
 

@@ -2,7 +2,6 @@
 
 use tvmd_core::nalgebra::{Matrix3, Vector3, Vector6};
 
-
 /// A cursor writing words into a buffer; every method returns `None` when it is full.
 pub struct Writer<'a> {
     buf: &'a mut [u32],

@@ -1,5 +1,5 @@
 //! The recorded f32 `paper-tilt` flight replayed on the target: the 1,000 consecutive control
-//! cycles `tvmd-sim record-cycles` wrote into `crates/tvmd-sim/tests/data/paper_tilt_f32.cycles`
+//! cycles `tvmd-sim record-cycles` (crate tvmd-cli) wrote into `crates/tvmd-sim/tests/data/paper_tilt_f32.cycles`
 //! (the core's exact f32 inputs, failure masks, and the host's outputs), fed in order to a fresh
 //! controller built from the recording's configuration words by the simulator's own code
 //! (`wire::CoreConfig::build`), each output compared with the host's: bit-identical, or within
@@ -12,10 +12,9 @@
 
 use cortex_m_semihosting::hprintln;
 
-/// Shared with tvmd-sim: the recording's layout and the controller's construction.
-#[allow(dead_code)]
-#[path = "../../../crates/tvmd-sim/src/control/wire.rs"]
-mod wire;
+// Shared with tvmd-sim (crate `tvmd-wire`): the recording's layout and the controller's
+// construction.
+use tvmd_wire as wire;
 
 use wire::{Reader, Writer, AGENTS};
 

@@ -28,4 +28,3 @@ pub fn cmd_montecarlo(args: MonteCarloRequest) -> Result<(), CliError> {
     }
     Ok(())
 }
-

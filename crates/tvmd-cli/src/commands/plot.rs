@@ -6,7 +6,6 @@ use tvmd_studies::plot::{self, PlotSeries};
 
 use crate::error::CliError;
 
-
 pub fn cmd_plot(logs: &[PathBuf], out: &Path) -> Result<(), CliError> {
     let mut all = Vec::new();
     for path in logs {
@@ -27,4 +26,3 @@ pub fn cmd_plot(logs: &[PathBuf], out: &Path) -> Result<(), CliError> {
     }
     Ok(())
 }
-

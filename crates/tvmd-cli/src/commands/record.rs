@@ -7,7 +7,6 @@ use tvmd_sim::runner::*;
 
 use crate::error::CliError;
 
-
 pub fn cmd_record_cycles(
     scenario: &str,
     out: &Path,
@@ -33,4 +32,3 @@ pub fn cmd_record_cycles(
     );
     Ok(())
 }
-

@@ -1,10 +1,28 @@
 //! The summary table `run` prints.
 
+use serde::Serialize;
+use tvmd_scenario::Precision;
+use tvmd_sim::sim::{PaperMetrics, RunSummary};
 
-
-
-
-use super::run::RunReport;
+/// Everything `run` writes to the summary JSON.
+#[derive(Serialize)]
+pub struct RunReport<'a> {
+    pub(crate) scenario: &'a str,
+    pub(crate) relaxation: f64,
+    pub(crate) allocator: &'a str,
+    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) null_space: Option<String>,
+    /// The controller's float type, `"f64"` or `"f32"`.
+    pub(crate) controller_precision: Precision,
+    /// Where the controller ran: `"host"` or the emulated target.
+    pub(crate) controller_target: &'a str,
+    /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
+    pub(crate) hover_roll_limit: Option<f64>,
+    pub(crate) summary: &'a RunSummary,
+    pub(crate) paper: PaperMetrics,
+    pub(crate) log: Option<String>,
+}
 
 fn opt(v: Option<f64>, unit: &str) -> String {
     v.map_or_else(|| "-".to_string(), |x| format!("{x:.6} {unit}"))
@@ -154,4 +172,3 @@ pub fn print_run(r: &RunReport<'_>) {
         println!("{k:<26} {v}");
     }
 }
-

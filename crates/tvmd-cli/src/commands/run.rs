@@ -5,39 +5,20 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use tvmd_log::paths::{check_outputs, create_parent, file_stem};
 use tvmd_log::LiveOptions;
+use tvmd_log::LogError;
 use tvmd_scenario::{Overrides, Precision, Scenario};
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::*;
-use tvmd_sim::sim::{PaperMetrics, RunSummary, SampleRetention};
-use tvmd_log::LogError;
+use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{PilTarget, SimError};
 use tvmd_studies::plot::{self, PlotSeries};
 
 use crate::error::CliError;
 
-use crate::interrupt::{catch_interrupts, INTERRUPT};
 use super::report::print_run;
+use super::report::RunReport;
+use crate::interrupt::{catch_interrupts, INTERRUPT};
 use crate::progress::{progress_bar, ticks_of};
-
-/// Everything `run` writes to the summary JSON.
-#[derive(Serialize)]
-pub struct RunReport<'a> {
-    pub(crate) scenario: &'a str,
-    pub(crate) relaxation: f64,
-    pub(crate) allocator: &'a str,
-    /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub(crate) null_space: Option<String>,
-    /// The controller's float type, `"f64"` or `"f32"`.
-    pub(crate) controller_precision: Precision,
-    /// Where the controller ran: `"host"` or the emulated target.
-    pub(crate) controller_target: &'a str,
-    /// `atan(c_y(1, s))`, the hover law's planned-roll limit.
-    pub(crate) hover_roll_limit: Option<f64>,
-    pub(crate) summary: &'a RunSummary,
-    pub(crate) paper: PaperMetrics,
-    pub(crate) log: Option<String>,
-}
 
 pub struct RunArgs {
     pub(crate) scenario: String,
@@ -193,4 +174,3 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> 
         .map_err(LogError::file(ACTION, path))?;
     Ok(())
 }
-

@@ -12,8 +12,8 @@ use tvmd_studies::plot::{self, PlotSeries};
 use crate::error::CliError;
 use std::sync::atomic::Ordering;
 
-use crate::interrupt::{catch_interrupts, INTERRUPT};
 use super::run::{plot_retention, print_stride, write_json};
+use crate::interrupt::{catch_interrupts, INTERRUPT};
 use crate::progress::{progress_bar, ticks_of};
 
 /// One row of the relaxation study.
@@ -154,4 +154,3 @@ pub fn cmd_sweep(
     }
     Ok(())
 }
-

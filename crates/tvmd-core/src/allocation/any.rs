@@ -9,20 +9,10 @@ use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, ConfigField};
 use crate::real::Real;
 
-/// Name of [`PseudoInverse`].
-pub const PSEUDO_INVERSE: &str = "pseudo-inverse";
-/// Name of [`WeightedPseudoInverse`].
-pub const WEIGHTED_PSEUDO_INVERSE: &str = "weighted-pseudo-inverse";
-/// Name of [`RedistributedPseudoInverse`] (the paper's).
-pub const REDISTRIBUTED_PSEUDO_INVERSE: &str = "redistributed-pseudo-inverse";
-/// Name of [`ExactBoundaryRedistribution`], the default (`docs/method.md`, "Allocation").
-pub const EXACT_BOUNDARY_REDISTRIBUTION: &str = "exact-boundary-redistribution";
-/// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without
-/// the feature can say what is missing).
-pub const CLARABEL: &str = "clarabel";
-/// Name of `SequentialConvexAllocator` (feature `clarabel`, known to every build as
-/// [`CLARABEL`] is).
-pub const CLARABEL_SEQUENTIAL: &str = "clarabel-sequential";
+use super::names::{
+    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+};
 
 #[cfg(feature = "clarabel")]
 const NAMES: &[&str] = &[

@@ -9,20 +9,22 @@ mod any;
 #[cfg(feature = "clarabel")]
 mod clarabel;
 mod exact_boundary;
+mod names;
 mod null_space;
 mod pseudo_inverse;
 mod redistributed;
 
-pub use any::{
-    AllocatorOptions, AnyAllocator, CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION,
-    PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
-};
+pub use any::{AllocatorOptions, AnyAllocator};
 #[cfg(feature = "clarabel")]
 pub use clarabel::{
     ClarabelAllocator, ClarabelStatus, FallbackReason, SequentialConvexAllocator, SequentialReport,
     SolveReport, StopReason,
 };
 pub use exact_boundary::ExactBoundaryRedistribution;
+pub use names::{
+    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+};
 pub use null_space::{
     NullSpaceObjective, NullSpaceReport, NullSpaceStage, MAX_NULL_SPACE_ITERATIONS,
 };

@@ -42,7 +42,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for PseudoInverse {
     }
 
     fn name(&self) -> &'static str {
-        super::any::PSEUDO_INVERSE
+        super::names::PSEUDO_INVERSE
     }
 }
 
@@ -111,7 +111,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for WeightedPseudoInverse<T, N> {
     }
 
     fn name(&self) -> &'static str {
-        super::any::WEIGHTED_PSEUDO_INVERSE
+        super::names::WEIGHTED_PSEUDO_INVERSE
     }
 }
 

@@ -108,6 +108,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
     }
 
     fn name(&self) -> &'static str {
-        super::any::REDISTRIBUTED_PSEUDO_INVERSE
+        super::names::REDISTRIBUTED_PSEUDO_INVERSE
     }
 }

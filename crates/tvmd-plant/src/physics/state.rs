@@ -117,4 +117,3 @@ impl MassError {
         *self == Self::default()
     }
 }
-

@@ -10,9 +10,9 @@ use tvmd_core::{
 
 use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
 use super::MAX_AGENTS;
+use crate::SimError;
 use tvmd_plant::math::from_rows;
 use tvmd_scenario::Scenario;
-use crate::SimError;
 
 pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
     SimError::InvalidScenario {

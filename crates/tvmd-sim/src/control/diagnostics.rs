@@ -9,8 +9,8 @@ use crate::diagnostics::{
     AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics,
     NullSpaceDiagnostics, PlannerDiagnostics,
 };
-use tvmd_plant::math::{planned_roll, to_rows};
 use tvmd_core::PlannerStatus;
+use tvmd_plant::math::{planned_roll, to_rows};
 
 /// The diagnostics of `out` for a team of `n` agents, with the controller's failure note.
 pub(super) fn cycle_diagnostics<T: CoreFloat>(

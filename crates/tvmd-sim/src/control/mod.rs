@@ -28,10 +28,10 @@ use tvmd_core::{AnyAllocator, FailureMask};
 use crate::diagnostics::{Diagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightOutput};
+use crate::SimError;
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceSample;
 use tvmd_scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
-use crate::SimError;
 
 mod config;
 mod convert;

@@ -19,10 +19,10 @@
 use tvmd_core::{FailureMask, Reference, RigidState};
 
 use super::engine::{CoreEngine, CycleAnswer, FailureAnswer};
-use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 use super::MAX_AGENTS;
 use crate::error::BoxedError;
 use crate::SimError;
+use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 
 pub use tvmd_wire::{
     cycle_words, EVENT_REFUSED, EVENT_SET, RECORDING_MAGIC as MAGIC, RECORDING_VERSION as VERSION,
@@ -141,7 +141,11 @@ impl CycleRecording {
 
     /// Parses a file written by [`CycleRecording::to_bytes`].
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, SimError> {
-        let bad = |why: &str| SimError::Log(tvmd_log::LogError::LogRead(format!("cycle recording: {why}")));
+        let bad = |why: &str| {
+            SimError::Log(tvmd_log::LogError::LogRead(format!(
+                "cycle recording: {why}"
+            )))
+        };
         if bytes.len() % 4 != 0 {
             return Err(bad("length is not a whole number of words"));
         }

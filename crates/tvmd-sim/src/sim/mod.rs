@@ -20,6 +20,7 @@
 //! scenario are compared sample by sample with [`difference`].
 
 pub mod difference;
+mod forces;
 pub mod retention;
 pub mod sample;
 pub mod summary;
@@ -32,14 +33,15 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::Serialize;
 
-use tvmd_plant::actuators::{agent_force_body, ActuatorBank, ActuatorCommand};
 use crate::flight::FlightController;
 use crate::sink::{LoggedTick, SceneRecord, Tick, TickSink};
-use tvmd_plant::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
-use tvmd_scenario::{Failure, Payload, PlantError, Scenario, StateNoise};
 use crate::SimError;
+use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand};
+use tvmd_plant::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
+use tvmd_scenario::{Failure, Payload, Scenario, StateNoise};
 
 pub use difference::FlightDifference;
+use forces::body_forces;
 pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
 pub use summary::{
@@ -55,32 +57,6 @@ pub const MAX_POSITION: f64 = 1e5;
 pub const MAX_SPEED: f64 = 300.0;
 /// Largest body rate (rad/s).
 pub const MAX_BODY_RATE: f64 = 200.0;
-
-/// The agents' body-frame forces for their actuator outputs, written over `out`.
-fn body_forces<'a>(
-    outputs: impl IntoIterator<Item = &'a ActuatorCommand>,
-    team: &TeamBody,
-    plant: &PlantError,
-    out: &mut Vec<Vector3<f64>>,
-) {
-    out.clear();
-    let outputs = outputs.into_iter().zip(&team.agents);
-    if plant.actuation_is_nominal() {
-        out.extend(outputs.map(|(c, a)| agent_force_body(c, a.quarter_turns)));
-    } else {
-        // Model error: the gimbal reaches its angles off by the offsets and the rotor makes
-        // a share of its thrust.
-        out.extend(outputs.enumerate().map(|(i, (c, a))| {
-            let [dx, dy] = plant.gimbal_offset(i);
-            let real = ActuatorCommand {
-                eta_x: c.eta_x + dx,
-                eta_y: c.eta_y + dy,
-                thrust: c.thrust * plant.efficiency(i),
-            };
-            agent_force_body(&real, a.quarter_turns)
-        }));
-    }
-}
 
 /// `Err(Diverged)` when the state at `t` is not finite or outside the valid range.
 fn check_divergence(t: f64, s: &PlantState) -> Result<(), SimError> {

@@ -3,9 +3,9 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use tvmd_plant::actuators::ActuatorCommand;
 use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
 use crate::flight::FlightOutput;
+use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceSample;

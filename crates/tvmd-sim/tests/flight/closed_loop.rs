@@ -8,10 +8,10 @@
 
 use std::f64::consts::PI;
 
-use tvmd_sim::control::{hover_roll_limit, AnyTvmdController};
 use tvmd_plant::reference::ReferenceConfig;
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::{Precision, Scenario};
+use tvmd_sim::control::{hover_roll_limit, AnyTvmdController};
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::PaperMetrics;
 use tvmd_sim::sim::{RunResult, Simulation};
 use tvmd_sim::GRAVITY;

@@ -3,8 +3,8 @@
 //! within the tolerances README.md and BENCHMARKS.md state against the default 1 ms, one
 //! iteration flight, and the two flights differ little at every controller tick.
 
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::Scenario;
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::{FlightDifference, RunResult};
 
 fn fly(toml: &str) -> RunResult {

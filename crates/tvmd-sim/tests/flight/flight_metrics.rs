@@ -2,8 +2,8 @@
 //! flight: the folded metrics equal the same definitions computed from the kept samples, and the
 //! verdict passes paper-tilt with the default bounds and names every bound a run misses.
 
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::Scenario;
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::{ErrorMetrics, RunResult, Sample};
 
 fn paper_tilt() -> (Scenario, RunResult) {

@@ -4,8 +4,8 @@
 //! precisions, since the classification runs in the controller's float type.
 
 use mcap::MessageStream;
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::{OnHoverLoss, Precision, Scenario};
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::RunResult;
 
 fn run(name: &str, land: bool, precision: Precision) -> RunResult {

@@ -1,7 +1,7 @@
 //! Flights of the loop: the paper's scenario, the plant and actuators, failures, the samples and
 //! the summary (one test binary; each module a topic).
 
-#[path = "../common.rs"]
+#[path = "../common/mod.rs"]
 mod common;
 
 mod closed_loop;

@@ -4,13 +4,13 @@
 //! stage moves forces inside `null(M)` only), the mean smallest margin to the admissible boundary
 //! rises and fewer periods end with an agent on a boundary.
 
-use tvmd_sim::runner::run_scenario;
+use tvmd_scenario::ScenarioError;
 use tvmd_scenario::{NullSpaceKind, Precision, Scenario};
-use tvmd_sim::SimError;
+use tvmd_sim::runner::run_scenario;
 
 fn field(text: &str) -> String {
     match Scenario::from_toml_str(text) {
-        Err(SimError::InvalidScenario { field, .. }) => field,
+        Err(ScenarioError::InvalidScenario { field, .. }) => field,
         other => panic!("{text}: {other:?}"),
     }
 }

@@ -4,12 +4,12 @@
 
 use nalgebra::Vector3;
 use tvmd_core::AnyAllocator;
-use tvmd_sim::control::{AnyTvmdController, MAX_AGENTS};
-use tvmd_sim::flight::FlightController;
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceConfig;
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::{Precision, Scenario};
+use tvmd_sim::control::{AnyTvmdController, MAX_AGENTS};
+use tvmd_sim::flight::FlightController;
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::FlightDifference;
 
 fn paper_tilt_in(precision: Precision) -> tvmd_sim::sim::RunResult {

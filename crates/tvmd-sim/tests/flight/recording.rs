@@ -4,13 +4,13 @@
 //! controller built from its configuration words (as the firmware does) reproduces every
 //! output bit for bit on the host.
 
+use tvmd_scenario::{Precision, Scenario};
 use tvmd_sim::control::recording::{cycle_words, CycleRecording, EVENT_REFUSED, EVENT_SET};
-use tvmd_wire::{self, Reader, Writer};
 use tvmd_sim::control::{core_of_scenario, wire_config};
 use tvmd_sim::runner::record_cycles;
-use tvmd_scenario::{Precision, Scenario};
+use tvmd_wire::{self as wire, Reader, Writer};
 
-const COMMITTED: &[u8] = include_bytes!("data/paper_tilt_f32.cycles");
+const COMMITTED: &[u8] = include_bytes!("../data/paper_tilt_f32.cycles");
 
 /// The recording pins the paper's allocator, the redistributed pseudo-inverse (not the
 /// default exact-boundary redistribution): it is the paper's f32 cycle the firmware replays, and

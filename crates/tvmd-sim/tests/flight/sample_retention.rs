@@ -2,8 +2,8 @@
 //! that keeps fewer samples (or none) reports the same numbers; a run that keeps none is not
 //! bounded by the memory its samples would take.
 
-use tvmd_sim::runner::{fly, Flight, RunSpec};
 use tvmd_scenario::Scenario;
+use tvmd_sim::runner::{fly, Flight, RunSpec};
 use tvmd_sim::sim::{RunResult, SampleRetention, SimOptions, Simulation, MAX_KEPT_SAMPLES};
 
 fn flown(samples: SampleRetention) -> RunResult {

@@ -2,8 +2,8 @@
 //! attitudes) against the physics they model: each steady state where the paper's law (no
 //! integral action) puts it, and every family flown to its end by more than one team.
 
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::{Air, Payload, Scenario, FAMILY_NAMES, HOVER_HEIGHT};
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::RunResult;
 use tvmd_sim::GRAVITY;
 

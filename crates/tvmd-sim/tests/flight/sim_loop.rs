@@ -1,15 +1,14 @@
 //! The control loop with test-only controllers: hover, landing, ZOH timing, failures, noise.
 
-
 use std::cell::RefCell;
 use std::rc::Rc;
 
 use crate::common::{zero_thrust, PdHover};
 use tvmd_plant::actuators::{ActuatorCommand, FailureKind};
-use tvmd_sim::flight::FlightOutput;
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::{ReferenceConfig, ReferenceSample};
 use tvmd_scenario::{Failure, Scenario, StateNoise};
+use tvmd_sim::flight::FlightOutput;
 use tvmd_sim::sim::Simulation;
 use tvmd_sim::SimError;
 

@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use mcap::MessageStream;
 use prost_reflect::{DescriptorPool, DynamicMessage, SerializeOptions};
 use serde_json::Value;
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::Scenario;
+use tvmd_sim::runner::run_scenario;
 
 /// `value` at the path `field[i].sub` (Foxglove's message path syntax, the subset we use).
 fn resolve<'a>(mut value: &'a Value, path: &str) -> Option<&'a Value> {

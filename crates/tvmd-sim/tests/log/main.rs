@@ -1,9 +1,8 @@
 //! The run logs: MCAP contents and schemas, the Foxglove layout, the controller's topics (one
 //! test binary; each module a topic).
 
-#[path = "../common.rs"]
+#[path = "../common/mod.rs"]
 mod common;
 
-mod controller_log;
 mod foxglove_layout;
 mod mcap_log;

@@ -1,7 +1,6 @@
 //! MCAP logs: protobuf channels with their schemas in the file, message counts, decimation,
 //! and finalisation on drop / error.
 
-
 use std::collections::BTreeMap;
 
 use crate::common::PdHover;
@@ -10,14 +9,16 @@ use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Vector3};
 use prost::Message;
 use prost_types::FileDescriptorSet;
+use tvmd_log::{proto, LogKind, RunLog};
 use tvmd_plant::actuators::ActuatorCommand;
-use tvmd_sim::flight::FlightOutput;
-use tvmd_log::{proto, LogKind, LogSettings, RunLog};
 use tvmd_plant::math::rot_x;
 use tvmd_plant::physics::{PlantState, TeamBody};
 use tvmd_plant::reference::{ReferenceConfig, ReferenceSample};
+use tvmd_scenario::LogSettings;
 use tvmd_scenario::Scenario;
+use tvmd_sim::flight::FlightOutput;
 use tvmd_sim::sim::Simulation;
+use tvmd_sim::McapSink;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;
 
@@ -154,7 +155,8 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
     let mut log = RunLog::create(&path).unwrap();
     let mut sim = Simulation::new(&s).unwrap();
     let mut ctl = PdHover::new(sim.team());
-    sim.run(&mut ctl, Some(&mut log)).unwrap();
+    sim.run(&mut ctl, Some(&mut McapSink::new(&mut log)))
+        .unwrap();
     log.finish().unwrap();
     let by_topic = counts(&std::fs::read(&path).unwrap());
     for topic in ["/state", "/reference", "/actuators", "/lyapunov", "/tf"] {
@@ -190,7 +192,7 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
                 },
             })
         };
-        sim.run(&mut ctl, Some(&mut log))
+        sim.run(&mut ctl, Some(&mut McapSink::new(&mut log)))
     };
     assert!(result.is_err());
     let bytes = std::fs::read(&path).unwrap();

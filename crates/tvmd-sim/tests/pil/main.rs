@@ -3,10 +3,10 @@
 //! planner saturation. Needs `qemu-system-arm` and the PIL firmware, so `#[ignore]`d in plain
 //! `cargo test`; `scripts/target.sh` builds the firmware and runs these with `--ignored`.
 
+use tvmd_scenario::{Precision, Scenario};
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::control::pil::PilTarget;
 use tvmd_sim::runner::{run_scenario, run_scenario_on};
-use tvmd_scenario::{Precision, Scenario};
 use tvmd_sim::sim::FlightDifference;
 use tvmd_sim::SimError;
 
@@ -117,7 +117,7 @@ fn pil_flight_with_an_agent_failure_matches_the_host() {
 fn pil_firmware_reports_a_corrupted_frame_and_an_unconfigured_cycle() {
     use std::time::{Duration, Instant};
     use tvmd_sim::control::pil::{firmware_path, frame, QemuLink};
-    use tvmd_sim::control::wire;
+    use tvmd_wire as wire;
 
     let mut link = QemuLink::spawn("mps2-an386", &firmware_path().unwrap()).unwrap();
     let soon = || Instant::now() + Duration::from_secs(30);

@@ -19,6 +19,7 @@
 //! faces) or an inexact minimizer; the docs (`docs/afs-atlas.md`) give the widths measured
 //! over the catalogue.
 
+pub mod bracket;
 pub mod certify;
 pub mod compare;
 pub mod inner;
@@ -31,6 +32,7 @@ mod run;
 pub mod section;
 pub mod support;
 
+pub use bracket::{bound_ray, RESTARTS};
 pub use certify::{certified_relaxation, CertifiedRelaxation, HeightRange};
 pub use compare::{compare, cone_radius, ConeComparison};
 pub use model::AtlasModel;

@@ -5,8 +5,9 @@
 use nalgebra::{Vector3, Vector6};
 use tvmd_core::GimbalCommand;
 
+use super::bracket::bound_ray;
 use super::model::AtlasModel;
-use super::ray::{bound_ray, Bracket, Ray, RayBound};
+use super::ray::{Bracket, Ray, RayBound};
 
 /// A cross-section to compute.
 #[derive(Clone, Copy, Debug, PartialEq)]

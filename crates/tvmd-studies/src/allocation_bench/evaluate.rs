@@ -7,9 +7,9 @@ use tvmd_core::nalgebra::{Vector3, Vector6};
 use tvmd_core::{AdmissibleSet, AllocationRequest, Allocator, AnyAllocator, GimbalCommand};
 
 use super::{failure_mask, team, team_size, AllocationSet, SetRequest, TeamRequests};
-use tvmd_sim::runner::run_scenario;
-use tvmd_scenario::{Overrides, Scenario};
 use crate::StudyError;
+use tvmd_scenario::{Overrides, Scenario};
+use tvmd_sim::runner::run_scenario;
 
 /// A request is allocated exactly when `e_f / ||u_fd|| <=` this (issue 16).
 pub const EXACT_TOLERANCE: f64 = 1e-9;

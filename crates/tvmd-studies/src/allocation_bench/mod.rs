@@ -14,11 +14,11 @@ mod commands;
 mod evaluate;
 mod generate;
 
+pub use commands::{allocator_names, evaluate_file, write_set};
 pub use evaluate::{
     closed_loop_rows, evaluate_requests, evaluate_set, markdown_by_kind, markdown_closed_loop,
     markdown_table, ClosedLoopRow, EvaluationRow, EXACT_TOLERANCE,
 };
-pub use commands::{allocator_names, evaluate_file, write_set};
 pub use generate::SET_TEAMS;
 
 use serde::{Deserialize, Serialize};
@@ -178,7 +178,8 @@ pub fn failure_mask<const N: usize>(
     team: &TeamConfig<f64, N>,
     failed: &[usize],
 ) -> Result<FailureMask<N>, StudyError> {
-    let invalid = |e: ConfigError| StudyError::InvalidTeam(format!("failed agents {failed:?}: {e}"));
+    let invalid =
+        |e: ConfigError| StudyError::InvalidTeam(format!("failed agents {failed:?}: {e}"));
     let mask = FailureMask::with_failed(failed).map_err(invalid)?;
     team.validate_failures(&mask).map_err(invalid)?;
     Ok(mask)

@@ -9,8 +9,8 @@ use serde::Serialize;
 use tvmd_core::team::presets::Preset;
 
 use super::{fly_all, Distributions, FlightRow, Study};
-use tvmd_scenario::Scenario;
 use crate::StudyError;
+use tvmd_scenario::Scenario;
 
 /// The allocators of the table by default (the Clarabel ones need the `clarabel` feature).
 pub const ALLOCATORS: [&str; 4] = [

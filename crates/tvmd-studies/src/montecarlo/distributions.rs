@@ -7,8 +7,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use tvmd_scenario::{PlantError, Scenario};
 use crate::StudyError;
+use tvmd_scenario::{PlantError, Scenario};
 
 /// Uniform distributions of the model error and the initial conditions. Every model-error
 /// half-width is multiplied by `model_error`, so one number sweeps the study from the nominal
@@ -164,9 +164,9 @@ impl Draw {
             let axis = nalgebra::Vector3::new(heading.cos(), heading.sin(), 0.0);
             let r =
                 nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), tilt)
-                    * nalgebra::Rotation3::from_matrix_unchecked(tvmd_plant::math::from_roll_pitch_yaw(
-                        s.initial_attitude,
-                    ));
+                    * nalgebra::Rotation3::from_matrix_unchecked(
+                        tvmd_plant::math::from_roll_pitch_yaw(s.initial_attitude),
+                    );
             s.initial_attitude = tvmd_plant::math::roll_pitch_yaw(r.matrix());
         }
         s.validate()?;

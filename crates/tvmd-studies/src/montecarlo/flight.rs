@@ -4,10 +4,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::distributions::{Distributions, Draw};
-use tvmd_sim::runner::{fly, RunSpec};
-use tvmd_scenario::Scenario;
-use tvmd_sim::sim::SampleRetention;
 use crate::StudyError;
+use tvmd_scenario::Scenario;
+use tvmd_sim::runner::{fly, RunSpec};
+use tvmd_sim::sim::SampleRetention;
 
 /// One flight: the base scenario (as TOML, so the spec stands alone), the team and allocator,
 /// and the draw's seed and index.

@@ -18,11 +18,11 @@ use std::path::{Path, PathBuf};
 
 pub use distributions::{Distributions, Draw};
 pub use flight::{fly_flight, FlightRow, FlightSpec};
-pub use study_run::{run, MonteCarloOutput, MonteCarloRequest};
 pub use report::{group_summaries, quantile, text_table, write_csv, GroupSummary};
+pub use study_run::{run, MonteCarloOutput, MonteCarloRequest};
 
-use tvmd_scenario::Scenario;
 use crate::StudyError;
+use tvmd_scenario::Scenario;
 
 /// Largest number of flights of one study.
 pub const MAX_FLIGHTS: usize = 10_000_000;

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use super::{fly_all, text_table, Distributions, ReportFiles, Study, StudyReport};
-use tvmd_scenario::Scenario;
 use crate::StudyError;
+use tvmd_scenario::Scenario;
 
 /// Arguments of `tvmd-sim montecarlo`.
 #[derive(Debug, Clone)]

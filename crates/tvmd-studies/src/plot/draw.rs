@@ -22,7 +22,6 @@ pub(crate) fn register_font() {
     });
 }
 
-
 pub(crate) fn plot_err(e: impl std::fmt::Display) -> StudyError {
     StudyError::Plot(e.to_string())
 }
@@ -208,4 +207,3 @@ pub(crate) fn ensure_parent(path: &Path) -> Result<(), StudyError> {
     }
     Ok(())
 }
-

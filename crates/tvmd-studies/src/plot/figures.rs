@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::draw::{ensure_parent, log_panel, panel, plot_err, register_font, series_of, Line, COLORS};
+use super::draw::{
+    ensure_parent, log_panel, panel, plot_err, register_font, series_of, Line, COLORS,
+};
 use super::PlotSeries;
 use crate::StudyError;
 
@@ -195,4 +197,3 @@ pub fn write_run_figures(
     lyapunov(series, &lyap)?;
     Ok(vec![state, lyap])
 }
-

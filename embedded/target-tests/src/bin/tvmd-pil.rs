@@ -1,7 +1,7 @@
 //! Processor-in-the-loop firmware: the f32 core on an emulated Cortex-M4F (QEMU `mps2-an386`)
 //! or Cortex-M7 (`mps2-an500`) serving `tvmd-sim run SCENARIO --pil cortex-m4|cortex-m7`.
 //!
-//! Frames (layout and kinds in tvmd-sim's `control/wire.rs`, shared verbatim) arrive on the
+//! Frames (layout and kinds in the crate `tvmd-wire`, shared with tvmd-sim) arrive on the
 //! boards' CMSDK UART0, which QEMU connects to its stdin/stdout (`-serial stdio`): the host
 //! configures the controller once, then sends failure masks and each period's state and
 //! reference; every request gets one reply (the core's whole output, a skipped cycle, a hover
@@ -18,9 +18,7 @@ use core::ptr::{read_volatile, write_volatile};
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 
-#[allow(dead_code)]
-#[path = "../../../../crates/tvmd-sim/src/control/wire.rs"]
-mod wire;
+use tvmd_wire as wire;
 
 use wire::{Reader, WireController, Writer, MAX_PAYLOAD_BYTES};
 

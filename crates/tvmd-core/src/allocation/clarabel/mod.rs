@@ -432,6 +432,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for ClarabelAllocator<T, N> {
     }
 
     fn name(&self) -> &'static str {
-        super::any::CLARABEL
+        super::names::CLARABEL
     }
 }

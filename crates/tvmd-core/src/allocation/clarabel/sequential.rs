@@ -437,6 +437,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for SequentialConvexAllocator<T, N
     }
 
     fn name(&self) -> &'static str {
-        super::super::any::CLARABEL_SEQUENTIAL
+        super::super::names::CLARABEL_SEQUENTIAL
     }
 }

@@ -466,6 +466,6 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
     }
 
     fn name(&self) -> &'static str {
-        super::any::EXACT_BOUNDARY_REDISTRIBUTION
+        super::names::EXACT_BOUNDARY_REDISTRIBUTION
     }
 }

@@ -6,6 +6,7 @@ use super::*;
 
 mod catalogue;
 mod certified;
+mod relaxation;
 
 /// One row of the certified-relaxation table: `(preset, s* nominal, s* without agent i)`.
 type CertifiedEntry = (Preset, Option<f64>, &'static [Option<f64>]);

@@ -6,9 +6,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::Instant;
 
 use super::PilError;
-use tvmd_wire::{
-    frame_crc, frame_header, FRAME_HEADER_BYTES, FRAME_MAGIC, MAX_PAYLOAD_BYTES,
-};
+use tvmd_wire::{frame_crc, frame_header, FRAME_HEADER_BYTES, FRAME_MAGIC, MAX_PAYLOAD_BYTES};
 
 /// One frame: kind, sequence number, payload.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -18,10 +18,10 @@ use std::time::{Duration, Instant};
 use tvmd_core::{FailureMask, Reference, RigidState};
 
 use super::engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 use super::MAX_AGENTS;
 use crate::error::BoxedError;
 use crate::SimError;
+use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 
 pub mod frame;
 mod link;

@@ -10,15 +10,15 @@
 mod fold;
 pub mod metrics;
 pub mod rules;
-mod verdict;
 #[cfg(test)]
 pub(crate) mod tests;
+mod verdict;
 
 use serde::{Deserialize, Serialize};
 
+use crate::sim::sample::Sample;
 use tvmd_plant::physics::PlantState;
 use tvmd_scenario::{Precision, Scenario};
-use crate::sim::sample::Sample;
 
 pub use fold::SummaryFold;
 pub use metrics::{EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics};

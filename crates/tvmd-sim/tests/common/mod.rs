@@ -3,10 +3,10 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use tvmd_plant::actuators::ActuatorCommand;
-use tvmd_sim::diagnostics::{Diagnostics, LyapunovDiagnostics};
-use tvmd_sim::flight::{FlightController, FlightOutput};
 use tvmd_plant::physics::{PlantState, TeamBody};
 use tvmd_plant::reference::ReferenceSample;
+use tvmd_sim::diagnostics::{Diagnostics, LyapunovDiagnostics};
+use tvmd_sim::flight::{FlightController, FlightOutput};
 use tvmd_sim::GRAVITY;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;

@@ -6,16 +6,17 @@ use std::collections::BTreeMap;
 use mcap::{MessageStream, Summary};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use prost::Message;
-use tvmd_sim::control::{core_reference, core_state, TvmdController};
-use tvmd_sim::flight::FlightController;
 use tvmd_log::proto;
 use tvmd_log::METADATA_SCENARIO;
 use tvmd_plant::physics::PlantState;
-use tvmd_studies::plot::{self, PlotSeries};
 use tvmd_plant::reference::ReferenceConfig;
-use tvmd_sim::runner::run_scenario;
 use tvmd_scenario::Scenario;
+use tvmd_sim::control::{core_reference, core_state, TvmdController};
+use tvmd_sim::flight::FlightController;
+use tvmd_sim::runner::run_scenario;
 use tvmd_sim::SimError;
+use tvmd_studies::plot::{self, PlotSeries};
+use tvmd_studies::StudyError;
 
 fn tmp_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("tvmd-sim-{name}-{}", std::process::id()));
@@ -121,7 +122,7 @@ fn short_run_log_has_every_channel_and_replots() {
     // Not a tvmd-sim log: a clear error.
     assert!(matches!(
         PlotSeries::from_mcap(b"not an mcap"),
-        Err(SimError::LogRead(_))
+        Err(StudyError::Log(tvmd_log::LogError::LogRead(_)))
     ));
 }
 
