@@ -1,4 +1,4 @@
-//! `tvmd.afs_atlas`: the AFS atlas of `tvmd_sim::afs_atlas` (a thin adapter: arguments in, the
+//! `tvmd.afs_atlas`: the AFS atlas of `tvmd_studies::afs_atlas` (a thin adapter: arguments in, the
 //! row as a dict out).
 
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! `tvmd.sim`'s Monte Carlo functions: thin adapters over `tvmd_sim::montecarlo`. Specs and rows
+//! `tvmd.sim`'s Monte Carlo functions: thin adapters over `tvmd_studies::montecarlo`. Specs and rows
 //! cross the boundary as JSON text so that any `concurrent.futures.Executor` (a process pool,
 //! a Dask cluster) can ship them; `tvmd/sim.py`'s `monte_carlo` composes them.
 

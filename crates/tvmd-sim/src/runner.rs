@@ -478,7 +478,7 @@ mod tests {
         );
         let e = relaxation_sweep(&base, &[0.5, 1.5], None, None, None).unwrap_err();
         assert!(
-            matches!(&e, SimError::InvalidScenario { field, .. } if field == "relaxation"),
+            matches!(&e, SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) if field == "relaxation"),
             "{e}"
         );
     }
