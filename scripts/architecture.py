@@ -12,7 +12,9 @@
   2. a crate's modules import each other in a cycle (below);
   3. a .rs file under a crate's src/ has more than MAX_FILE_LINES lines;
   4. a crate's tests/ folder builds more than MAX_TEST_BINARIES integration-test binaries
-     (top-level tests/*.rs plus tests/*/main.rs).
+     (top-level tests/*.rs plus tests/*/main.rs);
+  5. code of one crate reaches two modules deep into another workspace crate
+     (`other_crate::module::submodule::...`): each crate exports a curated surface.
 
 Checks 2-4 cover the workspace's crates and the separate workspaces embedded/*/ (found by
 their Cargo.toml, not through cargo, which would resolve their target-only dependencies).
@@ -570,6 +572,26 @@ def crate_roots(crate: dict) -> list[Path]:
 # ---------------------------------------------------------------------------------------------
 
 
+# `krate::module::submodule::` with snake_case modules, not a turbofish (`f::<T>`).
+DEEP_PATH = re.compile(r"\b(tvmd_[a-z0-9_]+)::([a-z][a-z0-9_]*)::([a-z][a-z0-9_]*)::(?!<)")
+
+
+def deep_paths(crate: dict, names: set[str]) -> list[str]:
+    """Paths from this crate's code two modules deep into another workspace crate."""
+    own = crate["name"].replace("-", "_")
+    found = []
+    for folder in ("src", "tests", "benches", "examples"):
+        for f in sorted((crate["dir"] / folder).rglob("*.rs")):
+            for k, line in enumerate(f.read_text().splitlines(), 1):
+                if line.lstrip().startswith("//"):
+                    continue
+                for m in DEEP_PATH.finditer(line):
+                    if m.group(1) != own and m.group(1) in names and m.group(2) != "nalgebra":
+                        found.append(f"{rel(f)}:{k}: `{m.group(0)}` reaches two modules deep "
+                                     f"into {m.group(1)}; export it from the crate's root")
+    return found
+
+
 def check_crate(crate: dict) -> list[str]:
     errors = []
     reached: set[Path] = set()
@@ -601,8 +623,11 @@ def main() -> int:
     if args.write:
         return 0
     print(f"crate table and names: {'ok' if not errors else 'FAILED'}")
+    names = {c["name"].replace("-", "_") for c in crates}
     for crate in crates + embedded_crates():
         found = check_crate(crate)
+        if crate in crates:
+            found += deep_paths(crate, names)
         print(f"{crate['name']} ({rel(crate['dir'])}): {'ok' if not found else f'{len(found)} problem(s)'}")
         errors += found
     if errors:

@@ -326,7 +326,7 @@ pub struct CatalogueArgs {
     pub jobs: Option<usize>,
 }
 
-impl From<CatalogueArgs> for tvmd_studies::montecarlo::catalogue::CatalogueSettings {
+impl From<CatalogueArgs> for tvmd_studies::catalogue::CatalogueSettings {
     fn from(a: CatalogueArgs) -> Self {
         Self {
             runs: a.runs,

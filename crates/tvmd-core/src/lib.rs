@@ -105,4 +105,5 @@ pub use offset_free::{Compensation, OffsetFree};
 pub use planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
 pub use projection::{project_force, project_force_in, ForceProjection};
 pub use real::Real;
+pub use team::presets::{self, Preset};
 pub use team::{AgentSpec, Arrangement, Navigator, TeamConfig};

@@ -48,7 +48,7 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("CAPACITY", CAPACITY)?;
-    m.add("GRAVITY", tvmd_core::team::presets::GRAVITY)?;
+    m.add("GRAVITY", tvmd_core::presets::GRAVITY)?;
     m.add("HAS_CLARABEL", cfg!(feature = "clarabel"))?;
     m.add("ALLOCATORS", PyTuple::new(py, allocation::ALLOCATORS)?)?;
     errors::register(m)?;

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use tvmd_scenario::{Overrides, Precision, Scenario};
-use tvmd_sim::control::pil::PilTarget;
+use tvmd_sim::pil::PilTarget;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 

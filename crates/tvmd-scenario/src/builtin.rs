@@ -3,13 +3,13 @@
 use std::f64::consts::PI;
 
 use super::{Failure, Scenario};
-use crate::ScenarioError;
+use crate::{ScenarioError, FAMILY_NAMES};
 use tvmd_plant::actuators::FailureKind;
 use tvmd_plant::physics::TeamBody;
 use tvmd_plant::reference::{PaperTilt, ReferenceConfig};
 
-/// Names of the built-in scenarios, for [`Scenario::builtin`].
-pub const BUILTIN_NAMES: &[&str] = &[
+/// The paper's scenarios and their variants (the families follow, from [`FAMILY_NAMES`]).
+const PAPER_NAMES: [&str; 11] = [
     "paper-tilt",
     "relaxation-0.25",
     "relaxation-0.5",
@@ -21,20 +21,30 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "a4-inc",
     "agent-failure",
     "a6-agent-failure",
-    // The scenario families (`families.rs`).
-    "hover",
-    "wind",
-    "payload",
-    "model-error",
-    "reference-jump",
-    "sine",
-    "figure-eight",
-    "initial-attitude-0.5",
-    "initial-attitude-1.0",
-    "initial-attitude-1.5",
-    "initial-attitude-2.0",
-    "initial-attitude-2.5",
 ];
+
+/// `a` then `b`, at compile time: the family names are written once, in `families.rs`.
+const fn concat<const N: usize>(a: &[&'static str], b: &[&'static str]) -> [&'static str; N] {
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < a.len() {
+        out[i] = a[i];
+        i += 1;
+    }
+    let mut j = 0;
+    while j < b.len() {
+        out[i + j] = b[j];
+        j += 1;
+    }
+    out
+}
+
+const ALL_NAMES: [&str; PAPER_NAMES.len() + FAMILY_NAMES.len()] =
+    concat(&PAPER_NAMES, FAMILY_NAMES);
+
+/// Names of the built-in scenarios, for [`Scenario::builtin`]: the paper's, then the scenario
+/// families' ([`FAMILY_NAMES`]).
+pub const BUILTIN_NAMES: &[&str] = &ALL_NAMES;
 
 impl Scenario {
     /// A built-in scenario by name (see [`BUILTIN_NAMES`]).

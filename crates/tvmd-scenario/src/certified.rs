@@ -4,12 +4,12 @@ use super::{LimitsConfig, Scenario};
 use tvmd_plant::GRAVITY;
 
 use crate::ScenarioError;
-use tvmd_core::team::presets::Preset;
+use tvmd_core::presets::Preset;
 
 impl Scenario {
     /// The certified relaxation `s*` of the scenario's team (`relaxation = "certified"`): the
     /// AFS atlas's value for a catalogue preset with the paper's limits
-    /// (`tvmd_core::team::presets::Preset::certified_relaxation`), the smallest over the
+    /// (`tvmd_core::presets::Preset::certified_relaxation`), the smallest over the
     /// nominal team and each agent a `[[failures]]` entry removes. Errors for explicit agents,
     /// other limits, or a degraded team without a certified value.
     pub fn certified_relaxation(&self) -> Result<f64, ScenarioError> {

@@ -136,7 +136,7 @@ mod tests {
 
     #[test]
     fn every_family_validates_with_every_catalogue_team() {
-        use tvmd_core::team::presets::Preset;
+        use tvmd_core::presets::Preset;
         for name in FAMILY_NAMES {
             let s = family(name).unwrap();
             s.validate().unwrap();

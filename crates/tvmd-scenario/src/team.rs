@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
-use tvmd_core::team::presets::Preset;
+use tvmd_core::presets::Preset;
 use tvmd_plant::{AgentBody, TeamBody, DEFAULT_COLLIDER_RADIUS};
 
 use crate::ScenarioError;
@@ -12,7 +12,7 @@ use crate::ScenarioError;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TeamSpec {
-    /// A catalogue team (`tvmd_core::team::presets::Preset::name`: `"a3-con"` .. `"t10-inc"`,
+    /// A catalogue team (`tvmd_core::presets::Preset::name`: `"a3-con"` .. `"t10-inc"`,
     /// `"a4-inc"` the paper's); used when `agents` is absent (default `"a4-inc"`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,

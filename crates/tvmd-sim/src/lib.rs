@@ -33,8 +33,8 @@ pub mod sim;
 pub mod sink;
 pub mod tick_log;
 
-pub use control::pil::{PilError, PilTarget};
-pub use control::recording::CycleRecording;
+pub use control::pil::{self, PilError, PilTarget};
+pub use control::recording::{self, CycleRecording};
 pub use control::{AnyTvmdController, TvmdController, MAX_AGENTS};
 pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};

@@ -17,4 +17,5 @@ pub mod montecarlo;
 pub mod plot;
 
 pub use error::StudyError;
+pub use montecarlo::catalogue;
 pub use plot::{PlotPoint, PlotSeries, PLOT_SAMPLES};

@@ -21,11 +21,9 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             .map(|(_, table)| print!("{table}"))
             .map_err(CliError::from),
         Command::Montecarlo(args) => montecarlo::cmd_montecarlo(args.into()),
-        Command::Catalogue(args) => {
-            tvmd_studies::montecarlo::catalogue::run_and_write(&args.into())
-                .map(|table| print!("{table}"))
-                .map_err(CliError::from)
-        }
+        Command::Catalogue(args) => tvmd_studies::catalogue::run_and_write(&args.into())
+            .map(|table| print!("{table}"))
+            .map_err(CliError::from),
         Command::Run {
             scenario,
             out,

@@ -5,7 +5,7 @@
 
 use tvmd_core::allocation::AllocatorOptions;
 use tvmd_core::nalgebra::{Vector3, Vector6};
-use tvmd_core::team::presets::GRAVITY;
+use tvmd_core::presets::GRAVITY;
 use tvmd_core::{
     AdmissibleSet, AllocationRequest, Allocator, AnyAllocator, GimbalCommand, TeamConfig,
 };

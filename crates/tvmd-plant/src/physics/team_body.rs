@@ -73,7 +73,7 @@ impl TeamBody {
 
     /// `n` agents of mass `mass` evenly on a circle of `radius` in the `x-y` plane, agent `i`
     /// at angle `2 pi i / n`; every second agent turned a quarter turn when `inconsistent`
-    /// (the layout of `tvmd_core::team::presets::ring`). Massless navigator.
+    /// (the layout of `tvmd_core::presets::ring`). Massless navigator.
     pub fn ring(n: usize, radius: f64, mass: f64, inconsistent: bool) -> Self {
         Self {
             agents: (0..n)
@@ -92,11 +92,11 @@ impl TeamBody {
         }
     }
 
-    /// A catalogue team (`tvmd_core::team::presets::Preset`) on a grid of `unit` metres with
+    /// A catalogue team (`tvmd_core::presets::Preset`) on a grid of `unit` metres with
     /// agents of `mass` kg, in the preset's agent order. Massless navigator, collider radius
     /// [`DEFAULT_COLLIDER_RADIUS`]. Errors when the core rejects the layout at that scale.
     pub fn preset(
-        preset: tvmd_core::team::presets::Preset,
+        preset: tvmd_core::presets::Preset,
         unit: f64,
         mass: f64,
     ) -> Result<Self, tvmd_core::ConfigError> {

@@ -5,8 +5,8 @@
 //! output bit for bit on the host.
 
 use tvmd_scenario::{Precision, Scenario};
-use tvmd_sim::control::recording::{cycle_words, CycleRecording, EVENT_REFUSED, EVENT_SET};
 use tvmd_sim::control::{core_of_scenario, wire_config};
+use tvmd_sim::recording::{cycle_words, CycleRecording, EVENT_REFUSED, EVENT_SET};
 use tvmd_sim::runner::record_cycles;
 use tvmd_wire::{self as wire, Reader, Writer};
 

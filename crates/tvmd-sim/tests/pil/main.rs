@@ -5,7 +5,7 @@
 
 use tvmd_scenario::{Precision, Scenario};
 use tvmd_sim::control::hover_roll_limit;
-use tvmd_sim::control::pil::PilTarget;
+use tvmd_sim::pil::PilTarget;
 use tvmd_sim::runner::{run_scenario, run_scenario_on};
 use tvmd_sim::sim::FlightDifference;
 use tvmd_sim::SimError;
@@ -116,7 +116,7 @@ fn pil_flight_with_an_agent_failure_matches_the_host() {
 #[ignore = "needs qemu-system-arm and the PIL firmware; run by scripts/target.sh"]
 fn pil_firmware_reports_a_corrupted_frame_and_an_unconfigured_cycle() {
     use std::time::{Duration, Instant};
-    use tvmd_sim::control::pil::{firmware_path, frame, QemuLink};
+    use tvmd_sim::pil::{firmware_path, frame, QemuLink};
     use tvmd_wire as wire;
 
     let mut link = QemuLink::spawn("mps2-an386", &firmware_path().unwrap()).unwrap();

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use tvmd_core::team::presets::Preset;
+use tvmd_core::presets::Preset;
 use tvmd_core::TeamConfig;
 
 use super::certify::HeightRange;

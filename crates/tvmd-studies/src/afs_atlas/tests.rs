@@ -5,7 +5,7 @@ use super::*;
 use nalgebra::{Matrix4, Vector3, Vector4, Vector6};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tvmd_core::team::presets::Preset;
+use tvmd_core::presets::Preset;
 use tvmd_core::{FailureMask, GimbalCommand, Relaxation, TeamConfig};
 
 fn team(preset: Preset) -> TeamConfig<f64, 16> {

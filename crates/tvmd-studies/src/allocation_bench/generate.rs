@@ -114,7 +114,7 @@ fn team_requests(
         .working(&mask)
         .map(|(_, a)| a.position.norm())
         .sum::<f64>();
-    let weight = t.mass() * tvmd_core::team::presets::GRAVITY;
+    let weight = t.mass() * tvmd_core::presets::GRAVITY;
     for certificate in [
         Certificate::ForceNorm,
         Certificate::TorqueNorm,

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use serde::Serialize;
-use tvmd_core::team::presets::Preset;
+use tvmd_core::presets::Preset;
 
 use super::{fly_all, Distributions, FlightRow, Study};
 use crate::StudyError;
