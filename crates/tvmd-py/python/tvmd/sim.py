@@ -56,8 +56,21 @@ def monte_carlo(
         model_errors=model_errors,
         distributions=distributions,
     )
+    if out is not None:
+        # Checked before any flight: a bad `out` must not cost the study.
+        _sim._check_report_dir(out)
     if executor is None:
-        rows = _sim.monte_carlo_fly(specs, jobs=jobs)
+        try:
+            rows = _sim.monte_carlo_fly(specs, jobs=jobs)
+        except KeyboardInterrupt as e:
+            # Ctrl-C: the finished flights' report travels with the exception, marked partial.
+            finished = getattr(e, "partial", None)
+            if finished is not None:
+                report = _sim.monte_carlo_report(finished)
+                report["interrupted"] = True
+                report["flights_asked"] = len(specs)
+                e.partial = report
+            raise
     else:
         if jobs is not None:
             raise ValueError("give `jobs` (threads here) or `executor`, not both")
