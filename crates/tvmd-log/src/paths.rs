@@ -93,34 +93,14 @@ pub fn create_parent(path: &Path, action: &'static str) -> Result<(), LogError> 
 }
 
 /// Checks outputs before anything runs: no output is given twice and none is an input
-/// ([`LogError::PathClash`], naming both roles and the path), none is an existing directory,
-/// and each one's directory exists (it is made) and takes a new file ([`LogError::File`],
-/// naming the path). `outputs` and `inputs` are `(role, path)` pairs.
+/// ([`LogError::PathClash`], naming both roles and the path), then each one by
+/// [`check_output`]. `outputs` and `inputs` are `(role, path)` pairs.
 pub fn check_outputs(
     outputs: &[(String, &Path)],
     inputs: &[(String, &Path)],
 ) -> Result<(), LogError> {
     let ids: Vec<PathBuf> = outputs.iter().map(|(_, p)| identity(p)).collect();
     for (k, ((role, path), id)) in outputs.iter().zip(&ids).enumerate() {
-        // "", "a/", "x/..": no file name to write (found by the hostile suite: such a log
-        // failed only when renamed into place, after the whole flight).
-        let text = path.as_os_str().to_string_lossy();
-        if path.file_name().is_none() || text.ends_with('/') || text.ends_with('\\') {
-            return Err(LogError::InvalidArgument {
-                name: role.clone(),
-                reason: format!("`{}` names no file", path.display()),
-            });
-        }
-        if path.is_dir() {
-            return Err(LogError::File {
-                action: "write an output",
-                path: path.to_path_buf(),
-                source: std::io::Error::new(
-                    std::io::ErrorKind::IsADirectory,
-                    format!("{role} is a directory"),
-                ),
-            });
-        }
         if let Some(((first, _), _)) = outputs.iter().zip(&ids).take(k).find(|(_, i)| *i == id) {
             return Err(LogError::PathClash(format!(
                 "{first} and {role} are both `{}`",
@@ -134,10 +114,37 @@ pub fn check_outputs(
             )));
         }
     }
-    for (_, path) in outputs {
-        check_writable(path, "write an output")?;
+    for (role, path) in outputs {
+        check_output(path, role, "write an output")?;
     }
     Ok(())
+}
+
+/// Checks one output file for `action` (e.g. `"write the MCAP log"`) before any work: it names
+/// a file ([`LogError::InvalidArgument`] for `""`, `"a/"`, `"x/.."`), is not an existing
+/// directory, and its directory exists (it is made) and takes a new file ([`check_writable`]);
+/// errors name the path (and `role`).
+pub fn check_output(path: &Path, role: &str, action: &'static str) -> Result<(), LogError> {
+    // "", "a/", "x/..": no file name to write (found by the hostile suite: such a log failed
+    // only when renamed into place, after the whole flight).
+    let text = path.as_os_str().to_string_lossy();
+    if path.file_name().is_none() || text.ends_with('/') || text.ends_with('\\') {
+        return Err(LogError::InvalidArgument {
+            name: role.to_string(),
+            reason: format!("`{}` names no file", path.display()),
+        });
+    }
+    if path.is_dir() {
+        return Err(LogError::File {
+            action,
+            path: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                format!("{role} is a directory"),
+            ),
+        });
+    }
+    check_writable(path, action)
 }
 
 /// Makes `path`'s directory and checks that it takes a new file (a temporary probe, removed at

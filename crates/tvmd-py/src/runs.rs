@@ -98,8 +98,12 @@ pub(crate) fn run_request(
     item: &Bound<'_, PyAny>,
     k: usize,
 ) -> PyResult<(RunSpec, Option<PathBuf>)> {
+    // The log is checked before any run flies, its errors named as the threads name a run's.
     let checked = |r: RunRequest| -> PyResult<(RunSpec, Option<PathBuf>)> {
-        let spec = r.spec().map_err(value_error)?;
+        let spec = r.flight().map_err(value_error)?;
+        let log = spec.log.as_deref().map(|l| (WRITE, l));
+        r.check_log()
+            .map_err(|e| sim_error(e, &batch_label(k, &spec), log))?;
         Ok((spec, r.input().map(Path::to_path_buf)))
     };
     let name = format!("runs[{k}]");
@@ -235,7 +239,7 @@ pub(crate) fn run_specs(
     jobs: Option<usize>,
     label: impl Fn(usize, &RunSpec) -> String,
 ) -> PyResult<Vec<PySimResult>> {
-    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    check_logs(&specs, &label)?;
     let outcomes = run_interruptibly(py, specs, jobs)?;
     let results = outcomes.into_iter().enumerate();
     results
@@ -249,6 +253,21 @@ pub(crate) fn run_specs(
             }
         })
         .collect()
+}
+
+/// Checks a batch's logs before any run flies ([`tvmd_log::paths`]): each one (the error
+/// prefixed with `label(k)`, as a failure of run `k` is), then no two the same.
+pub(crate) fn check_logs(
+    specs: &[RunSpec],
+    label: &impl Fn(usize, &RunSpec) -> String,
+) -> PyResult<()> {
+    for (k, spec) in specs.iter().enumerate() {
+        if let Some(log) = spec.log.as_deref() {
+            tvmd_log::paths::check_output(log, "the log", "write the MCAP log")
+                .map_err(|e| sim_error(e, &label(k, spec), Some((WRITE, log))))?;
+        }
+    }
+    runner::check_batch_outputs(specs, &[]).map_err(value_error)
 }
 
 /// Runs the batch on tvmd-sim's pool ([`interruptible`]): on `KeyboardInterrupt` (or any

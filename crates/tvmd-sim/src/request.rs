@@ -138,22 +138,38 @@ impl RunRequest {
     }
 
     /// Loads the scenario, applies the overrides, validates the result for the target
-    /// ([`RunSpec::on_target`]) and checks the log: not the scenario file, not a directory, in
-    /// a writable directory ([`tvmd_log::paths::check_outputs`]). Nothing is written but the
-    /// log's directory.
+    /// ([`RunSpec::on_target`]) and checks the log ([`RunRequest::check_log`]). Nothing is
+    /// written but the log's directory.
     pub fn spec(&self) -> Result<RunSpec, SimError> {
+        let spec = self.flight()?;
+        self.check_log()?;
+        Ok(spec)
+    }
+
+    /// [`RunRequest::spec`] without the log check (for a caller that checks it itself, naming
+    /// the run in a batch).
+    pub fn flight(&self) -> Result<RunSpec, SimError> {
         let scenario = self.scenario.load()?.with_overrides(&self.overrides())?;
         let mut spec = RunSpec::on_target(scenario, self.log.clone(), self.pil, self.precision)?;
         spec.samples = self.samples;
-        if let Some(log) = &self.log {
-            let inputs: Vec<(String, &Path)> = self
-                .input()
-                .map(|p| ("scenario file".to_string(), p))
-                .into_iter()
-                .collect();
-            tvmd_log::paths::check_outputs(&[("the log".to_string(), log)], &inputs)?;
-        }
         Ok(spec)
+    }
+
+    /// Checks the log before any work ([`tvmd_log::paths`]): it names a file, not a directory,
+    /// in a writable directory (made if missing), and is not the scenario file this request
+    /// reads.
+    pub fn check_log(&self) -> Result<(), SimError> {
+        let Some(log) = &self.log else {
+            return Ok(());
+        };
+        tvmd_log::paths::check_output(log, "the log", "write the MCAP log")?;
+        let inputs: Vec<(String, &Path)> = self
+            .input()
+            .map(|p| ("scenario file".to_string(), p))
+            .into_iter()
+            .collect();
+        tvmd_log::paths::check_outputs(&[("the log".to_string(), log)], &inputs)?;
+        Ok(())
     }
 }
 
