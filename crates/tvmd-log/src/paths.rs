@@ -204,7 +204,11 @@ pub fn temporary(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-    path.with_file_name(format!(".tmp-{}-{k}-{name}", std::process::id()))
+    // At most the last 200 characters (the extension kept): a name the file system takes
+    // must not become one it refuses.
+    let skip = name.chars().count().saturating_sub(200);
+    let tail: String = name.chars().skip(skip).collect();
+    path.with_file_name(format!(".tmp-{}-{k}-{tail}", std::process::id()))
 }
 
 /// Renames the finished `temporary` onto `path` (for `action`); on failure the temporary is
@@ -336,6 +340,11 @@ mod tests {
         assert!(left.is_empty(), "{left:?}");
         assert_ne!(temporary(&out), temporary(&out));
         assert_eq!(temporary(&out).extension(), out.extension());
+        // A long name the file system takes stays one it takes.
+        let long = tmp.join(format!("{}.mcap", "a".repeat(240)));
+        check_outputs(&[("log".into(), &long)], &[]).unwrap();
+        let t = temporary(&long);
+        assert!(t.file_name().unwrap().len() < 230 && t.extension() == long.extension());
         std::fs::remove_dir_all(&tmp).unwrap();
     }
 }
