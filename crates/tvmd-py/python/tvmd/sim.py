@@ -74,6 +74,7 @@ def monte_carlo(
     else:
         if jobs is not None:
             raise ValueError("give `jobs` (threads here) or `executor`, not both")
+        _check_executor(executor)
         rows = list(executor.map(_fly, specs))
     return _sim.monte_carlo_report(rows, out=out)
 
@@ -97,9 +98,18 @@ def _run_swept(item, index):
     return _sim._run_item(item, index, sweep=True)
 
 
+def _check_executor(executor):
+    # A TypeError naming the argument, not an AttributeError from inside (hostile suite).
+    if not callable(getattr(executor, "map", None)):
+        raise TypeError(
+            f"`executor` must be a concurrent.futures.Executor (with `map`), got {type(executor).__name__}"
+        )
+
+
 def _on_executor(items, jobs, executor, fly):
     if jobs is not None:
         raise ValueError("give `jobs` (threads here) or `executor`, not both")
+    _check_executor(executor)
     return list(executor.map(fly, items, range(len(items))))
 
 
