@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tvmd_scenario::Scenario;
 use tvmd_studies::montecarlo::{
-    fly_all_until, fly_flight, Distributions, FlightRow, FlightSpec, Study, StudyReport,
+    fly_all_until, fly_flight_until, Distributions, FlightRow, FlightSpec, Study, StudyReport,
 };
 
 use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
@@ -76,7 +76,12 @@ fn monte_carlo_specs(
 #[pyfunction]
 fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
     let spec = FlightSpec::from_json(spec).map_err(value_error)?;
-    let row = py.detach(|| fly_flight(&spec)).map_err(value_error)?;
+    // Ctrl-C stops the flight at its next controller tick (an executor's task too).
+    let row = match interruptible(py, |cancel| fly_flight_until(&spec, Some(cancel)))? {
+        Ended::Finished(row) => row.map_err(value_error)?,
+        Ended::Interrupted { signal, .. } => return Err(signal),
+    };
+    let row = row.ok_or_else(|| PyValueError::new_err("the flight was stopped"))?;
     serde_json::to_string(&row).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 

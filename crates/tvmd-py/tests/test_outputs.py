@@ -118,6 +118,8 @@ LONG_CALLS = {
     "relaxation_sweep": f"sim.relaxation_sweep([0.5, 1.0], toml={LONG!r}, max_samples=0)",
     "monte_carlo": "sim.monte_carlo(toml='duration = 2.0\\n', runs=100000, jobs=1)",
     "afs_atlas": "tvmd.afs_atlas('a8-inc', directions=3600, certify_heights=200)",
+    # One executor task of a study.
+    "monte_carlo_flight": f"sim.monte_carlo_flight(sim.monte_carlo_specs(toml={LONG!r}, runs=1)[0])",
 }
 
 
