@@ -26,7 +26,9 @@ What it found (each fixed, with a test):
 * Extreme magnitudes of names: a 240-character log name the file system takes was refused,
   its temporary name being too long; the temporary name now keeps at most 200 characters.
 
-Listed, not changed: ``out=""`` (Monte Carlo, ``monte_carlo_report``) means the working
+Listed, not changed: an empty complex array where real numbers are expected (e.g.
+``thrust_direction(np.zeros((0, 2), complex))``) is accepted, holding no value, with NumPy's
+``ComplexWarning`` from the conversion (a non-empty one is a ``TypeError``); ``out=""`` (Monte Carlo, ``monte_carlo_report``) means the working
 directory; an output path that is a symbolic link is replaced by the file (renamed into place),
 not written through; of the mutated built-ins about one in eight still flies (the rest fail to
 parse or validate, each naming the field), so the flight itself sees fewer examples than the
