@@ -108,6 +108,8 @@ rm -rf target/wheels
 # builds the wheel users install.
 .venv/bin/maturin build --profile ci --features clarabel -m crates/tvmd-py/Cargo.toml -o target/wheels
 .venv/bin/python -m pip install --quiet --force-reinstall --no-deps target/wheels/tvmd-*.whl
+# Includes the hostile suite (tests/test_hostile_properties.py: Hypothesis, derandomized, about
+# 35 s): random arguments to every public callable and mutated scenario documents.
 .venv/bin/python -m pytest -q crates/tvmd-py/tests
 
 step "all tests passed"

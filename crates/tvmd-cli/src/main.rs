@@ -20,7 +20,12 @@
 //!
 //! SIGINT or SIGTERM during `run` or `sweep` stops the flights at their next controller tick:
 //! the MCAP logs are finalised and the summary written with what was simulated (marked
-//! `interrupted`), and the exit status is 130. A second signal exits at once.
+//! `interrupted`), and the exit status is 130. `montecarlo` writes the report of the flights
+//! that finished (and says it is partial), `catalogue` the finished flights, `afs` nothing;
+//! each exits with 130. A second signal exits at once.
+//!
+//! Every output path follows one rule (`tvmd_log::paths`): checked before any work, written
+//! to a temporary file and renamed into place, every I/O error naming its path.
 
 mod args;
 mod commands;
@@ -44,7 +49,8 @@ fn main() -> ExitCode {
     let result = commands::dispatch(args::Cli::parse());
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(CliError::Interrupted(m)) => {
+        Err(CliError::Interrupted(m))
+        | Err(CliError::Study(tvmd_studies::StudyError::Interrupted(m))) => {
             eprintln!("interrupted: {m}");
             ExitCode::from(INTERRUPTED_STATUS)
         }

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
@@ -26,6 +26,8 @@ pub struct RunLog {
     writer: Option<LogWriter>,
     written: Written,
     mcap: Option<McapFile>,
+    // The temporary file the MCAP sink writes and the path it is renamed to when finished.
+    mcap_paths: Option<(PathBuf, PathBuf)>,
     live: Option<LiveServer>,
     finished: bool,
     // Dropped last: the channels and sinks belong to it.
@@ -45,14 +47,17 @@ impl RunLog {
             writer: None,
             written,
             mcap: None,
+            mcap_paths: None,
             live: None,
             finished: false,
             context,
         }
     }
 
-    /// A log writing to a new MCAP file at `path` (truncated; parent directories created).
-    /// I/O errors name the path ([`LogError::File`]).
+    /// A log writing to a new MCAP file at `path` (parent directories created). The file is
+    /// written under a temporary name in the same directory and renamed onto `path` when the
+    /// log is finished ([`crate::paths`]), so a reader, or a second run writing the same path,
+    /// never sees a half-written file. I/O errors name the path ([`LogError::File`]).
     pub fn create(path: impl AsRef<Path>) -> Result<Self, LogError> {
         let mut log = Self::new();
         log.add_mcap(path)?;
@@ -70,7 +75,10 @@ impl RunLog {
             });
         }
         crate::paths::create_parent(path, ACTION)?;
-        let file = BufWriter::new(File::create(path).map_err(LogError::file(ACTION, path))?);
+        let temporary = crate::paths::temporary(path);
+        let file = File::create(&temporary).map_err(LogError::file(ACTION, path))?;
+        self.mcap_paths = Some((temporary, path.to_path_buf()));
+        let file = BufWriter::new(file);
         // Chunks are compressed on the log's writer thread. mcap's default hands each chunk to
         // zstd's own worker pool (one thread per physical CPU), whose threads then compete with
         // the simulation loop for the cores, and with every other flight of a batch.
@@ -85,7 +93,12 @@ impl RunLog {
             .context
             .mcap_writer_with_options(options)
             .create(file)
-            .map_err(LogError::foxglove)?;
+            .map_err(|e| {
+                if let Some((temporary, _)) = self.mcap_paths.take() {
+                    let _ = std::fs::remove_file(temporary);
+                }
+                LogError::foxglove(e)
+            })?;
         self.mcap = Some(handle);
         Ok(())
     }
@@ -183,8 +196,17 @@ impl RunLog {
             live.stop();
         }
         if let Some(m) = self.mcap.take() {
-            let mut file = m.close().map_err(LogError::foxglove)?;
-            file.flush()?;
+            let closed = m.close().map_err(LogError::foxglove).and_then(|mut file| {
+                file.flush()?;
+                Ok(())
+            });
+            if let Some((temporary, path)) = self.mcap_paths.take() {
+                if let Err(e) = closed {
+                    let _ = std::fs::remove_file(&temporary);
+                    return Err(e);
+                }
+                crate::paths::rename_into_place(&temporary, &path, "write the MCAP log")?;
+            }
         }
         drained
     }

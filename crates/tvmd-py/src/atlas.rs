@@ -6,10 +6,11 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use tvmd_studies::afs_atlas::{run, AtlasRequest};
+use tvmd_studies::afs_atlas::{run_until, AtlasRequest};
 
 use crate::convert::{count, indices, record_to_py, Int};
 use crate::errors::value_error;
+use crate::interrupt::{interruptible, Ended};
 
 /// Directions per cross-section: tvmd-sim's bounds (`afs_atlas::report::atlas_entry`).
 const DIRECTIONS: (i128, i128) = (4, 3600);
@@ -59,7 +60,11 @@ fn afs_atlas<'py>(
         plots,
         json: None,
     };
-    let (mut rows, _) = py.detach(|| run(&args)).map_err(value_error)?;
+    let (mut rows, _) = match interruptible(py, |cancel| run_until(&args, Some(cancel)))? {
+        Ended::Finished(done) => done.map_err(value_error)?,
+        // Ctrl-C: the atlas stops within one ray; nothing is written.
+        Ended::Interrupted { signal, .. } => return Err(signal),
+    };
     let row = rows
         .pop()
         .ok_or_else(|| PyValueError::new_err("the atlas returned no row"))?;

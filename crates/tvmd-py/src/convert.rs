@@ -3,7 +3,7 @@
 //! (relaxation, iteration cap, null-space stage, sample retention, scenario). Nothing here
 //! panics: every shape is checked. It imports only [`crate::errors`].
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use numpy::ndarray::ArrayD;
@@ -16,6 +16,7 @@ use pyo3::{intern, IntoPyObjectExt};
 use tvmd_core::{AgentCommand, Relaxation};
 use tvmd_scenario::{NullSpaceConfig, Scenario};
 use tvmd_sim::sim::SampleRetention;
+use tvmd_sim::ScenarioSource;
 
 use crate::errors::{sim_error, value_error, OrRaise, READ};
 
@@ -417,14 +418,10 @@ pub(crate) fn relaxation_arg(
 
 /// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
 pub(crate) fn null_space_arg(spec: Option<&str>) -> PyResult<Option<NullSpaceConfig>> {
-    let Some(spec) = spec else {
-        return Ok(None);
-    };
-    let config: NullSpaceConfig = spec
-        .parse()
-        .map_err(|e| PyValueError::new_err(format!("`null_space`: {e}")))?;
-    config.validate().map_err(value_error)?;
-    Ok(Some(config))
+    // The one parser of the option, shared with the command line and `tvmd.sim.run`.
+    spec.map(tvmd_sim::RunRequest::parse_null_space)
+        .transpose()
+        .map_err(value_error)
 }
 
 /// A `max_samples` argument (named `name`): `None` keeps every tick, `n >= 0` at most `n`
@@ -441,22 +438,30 @@ pub(crate) fn jobs_arg(jobs: Option<&Int>) -> PyResult<Option<usize>> {
     jobs.map(|j| j.to("jobs", 1, USIZE_MAX)).transpose()
 }
 
-/// The scenario of a `scenario` argument: a `str` by the CLI's name-or-file rule
-/// (`Scenario::load`), an `os.PathLike` a file.
-pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
+/// The scenario source of a `scenario` argument ([`ScenarioSource`]): a `str` by the CLI's
+/// name-or-file rule (`Scenario::load`), an `os.PathLike` a file.
+pub(crate) fn scenario_source(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<ScenarioSource> {
     if let Ok(s) = obj.cast::<PyString>() {
-        let s = s.to_cow()?;
-        return Scenario::load(&s).map_err(|e| sim_error(e, "", Some((READ, Path::new(&*s)))));
+        return Ok(ScenarioSource::NameOrFile(s.to_cow()?.into_owned()));
     }
     if obj.hasattr("__fspath__")? {
         let path: PathBuf = obj.extract().map_err(|e| {
             PyTypeError::new_err(format!("`{name}` is not a usable file path: {e}"))
         })?;
-        return Scenario::from_file(&path).map_err(|e| sim_error(e, "", Some((READ, &path))));
+        return Ok(ScenarioSource::File(path));
     }
     let got = obj.get_type().name()?;
     Err(PyTypeError::new_err(format!(
         "`{name}` must be a built-in scenario name or a path to a TOML file (str or \
          os.PathLike), got {got}"
     )))
+}
+
+/// The scenario of a `scenario` argument ([`scenario_source`], loaded); errors name the file.
+pub(crate) fn scenario_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Scenario> {
+    let source = scenario_source(obj, name)?;
+    source.load().map_err(|e| {
+        let file = source.file().map(|p| (READ, p));
+        sim_error(e, "", file)
+    })
 }

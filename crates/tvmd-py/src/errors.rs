@@ -143,7 +143,7 @@ impl SimErrorKind for SimError {
             SimError::Physics(e) => e.kind(),
             SimError::Log(e) => e.kind(),
             SimError::Interrupted => ErrorKind::Interrupted,
-            SimError::InvalidScenario { .. } => ErrorKind::Value,
+            SimError::InvalidScenario { .. } | SimError::InvalidArgument { .. } => ErrorKind::Value,
             _ => ErrorKind::Runtime,
         }
     }

@@ -7,13 +7,14 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tvmd_sim::runner;
+use tvmd_sim::runner::RunSpec;
 use tvmd_sim::sim::SampleRetention;
 
 use crate::convert::{retention_arg, Int};
 use crate::errors::value_error;
 use crate::runs::RunArgs;
-use crate::runs::{batch_label, run_item, run_items, run_specs, sweep_label, sweep_run_specs};
+use crate::runs::{batch_label, check_logs, run_item, run_items, run_specs};
+use crate::runs::{sweep_label, sweep_run_specs};
 use crate::sim_result::{PySimResult, SimData};
 
 /// A `SimResult` from its pickle (`SimResult.__reduce__`).
@@ -31,7 +32,7 @@ fn sim_result_from_state(state: &[u8]) -> PyResult<PySimResult> {
 #[pyo3(name = "_check_runs")]
 fn check_runs(runs: &Bound<'_, PyAny>) -> PyResult<usize> {
     let specs = run_items(runs)?;
-    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    check_logs(&specs, &batch_label)?;
     Ok(specs.len())
 }
 
@@ -86,7 +87,7 @@ fn relaxation_sweep_runs<'py>(
         ..RunArgs::default()
     };
     let specs = sweep_run_specs(relaxations, args, mcap_dir)?;
-    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    check_logs(&specs, &|_, s: &RunSpec| sweep_label(s))?;
     specs
         .into_iter()
         .map(|spec| {

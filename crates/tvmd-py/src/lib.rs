@@ -6,11 +6,11 @@
 //! `python/tvmd/_tvmd.pyi` and `sim.pyi`.
 //!
 //! Modules import one way (no circle; `a <- b` reads "b imports a"): `errors` and `record`
-//! import no module of the crate, `convert` only `errors`, and every other module imports
+//! import no module of the crate, nor does `interrupt` (Ctrl-C for long calls), `convert` only `errors`, and every other module imports
 //! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
 //! `afs, allocation, law, planner, team <- controller`, and for the simulator
-//! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert` and
-//! `errors`. This file imports every module and no module imports it.
+//! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert`, `errors` and
+//! `interrupt`. This file imports every module and no module imports it.
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -31,6 +31,7 @@ mod controller;
 mod convert;
 mod errors;
 mod executor;
+mod interrupt;
 mod law;
 mod montecarlo;
 mod planner;

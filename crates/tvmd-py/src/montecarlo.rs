@@ -8,11 +8,12 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tvmd_scenario::Scenario;
 use tvmd_studies::montecarlo::{
-    fly_all, fly_flight, Distributions, FlightRow, FlightSpec, Study, StudyReport,
+    fly_all_until, fly_flight_until, Distributions, FlightRow, FlightSpec, Study, StudyReport,
 };
 
 use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
 use crate::errors::value_error;
+use crate::interrupt::{interruptible, Ended};
 
 /// The study's flights as JSON specs. See the stub.
 #[pyfunction]
@@ -75,7 +76,12 @@ fn monte_carlo_specs(
 #[pyfunction]
 fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
     let spec = FlightSpec::from_json(spec).map_err(value_error)?;
-    let row = py.detach(|| fly_flight(&spec)).map_err(value_error)?;
+    // Ctrl-C stops the flight at its next controller tick (an executor's task too).
+    let row = match interruptible(py, |cancel| fly_flight_until(&spec, Some(cancel)))? {
+        Ended::Finished(row) => row.map_err(value_error)?,
+        Ended::Interrupted { signal, .. } => return Err(signal),
+    };
+    let row = row.ok_or_else(|| PyValueError::new_err("the flight was stopped"))?;
     serde_json::to_string(&row).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
@@ -89,12 +95,30 @@ fn monte_carlo_fly(py: Python<'_>, specs: Vec<String>, jobs: Option<Int>) -> PyR
         .map(|s| FlightSpec::from_json(s))
         .collect::<Result<Vec<_>, _>>()
         .map_err(value_error)?;
-    let rows = py
-        .detach(|| fly_all(&specs, jobs, None))
-        .map_err(value_error)?;
-    rows.iter()
-        .map(|r| serde_json::to_string(r).map_err(|e| PyValueError::new_err(e.to_string())))
-        .collect()
+    let json = |rows: &[FlightRow]| -> PyResult<Vec<String>> {
+        rows.iter()
+            .map(|r| serde_json::to_string(r).map_err(|e| PyValueError::new_err(e.to_string())))
+            .collect()
+    };
+    match interruptible(py, |cancel| fly_all_until(&specs, jobs, None, Some(cancel)))? {
+        Ended::Finished(flown) => json(&flown.map_err(value_error)?.rows),
+        // Ctrl-C: the flights in the air stop at their next tick; the finished rows travel
+        // with the exception (`partial`), so that nothing finished is silently lost.
+        Ended::Interrupted { signal, partial } => {
+            let rows = partial.map(|f| f.rows).unwrap_or_default();
+            let message = format!(
+                "monte_carlo stopped: {} of {} flights finished (their rows: the exception's \
+                 `partial`)",
+                rows.len(),
+                specs.len()
+            );
+            let value = signal.value(py);
+            let _ = value.setattr("partial", json(&rows)?);
+            // Python 3.11+: the note prints under the traceback.
+            let _ = value.call_method1("add_note", (message,));
+            Err(signal)
+        }
+    }
 }
 
 /// The report of JSON rows: the flights and groups as lists of dicts, the overall success
@@ -117,11 +141,20 @@ fn monte_carlo_report<'py>(
     record_to_py(py, &report)
 }
 
+/// Checks a report directory before a study flies (`monte_carlo(out=...)`): not a file, made
+/// if missing, writable; the error names the path.
+#[pyfunction]
+#[pyo3(name = "_check_report_dir")]
+fn check_report_dir(out: PathBuf) -> PyResult<()> {
+    tvmd_log::paths::check_output_dir(&out, "the report directory (`out`)").map_err(value_error)
+}
+
 /// Adds the Monte Carlo functions to the `sim` submodule.
 pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(monte_carlo_specs, sim)?)?;
     sim.add_function(wrap_pyfunction!(monte_carlo_flight, sim)?)?;
     sim.add_function(wrap_pyfunction!(monte_carlo_fly, sim)?)?;
     sim.add_function(wrap_pyfunction!(monte_carlo_report, sim)?)?;
+    sim.add_function(wrap_pyfunction!(check_report_dir, sim)?)?;
     Ok(())
 }

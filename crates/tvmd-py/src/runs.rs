@@ -3,25 +3,26 @@
 //! the batch flown on tvmd-sim's pool with the GIL released ([`run_specs`]). Both `sim` (the
 //! threads) and `executor` (one run per task) build on it.
 
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::{Path, PathBuf};
 
-use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
+<<<<<<< HEAD
 use tvmd_scenario::{Overrides, Precision, Scenario};
 use tvmd_sim::pil::PilTarget;
+=======
+>>>>>>> hostile
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
+use tvmd_sim::{RunRequest, ScenarioSource};
 
 use crate::convert::Int;
-use crate::convert::{null_space_arg, retention_arg, scalars, scenario_arg, shape_error};
+use crate::convert::{retention_arg, scalars, scenario_source, shape_error};
 use crate::errors::{sim_error, value_error, WRITE};
+use crate::interrupt::{interruptible, Ended};
 use crate::sim_result::{PySimResult, SimData};
-
-/// The default scenario of `run` and `relaxation_sweep`.
-const DEFAULT_SCENARIO: &str = "paper-tilt";
 
 /// The keys a `run_many` dict may hold (the keyword arguments of `run`).
 const RUN_KEYS: &[&str] = &[
@@ -54,51 +55,73 @@ pub(crate) struct RunArgs<'a, 'py> {
 }
 
 impl RunArgs<'_, '_> {
-    /// Loads the scenario, applies the overrides and validates the result.
-    pub(crate) fn spec(self, scenario_name: &str) -> PyResult<RunSpec> {
-        let mut scenario = match (self.scenario.filter(|s| !s.is_none()), self.toml) {
+    /// The one run request of the CLI and Python ([`RunRequest`]): the string options parsed
+    /// by its parser (errors name the option).
+    pub(crate) fn request(self, scenario_name: &str) -> PyResult<RunRequest> {
+        let scenario = match (self.scenario.filter(|s| !s.is_none()), self.toml) {
             (Some(_), Some(_)) => {
                 return Err(PyValueError::new_err(
                     "give either `scenario` (a name or a file) or `toml` (TOML text), not both",
                 ))
             }
-            (Some(s), None) => scenario_arg(s, scenario_name)?,
-            (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
-            (None, None) => Scenario::builtin(DEFAULT_SCENARIO).map_err(value_error)?,
+            (Some(s), None) => scenario_source(s, scenario_name)?,
+            (None, Some(text)) => ScenarioSource::Toml(text),
+            (None, None) => ScenarioSource::Default,
         };
-        let precision = self.precision.as_deref().map(str::parse::<Precision>);
-        let precision = precision.transpose().map_err(value_error)?;
-        let pil = self.pil.as_deref().map(str::parse::<PilTarget>);
-        let pil = pil
-            .transpose()
-            .map_err(|e| PyValueError::new_err(format!("`pil`: {e}")))?;
-        let overrides = Overrides {
+        RunRequest {
+            scenario,
             relaxation: self.relaxation,
             allocator: self.allocator,
-            precision,
-            null_space: null_space_arg(self.null_space.as_deref())?,
             team: self.team,
-        };
-        overrides.apply(&mut scenario).map_err(value_error)?;
-        let spec = RunSpec::on_target(scenario, self.mcap, pil, precision);
-        let mut spec = spec.map_err(value_error)?;
-        spec.samples = self.samples;
-        Ok(spec)
+            log: self.mcap,
+            samples: self.samples,
+            ..RunRequest::default()
+        }
+        .with_strings(
+            self.precision.as_deref(),
+            self.pil.as_deref(),
+            self.null_space.as_deref(),
+        )
+        .map_err(value_error)
+    }
+
+    /// Loads the scenario, applies the overrides and validates the result
+    /// ([`RunRequest::spec`]: the log is checked too, and never the scenario file).
+    pub(crate) fn spec(self, scenario_name: &str) -> PyResult<RunSpec> {
+        self.request(scenario_name)?.spec().map_err(value_error)
     }
 }
 
 /// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments; `k` its
 /// index, which errors name.
 pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
+    Ok(run_request(item, k)?.0)
+}
+
+/// A `run_many` entry as its checked spec and the scenario file it reads, if any.
+pub(crate) fn run_request(
+    item: &Bound<'_, PyAny>,
+    k: usize,
+) -> PyResult<(RunSpec, Option<PathBuf>)> {
+    // The log is checked before any run flies, its errors named as the threads name a run's.
+    let checked = |r: RunRequest| -> PyResult<(RunSpec, Option<PathBuf>)> {
+        let spec = r.flight().map_err(value_error)?;
+        let log = spec.log.as_deref().map(|l| (WRITE, l));
+        r.check_log()
+            .map_err(|e| sim_error(e, &batch_label(k, &spec), log))?;
+        Ok((spec, r.input().map(Path::to_path_buf)))
+    };
     let name = format!("runs[{k}]");
     let Ok(dict) = item.cast::<PyDict>() else {
         if item.is_instance_of::<PyString>() || item.hasattr("__fspath__")? {
             let scenario = Some(item);
-            return RunArgs {
-                scenario,
-                ..RunArgs::default()
-            }
-            .spec(&name);
+            return checked(
+                RunArgs {
+                    scenario,
+                    ..RunArgs::default()
+                }
+                .request(&name)?,
+            );
         }
         let got = item.get_type().name()?;
         return Err(PyTypeError::new_err(format!(
@@ -134,7 +157,7 @@ pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
     let scenario = dict.get_item("scenario")?;
     let max_samples = opt::<Int>(dict, &name, "max_samples")?;
     let samples = retention_arg(max_samples.as_ref(), &format!("{name}['max_samples']"))?;
-    RunArgs {
+    let request = RunArgs {
         scenario: scenario.as_ref(),
         toml: opt(dict, &name, "toml")?,
         mcap: opt(dict, &name, "mcap")?,
@@ -146,21 +169,34 @@ pub(crate) fn run_item(item: &Bound<'_, PyAny>, k: usize) -> PyResult<RunSpec> {
         samples,
         team: opt(dict, &name, "team")?,
     }
-    .spec(&format!("{name}['scenario']"))
+    .request(&format!("{name}['scenario']"))?;
+    checked(request)
 }
 
-/// The runs of a `run_many` batch, each loaded and validated ([`run_item`]).
+/// The runs of a `run_many` batch, each loaded and validated ([`run_item`]), and the batch's
+/// paths checked: no log given twice, none a scenario file of the batch.
 pub(crate) fn run_items(runs: &Bound<'_, PyAny>) -> PyResult<Vec<RunSpec>> {
     if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
         return Err(PyTypeError::new_err(
             "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
         ));
     }
-    runs.try_iter()
+    let items = runs
+        .try_iter()
         .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?
         .enumerate()
-        .map(|(k, item)| run_item(&item?, k))
-        .collect()
+        .map(|(k, item)| run_request(&item?, k))
+        .collect::<PyResult<Vec<_>>>()?;
+    let inputs: Vec<(String, &Path)> = items
+        .iter()
+        .enumerate()
+        .filter_map(|(k, (_, input))| {
+            Some((format!("scenario file of runs[{k}]"), input.as_deref()?))
+        })
+        .collect();
+    let specs: Vec<RunSpec> = items.iter().map(|(spec, _)| spec.clone()).collect();
+    runner::check_batch_paths(&specs, &[], &inputs).map_err(value_error)?;
+    Ok(specs)
 }
 
 /// The runs of a relaxation study as `relaxation_sweep` takes them: `args`' scenario once per
@@ -208,7 +244,7 @@ pub(crate) fn run_specs(
     jobs: Option<usize>,
     label: impl Fn(usize, &RunSpec) -> String,
 ) -> PyResult<Vec<PySimResult>> {
-    runner::check_batch_outputs(&specs, &[]).map_err(value_error)?;
+    check_logs(&specs, &label)?;
     let outcomes = run_interruptibly(py, specs, jobs)?;
     let results = outcomes.into_iter().enumerate();
     results
@@ -224,32 +260,33 @@ pub(crate) fn run_specs(
         .collect()
 }
 
-/// How often a waiting batch looks for Python signals (Ctrl-C).
-const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
+/// Checks a batch's logs before any run flies ([`tvmd_log::paths`]): each one (the error
+/// prefixed with `label(k)`, as a failure of run `k` is), then no two the same.
+pub(crate) fn check_logs(
+    specs: &[RunSpec],
+    label: &impl Fn(usize, &RunSpec) -> String,
+) -> PyResult<()> {
+    for (k, spec) in specs.iter().enumerate() {
+        if let Some(log) = spec.log.as_deref() {
+            tvmd_log::paths::check_output(log, "the log", "write the MCAP log")
+                .map_err(|e| sim_error(e, &label(k, spec), Some((WRITE, log))))?;
+        }
+    }
+    runner::check_batch_outputs(specs, &[]).map_err(value_error)
+}
 
-/// Runs the batch on tvmd-sim's pool while this thread, GIL released, checks for Python signals
-/// every [`SIGNAL_POLL`]: on `KeyboardInterrupt` (or any signal handler's exception) the
-/// flights stop at their next controller tick (logs finalised), and the exception is raised.
+/// Runs the batch on tvmd-sim's pool ([`interruptible`]): on `KeyboardInterrupt` (or any
+/// signal handler's exception) the flights stop at their next controller tick (logs
+/// finalised), and the exception is raised.
 fn run_interruptibly(
     py: Python<'_>,
     specs: Vec<RunSpec>,
     jobs: Option<usize>,
 ) -> PyResult<Vec<RunOutcome>> {
-    let cancel = AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        let batch = scope.spawn(|| runner::run_many_until(specs, jobs, None, Some(&cancel)));
-        while !batch.is_finished() {
-            py.detach(|| std::thread::sleep(SIGNAL_POLL));
-            if let Err(signal) = py.check_signals() {
-                cancel.store(true, Ordering::Relaxed);
-                // The flights stop within one controller tick; join them so that their logs
-                // are complete when the exception reaches the caller.
-                let _ = py.detach(|| batch.join());
-                return Err(signal);
-            }
-        }
-        batch
-            .join()
-            .map_err(|_| PyRuntimeError::new_err("tvmd-sim: the batch thread panicked"))
-    })
+    match interruptible(py, |cancel| {
+        runner::run_many_until(specs, jobs, None, Some(cancel))
+    })? {
+        Ended::Finished(outcomes) => Ok(outcomes),
+        Ended::Interrupted { signal, .. } => Err(signal),
+    }
 }

@@ -36,7 +36,8 @@ def test_ctrl_c_stops_a_run_promptly_and_its_log_is_complete(tmp_path):
     duration = 400.0
 
     def interrupt_once_flying():
-        while not log.exists():
+        # The log is written under a temporary name beside it while the run flies.
+        while not any(p.name.startswith(".tmp-") for p in tmp_path.iterdir()):
             time.sleep(0.005)
         time.sleep(0.2)
         _thread.interrupt_main()

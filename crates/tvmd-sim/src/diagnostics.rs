@@ -125,6 +125,11 @@ pub struct HoverDiagnostics {
     /// The scenario's `failure_response` started a landing on this classification.
     #[serde(default)]
     pub landing: bool,
+    /// The controller refused the new failure mask (the remaining team cannot produce every
+    /// wrench) and keeps allocating to the agents it does not know have failed: why. The
+    /// classification is then `capable: false` with no margin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refused: Option<String>,
 }
 
 /// Optional diagnostics returned by a controller; every present part is logged and recorded.

@@ -30,6 +30,14 @@ pub enum SimError {
         /// What is wrong with it.
         reason: String,
     },
+    /// An option of a run request outside its range (`pil`, `null_space`, ...).
+    #[error("invalid argument `{name}`: {reason}")]
+    InvalidArgument {
+        /// The option.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// The controller returned an error.
     #[error("controller failed at t = {t:.3} s: {source}")]
     Controller {

@@ -15,7 +15,9 @@
 //! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller, in
 //!   f64 or f32, in process or on a processor in the loop;
 //! - [`runner`]: runs with the tvmd controller: one ([`run_scenario`]) or a batch on one
-//!   worker pool ([`run_many`], [`relaxation_sweep`]).
+//!   worker pool ([`run_many`], [`relaxation_sweep`]);
+//! - [`request`]: one run as the command line and Python ask for it ([`RunRequest`]: the
+//!   scenario, its overrides, the target, the log; one parser of its string options).
 //!
 //! The scenario is data ([`tvmd_scenario`]), the log a listener ([`tvmd_log`]), the studies
 //! above this crate (`tvmd-studies`). Conventions: SI units, z up, gravity `g = 9.81 m/s^2`
@@ -28,6 +30,7 @@ pub mod diagnostics;
 pub mod error;
 pub mod flight;
 pub mod pool;
+pub mod request;
 pub mod runner;
 pub mod sim;
 pub mod sink;
@@ -39,6 +42,7 @@ pub use control::{AnyTvmdController, TvmdController, MAX_AGENTS};
 pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};
 pub use flight::{FlightController, FlightOutput};
+pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{
     FlightDifference, PaperMetrics, RunResult, RunSummary, Sample, SampleRetention, SimOptions,

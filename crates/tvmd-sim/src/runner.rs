@@ -357,6 +357,16 @@ pub fn sweep_specs(
 /// Checks a batch's logs before any run starts ([`tvmd_log::paths::check_outputs`]): two runs
 /// writing one file would corrupt it, and `extra` outputs (a summary) must differ from them.
 pub fn check_batch_outputs(specs: &[RunSpec], extra: &[(String, &Path)]) -> Result<(), SimError> {
+    check_batch_paths(specs, extra, &[])
+}
+
+/// [`check_batch_outputs`], and no log or `extra` output is one of `inputs` (the batch's
+/// scenario files, `(role, path)`).
+pub fn check_batch_paths(
+    specs: &[RunSpec],
+    extra: &[(String, &Path)],
+    inputs: &[(String, &Path)],
+) -> Result<(), SimError> {
     let mut outputs: Vec<(String, &Path)> = specs
         .iter()
         .enumerate()
@@ -368,7 +378,7 @@ pub fn check_batch_outputs(specs: &[RunSpec], extra: &[(String, &Path)]) -> Resu
         })
         .collect();
     outputs.extend(extra.iter().cloned());
-    Ok(tvmd_log::paths::check_outputs(&outputs, &[])?)
+    Ok(tvmd_log::paths::check_outputs(&outputs, inputs)?)
 }
 
 /// The relaxation study: [`sweep_specs`] flown by [`run_many`]. An invalid `s` or a log path

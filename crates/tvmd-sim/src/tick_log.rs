@@ -369,6 +369,7 @@ mod tests {
             limiting_agent: None,
             limit: "thrust".into(),
             landing: true,
+            refused: None,
         };
         assert_eq!(hover(0.0, &h).limiting_agent, None);
         let h = HoverDiagnostics {

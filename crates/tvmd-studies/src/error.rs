@@ -55,6 +55,10 @@ pub enum StudyError {
     /// A figure could not be drawn or written.
     #[error("plot error: {0}")]
     Plot(String),
+    /// Stopped by a signal (SIGINT, SIGTERM, Ctrl-C in Python) or the caller's flag: what was
+    /// finished, and where it was kept, in words.
+    #[error("interrupted: {0}")]
+    Interrupted(String),
     /// A task of a study panicked (a bug) or did not finish.
     #[error("internal error in tvmd-studies (please report): {0}")]
     Internal(String),

@@ -8,22 +8,36 @@ mod run;
 mod sweep;
 
 use tvmd_log::LiveOptions;
-use tvmd_scenario::{Overrides, Scenario, BUILTIN_NAMES};
+use tvmd_scenario::{Scenario, BUILTIN_NAMES};
+use tvmd_sim::{RunRequest, ScenarioSource};
 use tvmd_studies::allocation_bench;
 
 use crate::args::{Cli, Command};
 use crate::error::CliError;
+use crate::interrupt::{catch_interrupts, INTERRUPT};
 
 /// Runs the parsed command.
 pub fn dispatch(cli: Cli) -> Result<(), CliError> {
     match cli.command {
-        Command::Afs(args) => tvmd_studies::afs_atlas::run(&args.into())
-            .map(|(_, table)| print!("{table}"))
-            .map_err(CliError::from),
+        Command::Afs(args) => {
+            catch_interrupts();
+            tvmd_studies::afs_atlas::run_until(&args.into(), Some(&INTERRUPT))
+                .map(|(_, table)| print!("{table}"))
+                .map_err(CliError::from)
+        }
         Command::Montecarlo(args) => montecarlo::cmd_montecarlo(args.into()),
+<<<<<<< HEAD
         Command::Catalogue(args) => tvmd_studies::catalogue::run_and_write(&args.into())
             .map(|table| print!("{table}"))
             .map_err(CliError::from),
+=======
+        Command::Catalogue(args) => {
+            catch_interrupts();
+            tvmd_studies::montecarlo::catalogue::run_and_write_until(&args.into(), Some(&INTERRUPT))
+                .map(|table| print!("{table}"))
+                .map_err(CliError::from)
+        }
+>>>>>>> hostile
         Command::Run {
             scenario,
             out,
@@ -75,21 +89,14 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             jobs,
             precision,
             allocator,
-        } => run::precision_arg(precision.as_deref()).and_then(|precision| {
-            sweep::cmd_sweep(
-                &relaxations,
-                &scenario,
-                Overrides {
-                    precision,
-                    allocator,
-                    ..Overrides::default()
-                },
-                plots,
-                logs,
-                summary,
-                jobs,
-            )
-        }),
+        } => RunRequest {
+            scenario: ScenarioSource::NameOrFile(scenario),
+            allocator,
+            ..RunRequest::default()
+        }
+        .with_strings(precision.as_deref(), None, None)
+        .map_err(CliError::from)
+        .and_then(|request| sweep::cmd_sweep(&relaxations, &request, plots, logs, summary, jobs)),
         Command::Plot { logs, out } => plot::cmd_plot(&logs, &out),
         Command::AllocationSet { out, seed } => allocation_bench::write_set(&out, seed)
             .map(|m| println!("{m}"))

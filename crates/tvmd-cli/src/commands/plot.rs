@@ -7,6 +7,8 @@ use tvmd_studies::plot::{self, PlotSeries};
 use crate::error::CliError;
 
 pub fn cmd_plot(logs: &[PathBuf], out: &Path) -> Result<(), CliError> {
+    // The rule of every output ([`tvmd_log::paths`]): checked before any work.
+    tvmd_log::paths::check_output_dir(out, "the figure directory (--out)")?;
     let mut all = Vec::new();
     for path in logs {
         let series = PlotSeries::from_mcap_file(path)?;

@@ -108,6 +108,7 @@ pub fn print_run(r: &RunReport<'_>) {
         ),
         ("saturated periods", s.saturated_periods.to_string()),
         ("skipped cycles", s.cycle_errors.to_string()),
+        ("failure masks", hover_classifications(s)),
         (
             "final position",
             format!(
@@ -171,4 +172,31 @@ pub fn print_run(r: &RunReport<'_>) {
     for (k, v) in rows {
         println!("{k:<26} {v}");
     }
+}
+
+/// The run's failure masks as the controller took them: each hover classification, and each
+/// mask it refused (it then keeps allocating to the agents it was told have failed).
+fn hover_classifications(s: &RunSummary) -> String {
+    if s.hover_classifications.is_empty() {
+        return "-".into();
+    }
+    let each: Vec<String> = s
+        .hover_classifications
+        .iter()
+        .map(|h| match &h.refused {
+            Some(why) => format!("t = {:.2} s REFUSED ({why})", h.time),
+            None => format!(
+                "t = {:.2} s {} (margin {:.3}{})",
+                h.time,
+                if h.capable {
+                    "hover-capable"
+                } else {
+                    "NOT hover-capable"
+                },
+                h.margin,
+                if h.landing { ", landing" } else { "" }
+            ),
+        })
+        .collect();
+    each.join("; ")
 }

@@ -3,14 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use tvmd_log::paths::{check_outputs, create_parent, file_stem};
+use tvmd_log::paths::{check_output_dir, check_outputs, file_stem, write_file};
 use tvmd_log::LiveOptions;
-use tvmd_log::LogError;
-use tvmd_scenario::{Overrides, Precision, Scenario};
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::*;
 use tvmd_sim::sim::SampleRetention;
-use tvmd_sim::{PilTarget, SimError};
+use tvmd_sim::{RunRequest, ScenarioSource};
 use tvmd_studies::plot::{self, PlotSeries};
 
 use crate::error::CliError;
@@ -35,27 +33,20 @@ pub struct RunArgs {
     pub(crate) live: Option<LiveOptions>,
 }
 
-/// The `--precision` argument (clap has checked the spelling; the parse names the field).
-pub fn precision_arg(p: Option<&str>) -> Result<Option<Precision>, CliError> {
-    Ok(p.map(str::parse).transpose()?)
-}
-
 pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
-    let precision = precision_arg(a.precision.as_deref())?;
-    let pil = a
-        .pil
-        .as_deref()
-        .map(str::parse::<PilTarget>)
-        .transpose()
-        .map_err(|e| SimError::Pil(Box::new(e)))?;
-    let scenario = Scenario::load(&a.scenario)?.with_overrides(&Overrides {
+    // The one run request of the command line and Python: parses the options (errors name
+    // them), loads the scenario, applies the overrides and validates.
+    let request = RunRequest {
+        scenario: ScenarioSource::NameOrFile(a.scenario.clone()),
         relaxation: a.relaxation,
         allocator: a.allocator,
-        precision,
         null_space: a.null_space,
         team: a.team,
-    })?;
-    let mut spec = RunSpec::on_target(scenario, None, pil, precision)?;
+        samples: plot_retention(a.plots.is_some()),
+        ..RunRequest::default()
+    }
+    .with_strings(a.precision.as_deref(), a.pil.as_deref(), None)?;
+    let mut spec = request.spec()?;
     let stem = file_stem(&spec.scenario.name);
     let log = if a.no_log {
         None
@@ -75,22 +66,19 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     }
     if let Some(p) = &summary_path {
         outputs.push(("the summary (--summary)".into(), p));
-        create_parent(p, "write the summary")?;
     }
-    let input = Path::new(&a.scenario);
-    let inputs: Vec<(String, &Path)> = if input.is_file() {
-        vec![("scenario file".into(), input)]
-    } else {
-        Vec::new()
-    };
+    let inputs: Vec<(String, &Path)> = request
+        .input()
+        .map(|p| ("scenario file".to_string(), p))
+        .into_iter()
+        .collect();
     check_outputs(&outputs, &inputs)?;
     if let Some(dir) = &a.plots {
-        std::fs::create_dir_all(dir).map_err(LogError::file("create the figure directory", dir))?;
+        check_output_dir(dir, "the figure directory (--plots)")?;
     }
     // Memory stays flat: the summary folds every tick, the log streams it, and only the
     // figures need samples (a bounded, evenly spaced set).
     spec.log.clone_from(&log);
-    spec.samples = plot_retention(a.plots.is_some());
     let scenario = &spec.scenario;
     catch_interrupts();
     let bar = progress_bar(ticks_of(scenario), &scenario.name);
@@ -167,10 +155,9 @@ pub fn print_stride(stride: usize) {
     }
 }
 
+/// Writes `value` as pretty JSON to `path` through a temporary file, errors naming the path.
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CliError> {
-    const ACTION: &str = "write the summary";
-    create_parent(path, ACTION)?;
-    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
-        .map_err(LogError::file(ACTION, path))?;
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    write_file(path, "write the summary", text.as_bytes())?;
     Ok(())
 }

@@ -3,10 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use tvmd_log::paths::create_parent;
-use tvmd_scenario::{Overrides, Precision, Scenario};
+use tvmd_log::paths::check_output_dir;
+use tvmd_scenario::Precision;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::*;
+use tvmd_sim::RunRequest;
 use tvmd_studies::plot::{self, PlotSeries};
 
 use crate::error::CliError;
@@ -36,14 +37,13 @@ struct SweepRow {
 
 pub fn cmd_sweep(
     relaxations: &[f64],
-    scenario_arg: &str,
-    overrides: Overrides,
+    request: &RunRequest,
     plots: Option<PathBuf>,
     logs: Option<PathBuf>,
     summary: Option<PathBuf>,
     jobs: Option<usize>,
 ) -> Result<(), CliError> {
-    let base = Scenario::load(scenario_arg)?.with_overrides(&overrides)?;
+    let base = request.spec()?.scenario;
     let mut specs = sweep_specs(&base, relaxations, logs.as_deref())?;
     for spec in &mut specs {
         spec.samples = plot_retention(plots.is_some());
@@ -55,10 +55,14 @@ pub fn cmd_sweep(
         .iter()
         .map(|p| ("the summary (--summary)".to_string(), p.as_path()))
         .collect();
-    check_batch_outputs(&specs, &extra)?;
-    if let Some(p) = &summary {
-        create_parent(p, "write the summary")?;
+    // Every output is checked before the first flight ([`tvmd_log::paths`]).
+    if let Some(dir) = &logs {
+        check_output_dir(dir, "the log directory (--logs)")?;
     }
+    if let Some(dir) = &plots {
+        check_output_dir(dir, "the figure directory (--plots)")?;
+    }
+    check_batch_outputs(&specs, &extra)?;
     catch_interrupts();
     let total: u64 = specs.iter().map(|s| ticks_of(&s.scenario)).sum();
     let bar = progress_bar(total, &format!("{} runs", specs.len()));

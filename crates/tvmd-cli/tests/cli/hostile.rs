@@ -2,7 +2,7 @@
 //! malformed scenarios. Each case ends in a clear error or a correct result, never a lost log,
 //! a silent clamp or a run that never ends.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
@@ -17,6 +17,15 @@ fn tmp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// Whether `dir` holds an output's temporary file (`tvmd_log::paths::temporary`).
+fn has_temporary(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries
+            .filter_map(Result::ok)
+            .any(|e| e.file_name().to_string_lossy().starts_with(".tmp-"))
+    })
 }
 
 fn failure(out: &Output) -> String {
@@ -50,8 +59,9 @@ fn interrupted_run_keeps_its_log(signal: &str) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Wait until the flight is under way (its log is created when it starts).
-    while !log.exists() {
+    // Wait until the flight is under way (its log's temporary file is created when it
+    // starts; the log itself appears, whole, when the run ends).
+    while !has_temporary(&dir) {
         assert!(child.try_wait().unwrap().is_none(), "the run ended early");
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -137,7 +147,7 @@ fn output_paths_are_checked_before_the_run() {
         "--summary",
         blocker.join("s.json").to_str().unwrap(),
     ]));
-    assert!(e.contains("write the summary"), "{e}");
+    assert!(e.contains("s.json") && e.contains("is a file"), "{e}");
     assert!(!e.contains("simulated time"));
     // Duplicate relaxations would write one log twice.
     let out = bin()

@@ -6,3 +6,4 @@ mod allocation_set;
 mod cli;
 mod hostile;
 mod live;
+mod outputs;

@@ -828,8 +828,10 @@ def afs_atlas(
     ``certified_range`` (``m_C g``), ``limiting`` (height in ``m_C g`` and angle in degrees where
     ``s*`` is limited), ``certified_worst_width``, ``note``. With ``plots`` (a directory) the
     cross-sections are drawn as ``<team>.png``. ``torque`` (N m) is held meanwhile (zero by
-    default). Raises ``ValueError`` for an unknown team, a bad mask or bad settings. Releases the
-    GIL; about 2 s for A4 with the defaults in a release build."""
+    default). Raises ``ValueError`` for an unknown team, a bad mask or bad settings, ``OSError``
+    (the path named) for a ``plots`` directory that cannot be one, before any work, and
+    ``KeyboardInterrupt`` on Ctrl-C (the computation stops within one ray; nothing written).
+    Releases the GIL; about 2 s for A4 with the defaults in a release build."""
 
 def allocate(
     team: Team,

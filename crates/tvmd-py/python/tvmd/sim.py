@@ -56,11 +56,25 @@ def monte_carlo(
         model_errors=model_errors,
         distributions=distributions,
     )
+    if out is not None:
+        # Checked before any flight: a bad `out` must not cost the study.
+        _sim._check_report_dir(out)
     if executor is None:
-        rows = _sim.monte_carlo_fly(specs, jobs=jobs)
+        try:
+            rows = _sim.monte_carlo_fly(specs, jobs=jobs)
+        except KeyboardInterrupt as e:
+            # Ctrl-C: the finished flights' report travels with the exception, marked partial.
+            finished = getattr(e, "partial", None)
+            if finished is not None:
+                report = _sim.monte_carlo_report(finished)
+                report["interrupted"] = True
+                report["flights_asked"] = len(specs)
+                e.partial = report
+            raise
     else:
         if jobs is not None:
             raise ValueError("give `jobs` (threads here) or `executor`, not both")
+        _check_executor(executor)
         rows = list(executor.map(_fly, specs))
     return _sim.monte_carlo_report(rows, out=out)
 
@@ -84,9 +98,18 @@ def _run_swept(item, index):
     return _sim._run_item(item, index, sweep=True)
 
 
+def _check_executor(executor):
+    # A TypeError naming the argument, not an AttributeError from inside (hostile suite).
+    if not callable(getattr(executor, "map", None)):
+        raise TypeError(
+            f"`executor` must be a concurrent.futures.Executor (with `map`), got {type(executor).__name__}"
+        )
+
+
 def _on_executor(items, jobs, executor, fly):
     if jobs is not None:
         raise ValueError("give `jobs` (threads here) or `executor`, not both")
+    _check_executor(executor)
     return list(executor.map(fly, items, range(len(items))))
 
 

@@ -421,6 +421,11 @@ def monte_carlo(
         ValueError: as ``run``; ``runs < 1``, an unknown team, allocator or distributions key,
             a half-width out of range, a draw that makes an invalid scenario (a tilted start on
             the ground), ``jobs`` with ``executor``.
+        OSError: ``out`` cannot be a report directory (an existing file, not writable),
+            checked before any flight, the path named.
+        KeyboardInterrupt: Ctrl-C while flying on threads: the flights stop at their next
+            controller tick; the exception's ``partial`` is the report of the flights that
+            finished (``"interrupted": True``, ``"flights_asked"``), no file written.
     """
 
 def monte_carlo_specs(

@@ -81,6 +81,8 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     response: FailureResponse,
     /// The classification of the mask accepted this tick, reported once.
     hover: Option<HoverDiagnostics>,
+    /// The last mask the core refused: reported once, not asked for again until it changes.
+    refused: Option<Vec<bool>>,
     landing: Option<Landing>,
 }
 
@@ -122,6 +124,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             last: None,
             response: FailureResponse::default(),
             hover: None,
+            refused: None,
             landing: None,
         }
     }
@@ -145,7 +148,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         let wanted: Vec<bool> = (0..self.n)
             .map(|i| failed.get(i).copied().unwrap_or(false))
             .collect();
-        if wanted == self.mask {
+        if wanted == self.mask || self.refused.as_ref() == Some(&wanted) {
             return Ok(());
         }
         let mut mask = FailureMask::<MAX_AGENTS>::none();
@@ -156,6 +159,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         match self.inner.set_failures(mask)? {
             Ok(hover) => {
                 self.failure_note = None;
+                self.refused = None;
                 let land = !hover.capable
                     && self.response.on_hover_loss == OnHoverLoss::Land
                     && self.landing.is_none();
@@ -172,13 +176,26 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
                     limiting_agent: hover.limiting_agent,
                     limit: hover.limit.as_str().to_string(),
                     landing: land,
+                    refused: None,
                 });
             }
             Err(e) => {
-                self.failure_note = Some(format!(
+                let note = format!(
                     "failure mask {wanted:?} refused, keeping {:?}: {e}",
                     self.mask
-                ));
+                );
+                // Reported like a classification (not hover-capable, no margin), so the
+                // summary, the table and Python see it, not only the log's note.
+                self.hover = Some(HoverDiagnostics {
+                    capable: false,
+                    margin: 0.0,
+                    limiting_agent: None,
+                    limit: "refused".into(),
+                    landing: false,
+                    refused: Some(note.clone()),
+                });
+                self.failure_note = Some(note);
+                self.refused = Some(wanted.clone());
             }
         }
         self.mask = self.inner.failures().as_array()[..self.n].to_vec();

@@ -186,3 +186,26 @@ fn failure_response_is_parsed_and_validated() {
         Scenario::from_toml_str("[failure_response]\nlanding_acceleration = 0.0\n").unwrap_err();
     assert!(e.to_string().contains("landing_acceleration"), "{e}");
 }
+
+/// Issue 43 item 4: A3-Con cannot lose an agent (the rest cannot produce every wrench), so
+/// the controller refuses the mask and keeps allocating to the failed agent. That used to
+/// leave only a note inside the MCAP log; the summary now records it as a classification
+/// that is not hover-capable and says why.
+#[test]
+fn a_refused_failure_mask_is_in_the_summary() {
+    let overrides = tvmd_scenario::Overrides {
+        team: Some("a3-con".into()),
+        ..Default::default()
+    };
+    let mut s = Scenario::builtin("agent-failure")
+        .unwrap()
+        .with_overrides(&overrides)
+        .unwrap();
+    s.duration = 5.5;
+    let r = run_scenario(&s, None, None).unwrap();
+    let c = &r.summary.hover_classifications;
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(!c[0].capable && (c[0].time - 5.0).abs() < 1e-9, "{c:?}");
+    let why = c[0].refused.as_deref().unwrap_or_default();
+    assert!(why.contains("refused"), "{c:?}");
+}

@@ -2,12 +2,13 @@
 //! attainable set at every height of a range and every direction of a grid.
 
 use nalgebra::Vector3;
+use std::sync::atomic::AtomicBool;
 use tvmd_core::Relaxation;
 
 use super::compare::cone_radius;
 use super::model::AtlasModel;
 use super::ray::Bracket;
-use super::section::{cross_section, hover_ceiling, CrossSection, SectionQuery};
+use super::section::{cross_section_until, hover_ceiling, CrossSection, SectionQuery};
 
 /// The cone counts as inside an attained radius up to `CERTIFY_TOLERANCE n sigma_Tf` (N): the
 /// bisection's stopping width, 1e-9, plus the residual accepted as attained, 1e-10, with margin.
@@ -86,6 +87,18 @@ pub fn certified_relaxation(
     range: &HeightRange,
     directions: usize,
 ) -> Option<CertifiedRelaxation> {
+    certified_relaxation_until(model, torque, range, directions, None)
+}
+
+/// [`certified_relaxation`], cut short once `cancel` is set (the result is then incomplete:
+/// the caller discards it).
+pub fn certified_relaxation_until(
+    model: &AtlasModel,
+    torque: &Vector3<f64>,
+    range: &HeightRange,
+    directions: usize,
+    cancel: Option<&AtomicBool>,
+) -> Option<CertifiedRelaxation> {
     let ceiling = hover_ceiling(model, torque).bracket;
     let top = ceiling.lower?;
     let k = range.heights.max(2);
@@ -97,13 +110,14 @@ pub fn certified_relaxation(
     let mut upper = 1.0_f64;
     let mut sections = Vec::with_capacity(k);
     for &height in &heights {
-        let section = cross_section(
+        let section = cross_section_until(
             model,
             &SectionQuery {
                 height,
                 torque: *torque,
                 directions,
             },
+            cancel,
         );
         for p in &section.points {
             // Attained to the inner solve's precision: where the cone is capped by the ball

@@ -33,13 +33,19 @@ pub mod section;
 pub mod support;
 
 pub use bracket::{bound_ray, RESTARTS};
-pub use certify::{certified_relaxation, CertifiedRelaxation, HeightRange};
+pub use certify::{
+    certified_relaxation, certified_relaxation_until, CertifiedRelaxation, HeightRange,
+};
 pub use compare::{compare, cone_radius, ConeComparison};
 pub use model::AtlasModel;
 pub use ray::{Bracket, Ray, RayBound};
-pub use report::{atlas_entry, markdown_table, AtlasEntry, AtlasRow, AtlasSettings, HeightRow};
-pub use run::{run, AtlasRequest};
-pub use section::{cross_section, hover_ceiling, ray_radius, CrossSection, SectionQuery};
+pub use report::{
+    atlas_entry, atlas_entry_until, markdown_table, AtlasEntry, AtlasRow, AtlasSettings, HeightRow,
+};
+pub use run::{run, run_until, AtlasRequest};
+pub use section::{
+    cross_section, cross_section_until, hover_ceiling, ray_radius, CrossSection, SectionQuery,
+};
 
 #[cfg(test)]
 mod tests;

@@ -22,6 +22,12 @@ fn polar(points: impl Iterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
 /// Draws `entry`'s cross-sections side by side into `path`: the attained boundary (solid),
 /// the outer bound (dashed), the cone at the entry's relaxation and at `s*` (if certified).
 pub fn cross_sections(entry: &AtlasEntry, relaxation: f64, path: &Path) -> Result<(), StudyError> {
+    tvmd_log::paths::write_via_temporary(path, "write the figure", |path| {
+        draw_cross_sections(entry, relaxation, path)
+    })
+}
+
+fn draw_cross_sections(entry: &AtlasEntry, relaxation: f64, path: &Path) -> Result<(), StudyError> {
     register_font();
     ensure_parent(path)?;
     let k = entry.sections.len().max(1);

@@ -1,14 +1,16 @@
 //! One team's atlas entry: hover ceiling, the cone against the attainable set at a few
 //! heights, and `s*`, as a serializable row (the CLI's table, Python's dict, the docs' table).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use nalgebra::Vector3;
 use serde::Serialize;
 use tvmd_core::{FailureMask, Relaxation, TeamConfig};
 
-use super::certify::{certified_relaxation, HeightRange};
+use super::certify::{certified_relaxation_until, HeightRange};
 use super::compare::{compare, cone_radius, Interval};
 use super::model::AtlasModel;
-use super::section::{cross_section, CrossSection, SectionQuery};
+use super::section::{cross_section_until, CrossSection, SectionQuery};
 use tvmd_plant::GRAVITY;
 
 use crate::StudyError;
@@ -134,6 +136,18 @@ pub fn atlas_entry<const N: usize>(
     failed: &[usize],
     settings: &AtlasSettings,
 ) -> Result<AtlasEntry, StudyError> {
+    atlas_entry_until(name, team, failed, settings, None)
+}
+
+/// [`atlas_entry`], stopping within one ray once `cancel` is set
+/// ([`StudyError::Interrupted`]).
+pub fn atlas_entry_until<const N: usize>(
+    name: &str,
+    team: &TeamConfig<f64, N>,
+    failed: &[usize],
+    settings: &AtlasSettings,
+    cancel: Option<&AtomicBool>,
+) -> Result<AtlasEntry, StudyError> {
     let bad = |name: &str, reason: String| StudyError::InvalidArgument {
         name: name.into(),
         reason,
@@ -178,17 +192,29 @@ pub fn atlas_entry<const N: usize>(
         .heights
         .iter()
         .map(|h| {
-            cross_section(
+            cross_section_until(
                 &model,
                 &SectionQuery {
                     height: h * weight,
                     torque,
                     directions: settings.directions,
                 },
+                cancel,
             )
         })
         .collect();
-    let cert = certified_relaxation(&model, &torque, &settings.range, settings.directions);
+    let cert = certified_relaxation_until(
+        &model,
+        &torque,
+        &settings.range,
+        settings.directions,
+        cancel,
+    );
+    if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        return Err(StudyError::Interrupted(format!(
+            "the atlas of {name} was stopped before it finished"
+        )));
+    }
     let ceiling = cert.as_ref().map_or_else(
         || super::section::hover_ceiling(&model, &torque).bracket,
         |c| c.ceiling,

@@ -2,13 +2,16 @@
 //! cross-sections. The binary only parses these arguments and prints what [`run`] returns.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use tvmd_log::paths;
 
 use tvmd_core::presets::Preset;
 use tvmd_core::TeamConfig;
 
 use super::certify::HeightRange;
 use super::plot::cross_sections;
-use super::report::{atlas_entry, markdown_table, AtlasRow, AtlasSettings};
+use super::report::{atlas_entry_until, markdown_table, AtlasRow, AtlasSettings};
 use crate::StudyError;
 
 /// Arguments of `tvmd-sim afs`.
@@ -54,6 +57,15 @@ pub fn presets(team: &str) -> Result<Vec<Preset>, StudyError> {
 /// Computes every row the arguments ask for, writes the plots and JSON, and returns the rows
 /// and the Markdown table.
 pub fn run(args: &AtlasRequest) -> Result<(Vec<AtlasRow>, String), StudyError> {
+    run_until(args, None)
+}
+
+/// [`run`], stopping within one ray once `cancel` is set ([`StudyError::Interrupted`]; no
+/// file is written then). The outputs (`plots`, `json`) are checked before any work.
+pub fn run_until(
+    args: &AtlasRequest,
+    cancel: Option<&AtomicBool>,
+) -> Result<(Vec<AtlasRow>, String), StudyError> {
     let settings = AtlasSettings {
         heights: args.heights.clone(),
         directions: args.directions,
@@ -70,8 +82,10 @@ pub fn run(args: &AtlasRequest) -> Result<(Vec<AtlasRow>, String), StudyError> {
         })?,
     };
     if let Some(dir) = &args.plots {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| StudyError::Plot(format!("cannot create `{}`: {e}", dir.display())))?;
+        paths::check_output_dir(dir, "the figure directory (--plots)")?;
+    }
+    if let Some(path) = &args.json {
+        paths::check_outputs(&[("the JSON table (--json)".into(), path)], &[])?;
     }
     let mut jobs = Vec::new();
     for preset in presets(&args.team)? {
@@ -85,8 +99,9 @@ pub fn run(args: &AtlasRequest) -> Result<(Vec<AtlasRow>, String), StudyError> {
     }
     let job =
         |(preset, team, failed, optional): &(Preset, TeamConfig<f64, 16>, Vec<usize>, bool)| {
-            let entry = match atlas_entry(preset.name(), team, failed, &settings) {
+            let entry = match atlas_entry_until(preset.name(), team, failed, &settings, cancel) {
                 Ok(entry) => entry,
+                Err(e @ StudyError::Interrupted(_)) => return Err(e),
                 // A one-agent failure the team cannot survive is a row of the table, not an error
                 // of the whole run.
                 Err(e) if *optional => {
@@ -107,10 +122,14 @@ pub fn run(args: &AtlasRequest) -> Result<(Vec<AtlasRow>, String), StudyError> {
         .into_iter()
         .map(|r| r.unwrap_or_else(|| Err(StudyError::Internal("an atlas worker panicked".into()))))
         .collect::<Result<Vec<AtlasRow>, StudyError>>()?;
+    if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        return Err(StudyError::Interrupted(
+            "the atlas was stopped before every row was computed; nothing was written".into(),
+        ));
+    }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&rows)?;
-        std::fs::write(path, text)
-            .map_err(|e| StudyError::Plot(format!("cannot write `{}`: {e}", path.display())))?;
+        paths::write_file(path, "write the atlas JSON", text.as_bytes())?;
     }
     let table = markdown_table(&rows);
     Ok((rows, table))

@@ -3,6 +3,7 @@
 //! ceiling, the largest vertical force at that torque with no lateral force.
 
 use nalgebra::{Vector3, Vector6};
+use std::sync::atomic::{AtomicBool, Ordering};
 use tvmd_core::GimbalCommand;
 
 use super::bracket::bound_ray;
@@ -67,9 +68,19 @@ pub fn ray_radius(model: &AtlasModel, height: f64, torque: &Vector3<f64>, angle:
 /// The cross-section of the query, each direction's dual warm-started from its neighbour's
 /// multiplier.
 pub fn cross_section(model: &AtlasModel, query: &SectionQuery) -> CrossSection {
+    cross_section_until(model, query, None)
+}
+
+/// [`cross_section`], stopping (with the directions bounded so far) once `cancel` is set.
+pub fn cross_section_until(
+    model: &AtlasModel,
+    query: &SectionQuery,
+    cancel: Option<&AtomicBool>,
+) -> CrossSection {
     let k = query.directions.max(1);
     let mut previous: Option<Vector6<f64>> = None;
     let points = (0..k)
+        .take_while(|_| !cancel.is_some_and(|c| c.load(Ordering::Relaxed)))
         .map(|i| {
             let angle = std::f64::consts::TAU * i as f64 / k as f64;
             let ray = lateral_ray(query.height, &query.torque, angle);

@@ -13,11 +13,9 @@ use crate::StudyError;
 
 /// Writes the set drawn with `seed` to `out`; returns a one-line description.
 pub fn write_set(out: &Path, seed: u64) -> Result<String, StudyError> {
+    tvmd_log::paths::check_outputs(&[("the allocation set (--out)".into(), out)], &[])?;
     let set = AllocationSet::generate(seed)?;
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    std::fs::write(out, set.to_json()?)?;
+    tvmd_log::paths::write_file(out, "write the allocation set", set.to_json()?.as_bytes())?;
     let requests: usize = set.teams.iter().map(|t| t.requests.len()).sum();
     Ok(format!(
         "allocation set (seed {seed}): {} teams, {requests} requests: {}",
@@ -47,7 +45,13 @@ pub fn evaluate_file(
     closed_loop: bool,
     json: Option<&Path>,
 ) -> Result<String, StudyError> {
-    let set = AllocationSet::from_json(&std::fs::read_to_string(set_path)?)?;
+    if let Some(p) = json {
+        let inputs = [("the allocation set (--set)".to_string(), set_path)];
+        tvmd_log::paths::check_outputs(&[("the JSON table (--json)".into(), p)], &inputs)?;
+    }
+    let text = std::fs::read_to_string(set_path)
+        .map_err(StudyError::file("read the allocation set", set_path))?;
+    let set = AllocationSet::from_json(&text)?;
     let names: Vec<&str> = allocators.iter().map(String::as_str).collect();
     let rows: Vec<EvaluationRow> = evaluate_set(&set, &names)?;
     let mut out = format!(
@@ -68,7 +72,8 @@ pub fn evaluate_file(
     };
     if let Some(p) = json {
         let value = serde_json::json!({ "set": rows, "closed_loop": closed });
-        std::fs::write(p, serde_json::to_string_pretty(&value)? + "\n")?;
+        let text = serde_json::to_string_pretty(&value)? + "\n";
+        tvmd_log::paths::write_file(p, "write the JSON table", text.as_bytes())?;
     }
     Ok(out)
 }

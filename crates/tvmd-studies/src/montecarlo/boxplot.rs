@@ -287,11 +287,13 @@ pub fn write_plots(
     for metric in &METRICS {
         let path = dir.join(format!("{}.png", metric.0));
         ensure_parent(&path)?;
-        box_plot(rows, groups, metric, &path)?;
+        tvmd_log::paths::write_via_temporary(&path, "write the figure", |t| {
+            box_plot(rows, groups, metric, t)
+        })?;
         out.push(path);
     }
     let path = dir.join("success_rate.png");
-    success_rate(groups, &path)?;
+    tvmd_log::paths::write_via_temporary(&path, "write the figure", |t| success_rate(groups, t))?;
     out.push(path);
     Ok(out)
 }

@@ -4,11 +4,12 @@
 //! (`hover` with the default distributions, `--runs` flights).
 
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
 use serde::Serialize;
 use tvmd_core::presets::Preset;
 
-use super::{fly_all, Distributions, FlightRow, Study};
+use super::{fly_all_until, Distributions, FlightRow, Study};
 use crate::StudyError;
 use tvmd_scenario::Scenario;
 
@@ -103,6 +104,19 @@ fn task_study(
 
 /// Flies the table; returns its rows and every flight.
 pub fn run(args: &CatalogueSettings) -> Result<(Vec<CatalogueRow>, Vec<FlightRow>), StudyError> {
+    run_until(args, None)
+}
+
+/// [`run`], stopping once `cancel` is set: [`StudyError::Interrupted`], after writing the
+/// finished flights to `catalogue-flights.csv` when `out` is given (the table needs them all).
+/// The output directory is checked before the first flight.
+pub fn run_until(
+    args: &CatalogueSettings,
+    cancel: Option<&AtomicBool>,
+) -> Result<(Vec<CatalogueRow>, Vec<FlightRow>), StudyError> {
+    if let Some(dir) = &args.out {
+        tvmd_log::paths::check_output_dir(dir, "the catalogue directory (--out)")?;
+    }
     let teams: Vec<String> = if args.teams.is_empty() {
         Preset::ALL.iter().map(|p| p.name().to_string()).collect()
     } else {
@@ -117,7 +131,23 @@ pub fn run(args: &CatalogueSettings) -> Result<(Vec<CatalogueRow>, Vec<FlightRow
     for (_, scenario) in TASKS {
         specs.extend(task_study(scenario, &teams, &allocators, args)?.specs()?);
     }
-    let flights = fly_all(&specs, args.jobs, None)?;
+    let flown = fly_all_until(&specs, args.jobs, None, cancel)?;
+    if flown.interrupted {
+        let kept = match &args.out {
+            Some(dir) => {
+                let path = dir.join("catalogue-flights.csv");
+                super::write_csv(&flown.rows, &path)?;
+                format!("written to {}", path.display())
+            }
+            None => "not written (no output directory)".into(),
+        };
+        return Err(StudyError::Interrupted(format!(
+            "the catalogue was stopped: {} of {} flights finished, {kept}; no table",
+            flown.rows.len(),
+            flown.total
+        )));
+    }
+    let flights = flown.rows;
     let mut rows = Vec::new();
     for team in &teams {
         for allocator in &allocators {
@@ -183,13 +213,21 @@ pub fn markdown(rows: &[CatalogueRow], runs: usize) -> String {
 
 /// Runs the table and writes its files if `out` is given; returns the Markdown.
 pub fn run_and_write(args: &CatalogueSettings) -> Result<String, StudyError> {
-    let (rows, flights) = run(args)?;
+    run_and_write_until(args, None)
+}
+
+/// [`run_and_write`], stopping once `cancel` is set ([`run_until`]).
+pub fn run_and_write_until(
+    args: &CatalogueSettings,
+    cancel: Option<&AtomicBool>,
+) -> Result<String, StudyError> {
+    let (rows, flights) = run_until(args, cancel)?;
     let md = markdown(&rows, args.runs);
     if let Some(dir) = &args.out {
         super::write_csv(&flights, &dir.join("catalogue-flights.csv"))?;
         super::write_csv(&rows, &dir.join("catalogue.csv"))?;
         let path = dir.join("catalogue.md");
-        std::fs::write(&path, &md).map_err(StudyError::file("write the table", &path))?;
+        tvmd_log::paths::write_file(&path, "write the table", md.as_bytes())?;
     }
     Ok(md)
 }

@@ -1,6 +1,8 @@
 //! One flight of a Monte Carlo study: its spec (what to fly, serialisable so that any
 //! executor can ship it) and its row of the results table.
 
+use std::sync::atomic::AtomicBool;
+
 use serde::{Deserialize, Serialize};
 
 use super::distributions::{Distributions, Draw};
@@ -128,6 +130,15 @@ pub struct FlightRow {
 /// Flies `spec` and returns its row; `Err` only when the flight cannot start (a bad scenario
 /// or draw). A flight that fails in the air is a row with `error` set and `success` false.
 pub fn fly_flight(spec: &FlightSpec) -> Result<FlightRow, StudyError> {
+    fly_flight_until(spec, None)?.ok_or_else(|| StudyError::Internal("a flight stopped".into()))
+}
+
+/// [`fly_flight`], stopping at the next controller tick once `cancel` is set: `None` then (a
+/// flight cut short is no sample of the study).
+pub fn fly_flight_until(
+    spec: &FlightSpec,
+    cancel: Option<&AtomicBool>,
+) -> Result<Option<FlightRow>, StudyError> {
     let (scenario, draw) = spec.scenario()?;
     let run = RunSpec {
         scenario: scenario.clone(),
@@ -135,14 +146,17 @@ pub fn fly_flight(spec: &FlightSpec) -> Result<FlightRow, StudyError> {
         pil: None,
         samples: SampleRetention::None,
     };
-    let flight = fly(&run, None, None)?;
+    let flight = fly(&run, None, cancel)?;
+    if flight.result.summary.interrupted {
+        return Ok(None);
+    }
     let s = &flight.result.summary;
     let m = &s.metrics;
     let p = m.position.as_ref();
     let att = m.attitude.as_ref();
     let planned = m.planned_attitude.as_ref();
     let plant = &draw.plant;
-    Ok(FlightRow {
+    Ok(Some(FlightRow {
         scenario: scenario.name.clone(),
         team: spec
             .team
@@ -188,5 +202,5 @@ pub fn fly_flight(spec: &FlightSpec) -> Result<FlightRow, StudyError> {
         mean_thrust_efficiency: m.thrust_efficiency.map(|e| e.mean),
         min_thrust_efficiency: m.thrust_efficiency.map(|e| e.min),
         time_saturated: m.time_saturated,
-    })
+    }))
 }

@@ -15,11 +15,12 @@ pub mod report;
 mod study_run;
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use distributions::{Distributions, Draw};
-pub use flight::{fly_flight, FlightRow, FlightSpec};
+pub use flight::{fly_flight, fly_flight_until, FlightRow, FlightSpec};
 pub use report::{group_summaries, quantile, text_table, write_csv, GroupSummary};
-pub use study_run::{run, MonteCarloOutput, MonteCarloRequest};
+pub use study_run::{run, run_until, MonteCarloOutput, MonteCarloRequest};
 
 use crate::StudyError;
 use tvmd_scenario::Scenario;
@@ -135,27 +136,61 @@ pub fn fly_all(
     jobs: Option<usize>,
     progress: Option<&(dyn Fn(usize) + Sync)>,
 ) -> Result<Vec<FlightRow>, StudyError> {
+    Ok(fly_all_until(specs, jobs, progress, None)?.rows)
+}
+
+/// The flights [`fly_all_until`] finished.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Flown {
+    /// The finished flights' rows, in input order.
+    pub rows: Vec<FlightRow>,
+    /// The flights asked for.
+    pub total: usize,
+    /// Whether `cancel` stopped the study (then `rows` holds fewer than `total`).
+    pub interrupted: bool,
+}
+
+/// [`fly_all`], stopping once `cancel` is set: the flights in the air stop at their next
+/// controller tick and are dropped, the others do not start; the finished rows are kept.
+pub fn fly_all_until(
+    specs: &[FlightSpec],
+    jobs: Option<usize>,
+    progress: Option<&(dyn Fn(usize) + Sync)>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Flown, StudyError> {
+    let stopped = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
     let done = std::sync::atomic::AtomicUsize::new(0);
     let workers = tvmd_sim::pool::worker_count(jobs, specs.len());
     let rows = tvmd_sim::pool::map_in_order(specs, workers, |_, spec| {
-        let row = fly_flight(spec);
-        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if stopped() {
+            return Ok(None);
+        }
+        let row = fly_flight_until(spec, cancel);
+        let n = done.fetch_add(1, Ordering::Relaxed) + 1;
         if let Some(p) = progress {
             p(n);
         }
         row
     });
-    rows.into_iter()
-        .enumerate()
-        .map(|(k, r)| match r {
-            Some(Ok(row)) => Ok(row),
-            Some(Err(e)) => Err(StudyError::InvalidArgument {
-                name: format!("flight {k}"),
-                reason: e.to_string(),
-            }),
-            None => Err(StudyError::Internal(format!("flight {k} did not finish"))),
-        })
-        .collect()
+    let mut finished = Vec::with_capacity(specs.len());
+    for (k, r) in rows.into_iter().enumerate() {
+        match r {
+            Some(Ok(Some(row))) => finished.push(row),
+            Some(Ok(None)) => {}
+            Some(Err(e)) => {
+                return Err(StudyError::InvalidArgument {
+                    name: format!("flight {k}"),
+                    reason: e.to_string(),
+                })
+            }
+            None => return Err(StudyError::Internal(format!("flight {k} did not finish"))),
+        }
+    }
+    Ok(Flown {
+        interrupted: finished.len() < specs.len() && stopped(),
+        total: specs.len(),
+        rows: finished,
+    })
 }
 
 /// What [`write_report`] wrote.
@@ -200,6 +235,9 @@ pub struct StudyReport {
 impl StudyReport {
     /// The report of `rows`, writing the tables and figures into `out` if given.
     pub fn new(rows: Vec<FlightRow>, out: Option<&Path>) -> Result<Self, StudyError> {
+        if let Some(dir) = out {
+            tvmd_log::paths::check_output_dir(dir, "the report directory (`out`)")?;
+        }
         let files = out.map(|dir| write_report(&rows, dir)).transpose()?;
         let successes = rows.iter().filter(|r| r.success).count();
         Ok(Self {

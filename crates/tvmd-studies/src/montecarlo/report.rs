@@ -120,11 +120,13 @@ pub fn write_csv<T: Serialize>(rows: &[T], path: &Path) -> Result<(), StudyError
             source,
         }
     };
-    let mut w = csv::Writer::from_path(path).map_err(csv_err)?;
-    for r in rows {
-        w.serialize(r).map_err(csv_err)?;
-    }
-    w.flush().map_err(StudyError::file(ACTION, path))
+    tvmd_log::paths::write_via_temporary(path, ACTION, |temporary| {
+        let mut w = csv::Writer::from_path(temporary).map_err(csv_err)?;
+        for r in rows {
+            w.serialize(r).map_err(csv_err)?;
+        }
+        w.flush().map_err(StudyError::file(ACTION, path))
+    })
 }
 
 /// The group summaries as a fixed-width text table.

@@ -2,8 +2,9 @@
 //! prints what [`run`] returns.
 
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
-use super::{fly_all, text_table, Distributions, ReportFiles, Study, StudyReport};
+use super::{fly_all_until, text_table, Distributions, ReportFiles, Study, StudyReport};
 use crate::StudyError;
 use tvmd_scenario::Scenario;
 
@@ -86,8 +87,12 @@ pub struct MonteCarloOutput {
     pub table: String,
     /// Overall success rate.
     pub success_rate: f64,
-    /// Flights flown.
+    /// Flights flown (and reported).
     pub flights: usize,
+    /// Flights asked for.
+    pub total: usize,
+    /// Whether the study was stopped: the report then holds the `flights` finished of `total`.
+    pub interrupted: bool,
     /// The files written.
     pub files: ReportFiles,
 }
@@ -97,20 +102,41 @@ pub fn run(
     args: &MonteCarloRequest,
     progress: Option<&(dyn Fn(usize, usize) + Sync)>,
 ) -> Result<MonteCarloOutput, StudyError> {
+    run_until(args, progress, None)
+}
+
+/// [`run`], stopping once `cancel` is set: the report (tables and figures) then holds the
+/// flights that finished and says so (`interrupted`). The output directory is checked before
+/// the first flight.
+pub fn run_until(
+    args: &MonteCarloRequest,
+    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
+    cancel: Option<&AtomicBool>,
+) -> Result<MonteCarloOutput, StudyError> {
     let study = args.study()?;
     let specs = study.specs()?;
+    let out = args.out_dir(&study);
+    tvmd_log::paths::check_output_dir(&out, "the report directory (--out)")?;
     let total = specs.len();
     let each = progress.map(|p| move |done: usize| p(done, total));
-    let rows = fly_all(
+    let flown = fly_all_until(
         &specs,
         args.jobs,
         each.as_ref().map(|f| f as &(dyn Fn(usize) + Sync)),
+        cancel,
     )?;
-    let report = StudyReport::new(rows, Some(&args.out_dir(&study)))?;
+    if flown.interrupted && flown.rows.is_empty() {
+        return Err(StudyError::Interrupted(format!(
+            "stopped before any of the {total} flights finished; nothing written"
+        )));
+    }
+    let report = StudyReport::new(flown.rows, Some(&out))?;
     Ok(MonteCarloOutput {
         table: text_table(&report.groups),
         success_rate: report.success_rate,
         flights: report.flights.len(),
+        total,
+        interrupted: flown.interrupted,
         files: report
             .files
             .ok_or_else(|| StudyError::Internal("the report wrote no files".into()))?,

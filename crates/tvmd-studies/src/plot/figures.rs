@@ -13,6 +13,12 @@ use crate::StudyError;
 /// Figure (a), the state profile: position `x, y, z` against `x_r` (top row) and roll, pitch,
 /// yaw against the reference, with the planned roll `phi_d` in the roll panel (bottom row).
 pub fn state_profile(series: &PlotSeries, path: &Path) -> Result<(), StudyError> {
+    tvmd_log::paths::write_via_temporary(path, "write the figure", |path| {
+        draw_state_profile(series, path)
+    })
+}
+
+fn draw_state_profile(series: &PlotSeries, path: &Path) -> Result<(), StudyError> {
     register_font();
     ensure_parent(path)?;
     let root = BitMapBackend::new(path, (1500, 820)).into_drawing_area();
@@ -80,6 +86,12 @@ pub fn state_profile(series: &PlotSeries, path: &Path) -> Result<(), StudyError>
 
 /// Figure (b): the Lyapunov candidates `V_x` and `V_R` against time (log scale).
 pub fn lyapunov(series: &PlotSeries, path: &Path) -> Result<(), StudyError> {
+    tvmd_log::paths::write_via_temporary(path, "write the figure", |path| {
+        draw_lyapunov(series, path)
+    })
+}
+
+fn draw_lyapunov(series: &PlotSeries, path: &Path) -> Result<(), StudyError> {
     register_font();
     ensure_parent(path)?;
     let root = BitMapBackend::new(path, (1200, 520)).into_drawing_area();
@@ -113,6 +125,12 @@ pub fn lyapunov(series: &PlotSeries, path: &Path) -> Result<(), StudyError> {
 /// Figure (c), the relaxation study: planned roll (with the reference roll), actual roll,
 /// allocation error `e_f` and position error `||x - x_r||` for each run.
 pub fn relaxation_study(runs: &[PlotSeries], path: &Path) -> Result<(), StudyError> {
+    tvmd_log::paths::write_via_temporary(path, "write the figure", |path| {
+        draw_relaxation_study(runs, path)
+    })
+}
+
+fn draw_relaxation_study(runs: &[PlotSeries], path: &Path) -> Result<(), StudyError> {
     register_font();
     ensure_parent(path)?;
     let root = BitMapBackend::new(path, (1500, 900)).into_drawing_area();
@@ -190,7 +208,7 @@ pub fn write_run_figures(
     dir: &Path,
     stem: &str,
 ) -> Result<Vec<PathBuf>, StudyError> {
-    std::fs::create_dir_all(dir)?;
+    tvmd_log::paths::check_output_dir(dir, "the figure directory")?;
     let state = dir.join(format!("{stem}-state.png"));
     let lyap = dir.join(format!("{stem}-lyapunov.png"));
     state_profile(series, &state)?;

@@ -202,6 +202,7 @@ impl SummaryFold {
                 capable: h.capable,
                 margin: h.margin,
                 landing: h.landing,
+                refused: h.refused.clone(),
             });
         }
         if let Some([b0, b1]) = self.tilt {

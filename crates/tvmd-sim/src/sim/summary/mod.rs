@@ -78,7 +78,8 @@ pub struct RunTotals {
     pub interrupted: bool,
 }
 
-/// One hover classification of a run: when the controller accepted a new failure mask.
+/// One hover classification of a run: when the controller accepted, or refused, a new failure
+/// mask.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HoverClassification {
     /// Time (s) of the controller tick that accepted the mask.
@@ -89,6 +90,10 @@ pub struct HoverClassification {
     pub margin: f64,
     /// Whether the scenario's `failure_response` started a landing on it.
     pub landing: bool,
+    /// The controller refused the mask (it keeps the previous one): why. Then `capable` is
+    /// false and `margin` 0.
+    #[serde(default)]
+    pub refused: Option<String>,
 }
 
 /// Summary of a run.
