@@ -33,7 +33,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
 =======
         Command::Catalogue(args) => {
             catch_interrupts();
-            tvmd_studies::montecarlo::catalogue::run_and_write_until(&args.into(), Some(&INTERRUPT))
+            tvmd_studies::catalogue::run_and_write_until(&args.into(), Some(&INTERRUPT))
                 .map(|table| print!("{table}"))
                 .map_err(CliError::from)
         }
