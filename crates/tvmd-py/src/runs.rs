@@ -9,11 +9,6 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-<<<<<<< HEAD
-use tvmd_scenario::{Overrides, Precision, Scenario};
-use tvmd_sim::pil::PilTarget;
-=======
->>>>>>> hostile
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{RunRequest, ScenarioSource};

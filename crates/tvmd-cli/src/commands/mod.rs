@@ -26,18 +26,12 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
                 .map_err(CliError::from)
         }
         Command::Montecarlo(args) => montecarlo::cmd_montecarlo(args.into()),
-<<<<<<< HEAD
-        Command::Catalogue(args) => tvmd_studies::catalogue::run_and_write(&args.into())
-            .map(|table| print!("{table}"))
-            .map_err(CliError::from),
-=======
         Command::Catalogue(args) => {
             catch_interrupts();
             tvmd_studies::catalogue::run_and_write_until(&args.into(), Some(&INTERRUPT))
                 .map(|table| print!("{table}"))
                 .map_err(CliError::from)
         }
->>>>>>> hostile
         Command::Run {
             scenario,
             out,
