@@ -84,6 +84,7 @@ fn task_study(
         model_error: 0.0,
         initial_position: 0.0,
         initial_tilt: 0.0,
+        conditions: super::Conditions::none(),
         ..Distributions::default()
     };
     Ok(Study {

@@ -9,6 +9,7 @@
 
 pub mod boxplot;
 pub mod catalogue;
+pub mod conditions;
 pub mod distributions;
 pub mod flight;
 pub mod report;
@@ -16,6 +17,7 @@ mod study_run;
 
 use std::path::{Path, PathBuf};
 
+pub use conditions::Conditions;
 pub use distributions::{Distributions, Draw};
 pub use flight::{fly_flight, FlightRow, FlightSpec};
 pub use report::{group_summaries, quantile, text_table, write_csv, GroupSummary};
