@@ -268,7 +268,10 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for NameOr<T> {
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 Ok(NameOr::Name(v.into()))
             }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<Self::Value, A::Error> {
                 T::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(NameOr::Table)
             }
         }
@@ -349,7 +352,10 @@ impl TryFrom<OffsetFreeInput> for OffsetFreeConfig {
         };
         let not_for = |field: &str, present: bool| {
             if present {
-                Err(format!("`{field}` is not a setting of kind = \"{}\"", t.kind))
+                Err(format!(
+                    "`{field}` is not a setting of kind = \"{}\"",
+                    t.kind
+                ))
             } else {
                 Ok(())
             }

@@ -12,7 +12,14 @@ fn empty_file_is_paper_tilt() {
     assert_eq!(s.law, LawConfig::default());
     let paper = Scenario::builtin("paper-tilt").unwrap();
     assert!(paper.law.is_paper());
-    assert_eq!(Scenario { law: LawConfig::paper(), ..s.clone() }.reference, paper.reference);
+    assert_eq!(
+        Scenario {
+            law: LawConfig::paper(),
+            ..s.clone()
+        }
+        .reference,
+        paper.reference
+    );
     assert_eq!(s.steps_per_control().unwrap(), 10);
     assert!((s.max_thrust().unwrap() - 2.0 * 0.7 * 9.81).abs() < 1e-12);
 }
@@ -150,7 +157,10 @@ fn load_takes_a_builtin_name_or_a_file() {
 fn law_parses_names_tables_and_round_trips() {
     let law = |text: &str| Scenario::from_toml_str(text).map(|s| s.law);
     assert_eq!(law("law = \"paper\"\n").unwrap(), LawConfig::paper());
-    assert_eq!(law("law = \"offset-free\"\n").unwrap(), LawConfig::default());
+    assert_eq!(
+        law("law = \"offset-free\"\n").unwrap(),
+        LawConfig::default()
+    );
     // A table states what differs from the default law.
     let t = law("[law]\ngains = \"team-scaled\"\nattitude_rate = \"off\"\n").unwrap();
     assert_eq!(t.gains, GainScheduleConfig::TeamScaled);
@@ -161,7 +171,10 @@ fn law_parses_names_tables_and_round_trips() {
         panic!("{n:?}")
     };
     assert_eq!(g.position_frequency, [1.0, 2.0, 3.0]);
-    assert_eq!(g.attitude_frequency, NaturalGainsConfig::default().attitude_frequency);
+    assert_eq!(
+        g.attitude_frequency,
+        NaturalGainsConfig::default().attitude_frequency
+    );
     let i = law(
         "[law]\noffset_free = { kind = \"integral\", k_x = [1.0, 1.0, 2.0], k_r = [0.5, 0.5, 0.5] }\n",
     )
@@ -181,7 +194,10 @@ fn law_parses_names_tables_and_round_trips() {
         OffsetFreeConfig::Off
     );
     for l in [LawConfig::paper(), LawConfig::default(), t, n, i, o] {
-        let s = Scenario { law: l, ..Scenario::default() };
+        let s = Scenario {
+            law: l,
+            ..Scenario::default()
+        };
         let back = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
         assert_eq!(back.law, l);
     }
@@ -206,7 +222,10 @@ fn bad_law_settings_name_the_field() {
             "[law]\noffset_free = { kind = \"observer\", k_x = [1.0, 1.0, 1.0] }\n",
             &["law.offset_free", "k_x", "observer"],
         ),
-        ("[law]\nattitude_rate = \"on\"\n", &["law.attitude_rate", "on"]),
+        (
+            "[law]\nattitude_rate = \"on\"\n",
+            &["law.attitude_rate", "on"],
+        ),
         (
             "[law]\nattitude_rate = { bandwidth = 20.0, rate = 1.0 }\n",
             &["law.attitude_rate", "rate"],

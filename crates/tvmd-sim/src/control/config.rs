@@ -5,8 +5,8 @@
 use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, AttitudeRateFilter, ControllerSettings,
-    DisturbanceObserver, FailureMask, GainSchedule, Gains, IntegralAction, NaturalGains,
-    Navigator, OffsetFree, RateLimits, Relaxation, TeamConfig,
+    DisturbanceObserver, FailureMask, GainSchedule, Gains, IntegralAction, NaturalGains, Navigator,
+    OffsetFree, RateLimits, Relaxation, TeamConfig,
 };
 
 use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
@@ -205,8 +205,7 @@ pub fn law_settings<T: CoreFloat>(
             bandwidth,
             max_rate,
         } => Some(
-            AttitudeRateFilter::new(to_core(bandwidth), to_core(max_rate))
-                .map_err(config_error)?,
+            AttitudeRateFilter::new(to_core(bandwidth), to_core(max_rate)).map_err(config_error)?,
         ),
     };
     Ok((gain_schedule, offset_free, attitude_rate))
