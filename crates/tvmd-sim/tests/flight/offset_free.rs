@@ -113,3 +113,15 @@ fn paper_experiment_height_and_yaw_errors_fall_tenfold() {
     assert!(z_new <= 0.1 * z_paper, "{z_new} vs {z_paper}");
     assert!(yaw_new <= 0.1 * yaw_paper, "{yaw_new} vs {yaw_paper}");
 }
+
+/// The PIL configuration words and the cycle recording carry the paper's law only: another is
+/// refused by name, the paper's scenarios pass.
+#[test]
+fn the_wire_configuration_refuses_a_law_it_cannot_carry() {
+    let e = tvmd_sim::control::wire_config(&Scenario::default()).unwrap_err();
+    assert!(
+        matches!(&e, tvmd_sim::SimError::InvalidScenario { field, .. } if field == "law"),
+        "{e}"
+    );
+    tvmd_sim::control::wire_config(&Scenario::builtin("paper-tilt").unwrap()).unwrap();
+}
