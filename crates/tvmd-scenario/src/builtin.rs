@@ -3,13 +3,15 @@
 use std::f64::consts::PI;
 
 use super::{Failure, Scenario};
-use crate::{ScenarioError, FAMILY_NAMES};
+use crate::{LawConfig, ScenarioError, FAMILY_NAMES};
 use tvmd_plant::actuators::FailureKind;
 use tvmd_plant::physics::TeamBody;
 use tvmd_plant::reference::{PaperTilt, ReferenceConfig};
 
-/// The paper's scenarios and their variants (the families follow, from [`FAMILY_NAMES`]).
-const PAPER_NAMES: [&str; 11] = [
+/// The paper's scenarios and their variants, which fly the paper's law (`law = "paper"`), and
+/// the paper's experiment with the offset-free law (the families follow, from
+/// [`FAMILY_NAMES`], with the default law).
+const PAPER_NAMES: [&str; 13] = [
     "paper-tilt",
     "relaxation-0.25",
     "relaxation-0.5",
@@ -21,6 +23,8 @@ const PAPER_NAMES: [&str; 11] = [
     "a4-inc",
     "agent-failure",
     "a6-agent-failure",
+    "paper-experiment",
+    "paper-experiment-offset-free",
 ];
 
 /// `a` then `b`, at compile time: the family names are written once, in `families.rs`.
@@ -47,9 +51,17 @@ const ALL_NAMES: [&str; PAPER_NAMES.len() + FAMILY_NAMES.len()] =
 pub const BUILTIN_NAMES: &[&str] = &ALL_NAMES;
 
 impl Scenario {
-    /// A built-in scenario by name (see [`BUILTIN_NAMES`]).
+    /// A built-in scenario by name (see [`BUILTIN_NAMES`]). The paper's scenarios name the
+    /// paper's law ([`LawConfig::paper`]), so they stay the paper's flights bit for bit.
     pub fn builtin(name: &str) -> Result<Self, ScenarioError> {
-        let mut s = Scenario::default();
+        let mut s = Scenario {
+            name: "paper-tilt".into(),
+            description: "The paper's simulation: A4-Inc, ascent, roll tilt to an infeasible \
+                          pi/3, descent; s = 0.5"
+                .into(),
+            law: LawConfig::paper(),
+            ..Scenario::default()
+        };
         let with = |mut s: Scenario, description: &str| {
             s.name = name.to_string();
             s.description = description.to_string();
@@ -131,6 +143,18 @@ impl Scenario {
                      at 12 s",
                 )
             }
+            "paper-experiment" => with(
+                crate::experiment::paper_experiment(LawConfig::paper()),
+                "The paper's experiment, modelled, with the paper's law: take-off, tilt and hover \
+                 to 20 s on a tether pulling 0.3 N down, a 0.03 N m yaw torque, agents 0 and 2 \
+                 at 98% thrust, gimbal offsets, servo and rotor dynamics, state noise and one \
+                 period of latency",
+            ),
+            "paper-experiment-offset-free" => with(
+                crate::experiment::paper_experiment(LawConfig::default()),
+                "paper-experiment flown with the offset-free law (natural gains, the \
+                 disturbance observer, the planned rates)",
+            ),
             other => {
                 return super::families::family(other).ok_or_else(|| {
                     ScenarioError::UnknownScenario {

@@ -1,4 +1,4 @@
-//! Optional disturbances: wind, an external wrench, state noise.
+//! Optional disturbances: wind, an external wrench, state noise, feedback latency.
 
 use serde::{Deserialize, Serialize};
 
@@ -73,4 +73,16 @@ pub struct Disturbances {
     /// Noise on the fed-back state.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub state_noise: Option<StateNoise>,
+    /// Feedback latency in whole controller periods (0 to [`MAX_FEEDBACK_LATENCY`]): the
+    /// controller's tick at `t` is given the (noisy) state of `t - latency * period` (the state
+    /// at `t = 0` until then), as an estimator and a link that lag by that much would give it.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub feedback_latency: u32,
+}
+
+/// The largest [`Disturbances::feedback_latency`] (controller periods).
+pub const MAX_FEEDBACK_LATENCY: u32 = 1000;
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }

@@ -1,7 +1,8 @@
 //! The authors' scenario families as built-ins (`docs/method.md`, "Scenario families"): wind,
 //! payload, model error, a reference jump, sine and figure-eight tracking and a far initial
 //! attitude. Each starts in a hover at 1.5 m (no take-off: the metrics see the task, not the
-//! ascent) with A4-Inc; `--team` / `team=` flies it with any catalogue team.
+//! ascent) with A4-Inc and the default law (offset-free); `--team` / `team=` flies it with any
+//! catalogue team.
 
 use super::{Air, Gust, Payload, PlantError, Scenario};
 use tvmd_plant::reference::{FigureEight, ReferenceConfig, Sine, Step};
@@ -23,7 +24,8 @@ pub const FAMILY_NAMES: &[&str] = &[
 ];
 
 /// Release height of the initial-attitude family (m): recovering from 2.5 rad costs A4-Inc
-/// about 19 m of height with the paper's gains (measured: `tvmd-sim run initial-attitude-2.5`).
+/// about 19 m of height with the paper's law, 13 m with the default one (measured:
+/// `tvmd-sim run initial-attitude-2.5`).
 pub const RELEASE_HEIGHT: f64 = 30.0;
 
 /// Hover height of the families (m).
@@ -87,8 +89,8 @@ pub(super) fn family(name: &str) -> Option<Scenario> {
                 target: [0.5, 0.0, HOVER_HEIGHT],
                 time: 2.0,
             });
-            "A 0.5 m reference jump along x at t = 2 s from a hover at 1.5 m; 40 s for the slow \
-             position loop (K_x = 0.4) to settle"
+            "A 0.5 m reference jump along x at t = 2 s from a hover at 1.5 m; 40 s, for the \
+             paper's slow position loop (K_x = 0.4) to settle too"
                 .into()
         }
         "sine" => {
@@ -110,7 +112,7 @@ pub(super) fn family(name: &str) -> Option<Scenario> {
         name if name.starts_with("initial-attitude-") => {
             let roll: f64 = name["initial-attitude-".len()..].parse().ok()?;
             let high = [0.0, 0.0, RELEASE_HEIGHT];
-            // The position loop (K_x = 0.4, K_v = 0.8 on 2.8 kg) takes about 30 s to close.
+            // The paper's position loop (K_x = 0.4, K_v = 0.8 on 2.8 kg) takes about 30 s to close.
             s.duration = 40.0;
             s.initial_position = high;
             s.initial_attitude = [roll, 0.0, 0.0];

@@ -1,6 +1,7 @@
 //! Scenarios: TOML files (serde) and built-ins.
 //!
-//! Every field has a default (the paper's simulation, scenario `paper-tilt`), so a file only
+//! Every field has a default (the paper's manoeuvre, scenario `paper-tilt`, but flown with the
+//! offset-free law of `[law]`; the built-in `paper-tilt` names `law = "paper"`), so a file only
 //! states what differs. Unknown keys are rejected, and parse errors name the offending key
 //! (the message shows the key and its line). Semantic checks ([`Scenario::validate`]) name the
 //! field by its dotted path.
@@ -32,6 +33,12 @@
 //! k_r = [12.0, 12.0, 1.0]
 //! k_xi = [8.0, 8.0, 1.5, 0.8, 0.8, 2.0]
 //!
+//! [law]                      # the law beyond the paper; this is the default (law = "paper":
+//!                            # the [gains] as given, no offset-free action, the reference's rates)
+//! gains = { natural = { position_frequency = [1.5, 1.5, 1.5], attitude_frequency = [6.0, 6.0, 6.0] } }
+//! offset_free = { kind = "observer", force_bandwidth = 10.0, torque_bandwidth = 10.0, max_torque = 5.0 }
+//! attitude_rate = { bandwidth = 20.0, max_rate = 5.0 }
+//!
 //! [reference]
 //! kind = "paper-tilt"        # or "hover" with position = [..] and roll = ..
 //! ascent_height = 1.5
@@ -54,6 +61,7 @@
 //! wind = [0.5, 0.0, 0.0]
 //! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
 //! state_noise = { position = 0.01, velocity = 0.02, attitude = 0.005, angular_velocity = 0.01, seed = 7 }
+//! feedback_latency = 1       # the controller sees the state of one period before (default 0)
 //!
 //! [success]                  # the verdict's bounds (see `SuccessBounds`)
 //! max_steady_state_position_error = 0.05
@@ -73,8 +81,10 @@ mod checks;
 mod controller;
 mod disturbances;
 mod error;
+mod experiment;
 mod failures;
 mod families;
+mod law;
 mod log_settings;
 mod null_space;
 mod overrides;
@@ -87,10 +97,14 @@ mod validate;
 pub use air::{Air, Gust, DRAG_AREA_PER_AGENT};
 pub use builtin::BUILTIN_NAMES;
 pub use controller::{GainsConfig, Precision, ALLOCATOR_NAMES};
-pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise};
+pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise, MAX_FEEDBACK_LATENCY};
 pub use error::ScenarioError;
 pub use failures::{Failure, FailureResponse, OnHoverLoss};
 pub use families::{FAMILY_NAMES, HOVER_HEIGHT, RELEASE_HEIGHT};
+pub use law::{
+    AttitudeRateConfig, GainScheduleConfig, LawConfig, NaturalGainsConfig, OffsetFreeConfig,
+    LAW_NAMES,
+};
 pub use log_settings::LogSettings;
 pub use null_space::{
     NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,

@@ -8,7 +8,7 @@ use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
 use crate::error::invalid;
 use crate::{
-    Disturbances, Failure, FailureResponse, GainsConfig, LimitsConfig, LogSettings,
+    Disturbances, Failure, FailureResponse, GainsConfig, LawConfig, LimitsConfig, LogSettings,
     NullSpaceConfig, Payload, PlantError, Precision, ScenarioError, SuccessBounds, TeamSpec,
 };
 
@@ -59,8 +59,13 @@ pub struct Scenario {
     pub team: TeamSpec,
     /// Gimbal and thrust limits.
     pub limits: LimitsConfig,
-    /// Controller gains.
+    /// Controller gains (used as `law.gains` says: as given by `"paper"`, scaled by
+    /// `"team-scaled"`, not at all by natural gains).
     pub gains: GainsConfig,
+    /// The control law's settings beyond the paper (`[law]`, [`LawConfig`]): natural gains,
+    /// the disturbance observer and the planned rates by default; `law = "paper"` for the
+    /// paper's law, bit for bit.
+    pub law: LawConfig,
     /// Reference trajectory.
     pub reference: ReferenceConfig,
     /// Actuator model (ideal by default).
@@ -87,8 +92,8 @@ impl Default for Scenario {
     fn default() -> Self {
         Self {
             name: "paper-tilt".into(),
-            description: "The paper's simulation: A4-Inc, ascent, roll tilt to an infeasible \
-                          pi/3, descent; s = 0.5"
+            description: "The paper's manoeuvre (A4-Inc, ascent, roll tilt to an infeasible pi/3, \
+                          descent; s = 0.5) flown with the offset-free law"
                 .into(),
             duration: 16.0,
             controller_period: 0.01,
@@ -103,6 +108,7 @@ impl Default for Scenario {
             team: TeamSpec::default(),
             limits: LimitsConfig::default(),
             gains: GainsConfig::default(),
+            law: LawConfig::default(),
             reference: ReferenceConfig::default(),
             actuators: ActuatorModel::default(),
             failures: Vec::new(),

@@ -8,6 +8,18 @@ use tvmd_plant::ReferenceConfig;
 fn empty_file_is_paper_tilt() {
     let s = Scenario::from_toml_str("").unwrap();
     assert_eq!(s, Scenario::default());
+    // The paper's manoeuvre, flown with the law that flies; the built-in names the paper's.
+    assert_eq!(s.law, LawConfig::default());
+    let paper = Scenario::builtin("paper-tilt").unwrap();
+    assert!(paper.law.is_paper());
+    assert_eq!(
+        Scenario {
+            law: LawConfig::paper(),
+            ..s.clone()
+        }
+        .reference,
+        paper.reference
+    );
     assert_eq!(s.steps_per_control().unwrap(), 10);
     assert!((s.max_thrust().unwrap() - 2.0 * 0.7 * 9.81).abs() < 1e-12);
 }
@@ -139,4 +151,105 @@ fn load_takes_a_builtin_name_or_a_file() {
         "{e}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn law_parses_names_tables_and_round_trips() {
+    let law = |text: &str| Scenario::from_toml_str(text).map(|s| s.law);
+    assert_eq!(law("law = \"paper\"\n").unwrap(), LawConfig::paper());
+    assert_eq!(
+        law("law = \"offset-free\"\n").unwrap(),
+        LawConfig::default()
+    );
+    // A table states what differs from the default law.
+    let t = law("[law]\ngains = \"team-scaled\"\nattitude_rate = \"off\"\n").unwrap();
+    assert_eq!(t.gains, GainScheduleConfig::TeamScaled);
+    assert_eq!(t.offset_free, OffsetFreeConfig::observer());
+    assert_eq!(t.attitude_rate, AttitudeRateConfig::Off);
+    let n = law("[law.gains.natural]\nposition_frequency = [1.0, 2.0, 3.0]\n").unwrap();
+    let GainScheduleConfig::Natural(g) = n.gains else {
+        panic!("{n:?}")
+    };
+    assert_eq!(g.position_frequency, [1.0, 2.0, 3.0]);
+    assert_eq!(
+        g.attitude_frequency,
+        NaturalGainsConfig::default().attitude_frequency
+    );
+    let i = law(
+        "[law]\noffset_free = { kind = \"integral\", k_x = [1.0, 1.0, 2.0], k_r = [0.5, 0.5, 0.5] }\n",
+    )
+    .unwrap();
+    assert!(matches!(
+        i.offset_free,
+        OffsetFreeConfig::Integral { k_x: [1.0, 1.0, 2.0], max_torque, .. } if max_torque == 5.0
+    ));
+    let o = law("[law]\noffset_free = { kind = \"observer\", force_bandwidth = 4.0 }\n").unwrap();
+    assert!(matches!(
+        o.offset_free,
+        OffsetFreeConfig::Observer { force_bandwidth, torque_bandwidth, .. }
+            if force_bandwidth == 4.0 && torque_bandwidth == 10.0
+    ));
+    assert_eq!(
+        law("[law]\noffset_free = \"off\"\n").unwrap().offset_free,
+        OffsetFreeConfig::Off
+    );
+    for l in [LawConfig::paper(), LawConfig::default(), t, n, i, o] {
+        let s = Scenario {
+            law: l,
+            ..Scenario::default()
+        };
+        let back = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
+        assert_eq!(back.law, l);
+    }
+}
+
+#[test]
+fn bad_law_settings_name_the_field() {
+    let err = |text: &str| Scenario::from_toml_str(text).unwrap_err().to_string();
+    for (text, names) in [
+        ("law = \"fast\"\n", &["law", "unknown law `fast`"][..]),
+        ("[law]\ngains = \"scaled\"\n", &["law.gains", "scaled"]),
+        ("[law]\nspeed = 1\n", &["law", "speed"]),
+        (
+            "[law]\noffset_free = { kind = \"kalman\" }\n",
+            &["law.offset_free", "kalman", "observer, integral"],
+        ),
+        (
+            "[law]\noffset_free = { kind = \"integral\", k_x = [1.0, 1.0, 1.0] }\n",
+            &["law.offset_free", "k_r"],
+        ),
+        (
+            "[law]\noffset_free = { kind = \"observer\", k_x = [1.0, 1.0, 1.0] }\n",
+            &["law.offset_free", "k_x", "observer"],
+        ),
+        (
+            "[law]\nattitude_rate = \"on\"\n",
+            &["law.attitude_rate", "on"],
+        ),
+        (
+            "[law]\nattitude_rate = { bandwidth = 20.0, rate = 1.0 }\n",
+            &["law.attitude_rate", "rate"],
+        ),
+        (
+            "[law.gains.natural]\nattitude_damping = [1.0, 0.0, 1.0]\n",
+            &["law.gains.natural.attitude_damping[1]"],
+        ),
+        (
+            "[law]\noffset_free = { kind = \"observer\", max_torque = -1.0 }\n",
+            &["law.offset_free.max_torque"],
+        ),
+        (
+            "[law]\nattitude_rate = { bandwidth = inf }\n",
+            &["law.attitude_rate.bandwidth"],
+        ),
+        (
+            "[disturbances]\nfeedback_latency = 5000\n",
+            &["disturbances.feedback_latency", "5000"],
+        ),
+    ] {
+        let e = err(text);
+        for name in names {
+            assert!(e.contains(name), "{text}: {e} lacks {name}");
+        }
+    }
 }

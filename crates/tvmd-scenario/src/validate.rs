@@ -282,6 +282,17 @@ impl Scenario {
                 &[n.position, n.velocity, n.attitude, n.angular_velocity],
             )?;
         }
+        let latency = self.disturbances.feedback_latency;
+        if latency > crate::disturbances::MAX_FEEDBACK_LATENCY {
+            return Err(invalid(
+                "disturbances.feedback_latency",
+                format!(
+                    "must be at most {} controller periods, got {latency}",
+                    crate::disturbances::MAX_FEEDBACK_LATENCY
+                ),
+            ));
+        }
+        self.law.validate()?;
         Ok(())
     }
 }

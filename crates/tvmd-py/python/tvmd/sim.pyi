@@ -375,6 +375,11 @@ class Distributions(TypedDict, total=False):
     initial_tilt: float
     """Initial tilt in ``[0, e]`` rad about a random horizontal axis (default 0, at most 2.5;
     the scenario must start in the air)."""
+    conditions: dict[str, Any]
+    """Flight conditions every flight meets where the scenario sets none: ``servo`` (a servo
+    model table), ``state_noise`` (a noise table; its seed is drawn per flight),
+    ``feedback_latency`` (periods); default 40 rad/s servos, 1 mm / 1 cm/s / 2 mrad / 0.01 rad/s
+    noise and one period. ``{"servo": None, "state_noise": None, "feedback_latency": 0}``: none."""
 
 def monte_carlo(
     scenario: Optional[_ScenarioArg] = None,

@@ -4,15 +4,18 @@
 
 use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
-    AgentLimits, AgentSpec, AnyAllocator, ControllerSettings, FailureMask, Gains, Navigator,
-    RateLimits, Relaxation, TeamConfig,
+    AgentLimits, AgentSpec, AnyAllocator, AttitudeRateFilter, ControllerSettings,
+    DisturbanceObserver, FailureMask, GainSchedule, Gains, IntegralAction, NaturalGains, Navigator,
+    OffsetFree, RateLimits, Relaxation, TeamConfig,
 };
 
 use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
 use super::MAX_AGENTS;
 use crate::SimError;
 use tvmd_plant::math::from_rows;
-use tvmd_scenario::Scenario;
+use tvmd_scenario::{
+    AttitudeRateConfig, GainScheduleConfig, LawConfig, OffsetFreeConfig, Scenario,
+};
 
 pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
     SimError::InvalidScenario {
@@ -49,6 +52,11 @@ fn config_field(e: &ConfigError) -> &'static str {
         Some(ConfigField::GainKx) => "gains.k_x",
         Some(ConfigField::GainKr) => "gains.k_r",
         Some(ConfigField::GainKomega | ConfigField::GainKv) => "gains.k_xi",
+        Some(ConfigField::NaturalFrequency | ConfigField::DampingRatio) => "law.gains.natural",
+        Some(ConfigField::IntegralGain | ConfigField::ObserverBandwidth) => "law.offset_free",
+        Some(ConfigField::OffsetFreeTorqueBound) => "law.offset_free.max_torque",
+        Some(ConfigField::AttitudeRateBandwidth) => "law.attitude_rate.bandwidth",
+        Some(ConfigField::AttitudeRateLimit) => "law.attitude_rate.max_rate",
         Some(ConfigField::RateLimits) => "controller_rate_limits",
         Some(ConfigField::Period) => "controller_period",
         Some(ConfigField::Gravity) => "physics.gravity",
@@ -108,8 +116,9 @@ pub fn team_config<T: CoreFloat>(
     TeamConfig::new(&agents, limits, navigator).map_err(config_error)
 }
 
-/// The core's controller settings of a scenario in `T`: gains, relaxation, gravity, period and
-/// the optional controller rate limits.
+/// The core's controller settings of a scenario in `T`: gains, relaxation, gravity, period,
+/// the optional controller rate limits and null-space stage, and the law's settings
+/// (`[law]`: gain schedule, offset-free action, planned rates; [`law_settings`]).
 pub fn controller_settings<T: CoreFloat>(
     scenario: &Scenario,
 ) -> Result<ControllerSettings<T>, SimError> {
@@ -122,6 +131,7 @@ pub fn controller_settings<T: CoreFloat>(
         .map(|[x, y]| RateLimits::new(to_core(x), to_core(y)))
         .transpose()
         .map_err(config_error)?;
+    let (gain_schedule, offset_free, attitude_rate) = law_settings(&scenario.law)?;
     Ok(ControllerSettings {
         gains,
         relaxation,
@@ -133,10 +143,72 @@ pub fn controller_settings<T: CoreFloat>(
             .as_ref()
             .map(|n| n.stage::<T>())
             .transpose()?,
-        gain_schedule: tvmd_core::GainSchedule::AsGiven,
-        offset_free: None,
-        attitude_rate: None,
+        gain_schedule,
+        offset_free,
+        attitude_rate,
     })
+}
+
+/// The core's settings of the scenario's `[law]` in `T`: the gain schedule, the offset-free
+/// action and the planned-rate filter. `law = "paper"` gives `AsGiven`, `None`, `None`: the
+/// paper's cycle bit for bit.
+#[allow(clippy::type_complexity)]
+pub fn law_settings<T: CoreFloat>(
+    law: &LawConfig,
+) -> Result<
+    (
+        GainSchedule<T>,
+        Option<OffsetFree<T>>,
+        Option<AttitudeRateFilter<T>>,
+    ),
+    SimError,
+> {
+    let gain_schedule = match &law.gains {
+        GainScheduleConfig::Paper => GainSchedule::AsGiven,
+        GainScheduleConfig::TeamScaled => GainSchedule::TeamScaled,
+        GainScheduleConfig::Natural(n) => GainSchedule::Natural(
+            NaturalGains::new(
+                n.position_frequency.map(to_core),
+                n.position_damping.map(to_core),
+                n.attitude_frequency.map(to_core),
+                n.attitude_damping.map(to_core),
+            )
+            .map_err(config_error)?,
+        ),
+    };
+    let offset_free = match law.offset_free {
+        OffsetFreeConfig::Off => None,
+        OffsetFreeConfig::Observer {
+            force_bandwidth,
+            torque_bandwidth,
+            max_torque,
+        } => Some(OffsetFree::Observer(
+            DisturbanceObserver::new(
+                to_core(force_bandwidth),
+                to_core(torque_bandwidth),
+                to_core(max_torque),
+            )
+            .map_err(config_error)?,
+        )),
+        OffsetFreeConfig::Integral {
+            k_x,
+            k_r,
+            max_torque,
+        } => Some(OffsetFree::Integral(
+            IntegralAction::new(k_x.map(to_core), k_r.map(to_core), to_core(max_torque))
+                .map_err(config_error)?,
+        )),
+    };
+    let attitude_rate = match law.attitude_rate {
+        AttitudeRateConfig::Off => None,
+        AttitudeRateConfig::Filter {
+            bandwidth,
+            max_rate,
+        } => Some(
+            AttitudeRateFilter::new(to_core(bandwidth), to_core(max_rate)).map_err(config_error)?,
+        ),
+    };
+    Ok((gain_schedule, offset_free, attitude_rate))
 }
 
 /// The allocator named by `scenario.allocator`, in `T`.
@@ -173,9 +245,17 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 /// The f32 controller's configuration of a scenario as the words an f32 target builds it from
 /// ([`tvmd_wire::CoreConfig`]): every value rounded exactly as [`team_config`],
 /// [`controller_settings`] and [`allocator`] round it. Errors name the scenario field, as
-/// [`super::TvmdController::from_scenario`]'s do.
+/// [`super::TvmdController::from_scenario`]'s do. The words carry the paper's law only (no
+/// `[law]` settings): any other `law` is refused, naming the field.
 pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
     use tvmd_wire::{CoreConfig, AGENTS, ALLOCATOR_NAME_BYTES};
+    if !scenario.law.is_paper() {
+        return Err(invalid(
+            "law",
+            "the PIL firmware and the cycle recording carry the paper's law only: give \
+             law = \"paper\"",
+        ));
+    }
     team_config::<f32>(scenario)?;
     controller_settings::<f32>(scenario)?;
     allocator::<f32>(&scenario.allocator)?;

@@ -37,6 +37,10 @@ pub trait CoreEngine<T: CoreFloat> {
     /// [`tvmd_core::Controller::failures`]: the mask the core accepted.
     fn failures(&self) -> FailureMask<MAX_AGENTS>;
 
+    /// [`tvmd_core::Controller::set_landed`]: the team is on the ground (the offset-free
+    /// state is cleared and held). Without an offset-free action it changes nothing.
+    fn set_landed(&mut self, landed: bool) -> Result<(), BoxedError>;
+
     /// [`tvmd_core::Controller::step`].
     fn step(
         &mut self,
@@ -55,6 +59,11 @@ impl<T: CoreFloat> CoreEngine<T> for CoreController<T> {
 
     fn failures(&self) -> FailureMask<MAX_AGENTS> {
         *tvmd_core::Controller::failures(self)
+    }
+
+    fn set_landed(&mut self, landed: bool) -> Result<(), BoxedError> {
+        tvmd_core::Controller::set_landed(self, landed);
+        Ok(())
     }
 
     fn step(

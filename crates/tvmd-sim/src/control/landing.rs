@@ -19,6 +19,13 @@ use tvmd_plant::reference::ReferenceSample;
 /// Height (m) above the rest height under which a landed team is disarmed.
 pub const TOUCHDOWN_HEIGHT: f64 = 0.05;
 
+/// Height (m) of the fed-back centre of mass above the rest height (`z = 0`, the team resting
+/// on the ground) at or under which the controller is told the team is on the ground
+/// ([`tvmd_core::Controller::set_landed`]): before take-off and after touchdown. A land
+/// detector on the controller's own state estimate, as a flight controller's would be; 2 cm
+/// is well above the ground contact's jitter and the state noise of the scenarios.
+pub const LANDED_HEIGHT: f64 = 0.02;
+
 /// A landing started at time `start` from `from`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Landing {

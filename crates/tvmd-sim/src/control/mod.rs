@@ -11,16 +11,20 @@
 //! 1. converts the simulator's state (world velocity `x_dot`, body `Omega`) into the core's
 //!    state with the body-frame velocity `v = R^T x_dot`, and the reference likewise, rounding
 //!    to `T` (module `convert`: the only place precisions meet);
-//! 2. passes a changed failure mask (the failures the controller is told of) to
+//! 2. tells the core whether the team is on the ground ([`tvmd_core::Controller::set_landed`],
+//!    when it changes): the fed-back centre of mass at most [`LANDED_HEIGHT`] above its rest
+//!    height `z = 0`, before take-off and after touchdown (the ground's reaction is not a
+//!    disturbance for the offset-free action to learn);
+//! 3. passes a changed failure mask (the failures the controller is told of) to
 //!    [`tvmd_core::Controller::set_failures`]; if the core refuses it (the remaining team cannot
 //!    produce every wrench) the old mask stays and the reason is reported in
 //!    [`Diagnostics::failure_note`]; an accepted mask's hover classification is reported in
 //!    [`Diagnostics::hover`], and with `failure_response.on_hover_loss = "land"` a team
 //!    classified not hover-capable flies a level descent to `z = 0` from then on (module
 //!    `landing`);
-//! 3. runs one [`tvmd_core::Controller::step`] in `T`; on a [`tvmd_core::CycleError`] it holds
+//! 4. runs one [`tvmd_core::Controller::step`] in `T`; on a [`tvmd_core::CycleError`] it holds
 //!    the commands the error carries and reports the error in [`Diagnostics::cycle_error`];
-//! 4. converts the commands and every part of [`Diagnostics`] (planner, control law,
+//! 5. converts the commands and every part of [`Diagnostics`] (planner, control law,
 //!    allocation, Lyapunov values) back to f64 (exact).
 
 use tvmd_core::{AnyAllocator, FailureMask};
@@ -42,9 +46,11 @@ pub mod pil;
 pub mod recording;
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-pub use landing::Landing;
+pub use landing::{Landing, LANDED_HEIGHT};
 
-pub use config::{allocator, controller_settings, hover_roll_limit, team_config, wire_config};
+pub use config::{
+    allocator, controller_settings, hover_roll_limit, law_settings, team_config, wire_config,
+};
 pub use convert::{core_reference, core_state, sim_command, CoreFloat};
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
@@ -84,6 +90,8 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     /// The last mask the core refused: reported once, not asked for again until it changes.
     refused: Option<Vec<bool>>,
     landing: Option<Landing>,
+    /// What the core was last told by `set_landed`.
+    landed: bool,
 }
 
 impl<T: CoreFloat> TvmdController<T> {
@@ -126,6 +134,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             hover: None,
             refused: None,
             landing: None,
+            landed: false,
         }
     }
 
@@ -214,6 +223,11 @@ impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
         reference: &ReferenceSample,
         failed: &[bool],
     ) -> Result<FlightOutput, BoxedError> {
+        let landed = state.position.z <= landing::LANDED_HEIGHT;
+        if landed != self.landed {
+            self.inner.set_landed(landed)?;
+            self.landed = landed;
+        }
         self.update_failures(t, state, failed)?;
         let n = self.n;
         if let Some(landing) = &mut self.landing {

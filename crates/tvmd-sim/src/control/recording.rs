@@ -81,6 +81,12 @@ impl<E: CoreEngine<f32>> CoreEngine<f32> for Recorder<E> {
         self.inner.failures()
     }
 
+    /// Forwarded, not recorded: a recording carries the paper's law only
+    /// ([`super::wire_config`] refuses another), for which the landed hold changes nothing.
+    fn set_landed(&mut self, landed: bool) -> Result<(), BoxedError> {
+        self.inner.set_landed(landed)
+    }
+
     fn step(
         &mut self,
         state: &RigidState<f32>,

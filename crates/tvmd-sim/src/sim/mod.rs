@@ -5,7 +5,8 @@
 //! Actuators, failures and disturbances act at the physics rate. Each controller tick
 //! (`t_k = k controller_period`):
 //!
-//! 1. the true state is read and, if configured, noise is added to the copy fed back;
+//! 1. the true state is read and, if configured, noise is added to the copy fed back, which
+//!    reaches the controller `disturbances.feedback_latency` ticks later ([`latency`]);
 //! 2. the reference is evaluated at `t_k`;
 //! 3. the controller is called with the state, the reference and the failure flags it is
 //!    told about (a failure with `controller_informed = false` stays `false` for it);
@@ -21,6 +22,7 @@
 
 pub mod difference;
 mod forces;
+pub mod latency;
 pub mod retention;
 pub mod sample;
 pub mod summary;
@@ -127,6 +129,7 @@ pub struct Simulation {
     failed_true: Vec<bool>,
     failed_told: Vec<bool>,
     noise: Option<(StateNoise, ChaCha8Rng)>,
+    delay: latency::FeedbackDelay,
     max_thrust: f64,
     samples: SampleStore,
     fold: SummaryFold,
@@ -179,6 +182,7 @@ impl Simulation {
                 .disturbances
                 .state_noise
                 .map(|s| (s, ChaCha8Rng::seed_from_u64(s.seed))),
+            delay: latency::FeedbackDelay::new(scenario.disturbances.feedback_latency),
             max_thrust: scenario.max_thrust()?,
             scenario: scenario.clone(),
             team,
@@ -386,6 +390,7 @@ impl Simulation {
                 let truth = self.world.state();
                 check_divergence(t, &truth)?;
                 let fed = self.noisy(&truth);
+                let fed = self.delay.delay(fed);
                 let reference = self.scenario.reference.at(t);
                 let out = controller
                     .step(t, &fed, &reference, &self.failed_told)

@@ -7,8 +7,10 @@ use tvmd_scenario::Scenario;
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::{FlightDifference, RunResult};
 
+/// `paper-tilt` (the paper's manoeuvre with the paper's law) with the TOML `toml` added.
 fn fly(toml: &str) -> RunResult {
-    run_scenario(&Scenario::from_toml_str(toml).unwrap(), None, None).unwrap()
+    let toml = format!("law = \"paper\"\n{toml}");
+    run_scenario(&Scenario::from_toml_str(&toml).unwrap(), None, None).unwrap()
 }
 
 /// The stated tolerances (about 4x the differences measured with rapier 0.36.1).

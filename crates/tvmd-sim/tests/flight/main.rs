@@ -9,6 +9,7 @@ mod coarse_step;
 mod flight_metrics;
 mod hover_failure;
 mod null_space;
+mod offset_free;
 mod precision;
 mod recording;
 mod sample_retention;

@@ -1,8 +1,9 @@
 //! The scenario families (wind, payload, model error, reference jump, tracking, initial
 //! attitudes) against the physics they model: each steady state where the paper's law (no
-//! integral action) puts it, and every family flown to its end by more than one team.
+//! integral action, `law = "paper"`) puts it, and every family flown to its end by more than
+//! one team with its own (default) law. The default law's steady states: `offset_free.rs`.
 
-use tvmd_scenario::{Air, Payload, Scenario, FAMILY_NAMES, HOVER_HEIGHT};
+use tvmd_scenario::{Air, LawConfig, Payload, Scenario, FAMILY_NAMES, HOVER_HEIGHT};
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::RunResult;
 use tvmd_sim::GRAVITY;
@@ -52,6 +53,7 @@ fn every_family_flies_to_its_end_with_two_teams() {
 #[test]
 fn an_unmodelled_mass_sags_by_dm_g_over_k_z() {
     let mut s = Scenario::builtin("hover").unwrap();
+    s.law = LawConfig::paper();
     s.duration = 40.0;
     s.plant.mass_scale = 1.02;
     let r = fly(&s);
@@ -68,6 +70,7 @@ fn an_unmodelled_mass_sags_by_dm_g_over_k_z() {
 #[test]
 fn a_steady_wind_pushes_the_team_downwind_by_drag_over_k_x() {
     let mut s = Scenario::builtin("hover").unwrap();
+    s.law = LawConfig::paper();
     s.duration = 40.0;
     s.disturbances.air = Some(Air {
         velocity: [1.0, 0.0, 0.0],
@@ -90,6 +93,7 @@ fn a_steady_wind_pushes_the_team_downwind_by_drag_over_k_x() {
 #[test]
 fn a_payload_off_the_centre_sags_and_tilts() {
     let mut s = Scenario::builtin("hover").unwrap();
+    s.law = LawConfig::paper();
     s.duration = 40.0;
     s.payloads = vec![Payload {
         mass: 0.1,
@@ -112,8 +116,11 @@ fn a_payload_off_the_centre_sags_and_tilts() {
 }
 
 #[test]
-fn the_model_error_family_misses_its_bounds_and_says_so() {
-    let r = fly(&Scenario::builtin("model-error").unwrap());
+fn the_model_error_family_misses_its_bounds_with_the_paper_law_and_says_so() {
+    let r = fly(&Scenario {
+        law: LawConfig::paper(),
+        ..Scenario::builtin("model-error").unwrap()
+    });
     let v = &r.summary.verdict;
     assert!(
         !v.success && v.failures.iter().any(|f| f.contains("position")),

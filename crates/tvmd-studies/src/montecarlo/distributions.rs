@@ -7,6 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::conditions::Conditions;
 use crate::StudyError;
 use tvmd_scenario::{PlantError, Scenario};
 
@@ -35,6 +36,9 @@ pub struct Distributions {
     /// e = 0 (a scenario that starts on the ground cannot start tilted). Not scaled by
     /// `model_error`.
     pub initial_tilt: f64,
+    /// The flight conditions every flight meets ([`Conditions`]): servo dynamics, state
+    /// noise and one period of latency by default.
+    pub conditions: Conditions,
 }
 
 impl Default for Distributions {
@@ -48,6 +52,7 @@ impl Default for Distributions {
             gimbal_offset: 0.01,
             initial_position: 0.1,
             initial_tilt: 0.0,
+            conditions: Conditions::default(),
         }
     }
 }

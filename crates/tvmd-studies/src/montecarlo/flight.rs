@@ -43,7 +43,8 @@ impl FlightSpec {
         })
     }
 
-    /// The scenario this flight flies: base, team, allocator, then the draw.
+    /// The scenario this flight flies: base, team, allocator, the draw, then the study's
+    /// flight conditions.
     pub fn scenario(&self) -> Result<(Scenario, Draw), StudyError> {
         let mut base = Scenario::from_toml_str(&self.scenario_toml)?;
         if let Some(team) = &self.team {
@@ -54,7 +55,12 @@ impl FlightSpec {
         base.validate()?;
         let n = base.team_body()?.len();
         let draw = Draw::new(&self.distributions, self.seed, self.index, n);
-        Ok((draw.apply(&base)?, draw))
+        let mut flown = draw.apply(&base)?;
+        self.distributions
+            .conditions
+            .apply(&mut flown, self.seed, self.index);
+        flown.validate()?;
+        Ok((flown, draw))
     }
 }
 

@@ -9,6 +9,7 @@
 
 pub mod boxplot;
 pub mod catalogue;
+pub mod conditions;
 pub mod distributions;
 pub mod flight;
 pub mod report;
@@ -17,6 +18,7 @@ mod study_run;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub use conditions::Conditions;
 pub use distributions::{Distributions, Draw};
 pub use flight::{fly_flight, fly_flight_until, FlightRow, FlightSpec};
 pub use report::{group_summaries, quantile, text_table, write_csv, GroupSummary};

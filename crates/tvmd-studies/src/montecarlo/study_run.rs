@@ -65,6 +65,7 @@ impl MonteCarloRequest {
                 gimbal_offset: or(self.gimbal_offset, d.gimbal_offset),
                 initial_position: or(self.initial_position, d.initial_position),
                 initial_tilt: or(self.initial_tilt, d.initial_tilt),
+                conditions: d.conditions,
             },
             scenario,
         })

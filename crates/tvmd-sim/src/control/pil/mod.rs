@@ -328,6 +328,12 @@ impl CoreEngine<f32> for PilCore {
         self.failures
     }
 
+    /// Nothing to send: the firmware runs the paper's law only ([`super::wire_config`]
+    /// refuses another), which has no offset-free state to hold.
+    fn set_landed(&mut self, _landed: bool) -> Result<(), BoxedError> {
+        Ok(())
+    }
+
     fn step(
         &mut self,
         state: &RigidState<f32>,
