@@ -22,32 +22,48 @@ pub struct FlightOutput {
     pub diagnostics: Diagnostics,
 }
 
-/// A digital flight controller.
-///
-/// `state` is the (possibly noisy) fed-back state; `failed[i]` is true if agent `i` failed
-/// and the controller is told so. Closures with the same signature implement the trait.
+/// What a flight controller is given at one controller tick `t_k`: the one definition of a
+/// step's inputs, shared by every controller and by the loop.
+#[derive(Clone, Copy, Debug)]
+pub struct FlightInput<'a> {
+    /// Simulation time `t_k` (s).
+    pub t: f64,
+    /// The fed-back state (the true state with the scenario's noise and feedback latency).
+    pub state: &'a PlantState,
+    /// The reference at `t_k`.
+    pub reference: &'a ReferenceSample,
+    /// `failed[i]`: agent `i` failed and the controller is told so.
+    pub failed: &'a [bool],
+}
+
+impl<'a> FlightInput<'a> {
+    /// The inputs of one tick.
+    pub fn new(
+        t: f64,
+        state: &'a PlantState,
+        reference: &'a ReferenceSample,
+        failed: &'a [bool],
+    ) -> Self {
+        Self {
+            t,
+            state,
+            reference,
+            failed,
+        }
+    }
+}
+
+/// A digital flight controller. Closures taking a [`FlightInput`] implement the trait.
 pub trait FlightController {
     /// Computes the commands for the next controller period.
-    fn step(
-        &mut self,
-        t: f64,
-        state: &PlantState,
-        reference: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError>;
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError>;
 }
 
 impl<F> FlightController for F
 where
-    F: FnMut(f64, &PlantState, &ReferenceSample, &[bool]) -> Result<FlightOutput, BoxedError>,
+    F: FnMut(&FlightInput<'_>) -> Result<FlightOutput, BoxedError>,
 {
-    fn step(
-        &mut self,
-        t: f64,
-        state: &PlantState,
-        reference: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError> {
-        self(t, state, reference, failed)
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
+        self(input)
     }
 }

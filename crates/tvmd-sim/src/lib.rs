@@ -41,7 +41,7 @@ pub use control::recording::{self, CycleRecording};
 pub use control::{AnyTvmdController, TvmdController, MAX_AGENTS};
 pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};
-pub use flight::{FlightController, FlightOutput};
+pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{

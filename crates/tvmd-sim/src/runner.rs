@@ -13,15 +13,13 @@ use crate::control::recording::{CycleRecording, Recorder};
 use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
-use crate::flight::{FlightController, FlightOutput};
+use crate::flight::{FlightController, FlightInput, FlightOutput};
 use crate::sim::summary::Verdict;
 use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
 use crate::sink::TickSink;
 use crate::tick_log::McapSink;
 use crate::SimError;
 use tvmd_log::{LiveOptions, RunLog, METADATA_SCENARIO};
-use tvmd_plant::physics::PlantState;
-use tvmd_plant::reference::ReferenceSample;
 use tvmd_scenario::{Precision, Scenario};
 
 /// A controller that reports the time of every call to a callback (for progress bars).
@@ -38,15 +36,9 @@ impl<'a> WithProgress<'a> {
 }
 
 impl FlightController for WithProgress<'_> {
-    fn step(
-        &mut self,
-        t: f64,
-        state: &PlantState,
-        reference: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError> {
-        (self.progress)(t);
-        self.inner.step(t, state, reference, failed)
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
+        (self.progress)(input.t);
+        self.inner.step(input)
     }
 }
 

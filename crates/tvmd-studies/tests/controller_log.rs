@@ -12,7 +12,7 @@ use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceConfig;
 use tvmd_scenario::Scenario;
 use tvmd_sim::control::{core_reference, core_state, TvmdController};
-use tvmd_sim::flight::FlightController;
+use tvmd_sim::flight::{FlightController, FlightInput};
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::SimError;
 use tvmd_studies::plot::{self, PlotSeries};
@@ -183,10 +183,14 @@ fn failures_reach_the_core_and_bad_inputs_hold_the_commands() {
     }
     .at(0.0);
     let mut failed = vec![false; 6];
-    let healthy = ctl.step(0.0, &state, &reference, &failed).unwrap();
+    let healthy = ctl
+        .step(&FlightInput::new(0.0, &state, &reference, &failed))
+        .unwrap();
     assert!(healthy.diagnostics.cycle_error.is_none());
     failed[3] = true;
-    let degraded = ctl.step(0.01, &state, &reference, &failed).unwrap();
+    let degraded = ctl
+        .step(&FlightInput::new(0.01, &state, &reference, &failed))
+        .unwrap();
     assert!(ctl.core().failures().is_failed(3));
     assert_eq!(degraded.commands[3].thrust, 0.0);
     assert!(degraded.diagnostics.allocation.unwrap().e_f < 1e-9);
@@ -194,7 +198,9 @@ fn failures_reach_the_core_and_bad_inputs_hold_the_commands() {
     // A non-rotation attitude: the cycle is skipped, the previous commands are held.
     let mut bad = state;
     bad.rotation = Matrix3::identity() * 2.0;
-    let held = ctl.step(0.02, &bad, &reference, &failed).unwrap();
+    let held = ctl
+        .step(&FlightInput::new(0.02, &bad, &reference, &failed))
+        .unwrap();
     let why = held.diagnostics.cycle_error.expect("cycle error reported");
     assert!(why.contains("state.attitude"), "{why}");
     assert_eq!(held.commands, degraded.commands);

@@ -31,10 +31,9 @@ use tvmd_core::{AnyAllocator, FailureMask};
 
 use crate::diagnostics::{Diagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
-use crate::flight::{FlightController, FlightOutput};
+use crate::flight::{FlightController, FlightInput, FlightOutput};
 use crate::SimError;
 use tvmd_plant::physics::PlantState;
-use tvmd_plant::reference::ReferenceSample;
 use tvmd_scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
 
 mod config;
@@ -216,13 +215,13 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
 }
 
 impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
-    fn step(
-        &mut self,
-        t: f64,
-        state: &PlantState,
-        reference: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError> {
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
+        let FlightInput {
+            t,
+            state,
+            reference,
+            failed,
+        } = *input;
         let landed = state.position.z <= landing::LANDED_HEIGHT;
         if landed != self.landed {
             self.inner.set_landed(landed)?;
@@ -353,17 +352,11 @@ impl AnyTvmdController {
 pub use crate::flight::HOST_TARGET;
 
 impl FlightController for AnyTvmdController {
-    fn step(
-        &mut self,
-        t: f64,
-        state: &PlantState,
-        reference: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError> {
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
         match self {
-            Self::F64(c) => c.step(t, state, reference, failed),
-            Self::F32(c) => c.step(t, state, reference, failed),
-            Self::Pil(c) => c.step(t, state, reference, failed),
+            Self::F64(c) => c.step(input),
+            Self::F32(c) => c.step(input),
+            Self::Pil(c) => c.step(input),
         }
     }
 }

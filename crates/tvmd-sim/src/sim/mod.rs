@@ -35,7 +35,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::Serialize;
 
-use crate::flight::FlightController;
+use crate::flight::{FlightController, FlightInput};
 use crate::sink::{LoggedTick, SceneRecord, Tick, TickSink};
 use crate::SimError;
 use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand};
@@ -393,7 +393,7 @@ impl Simulation {
                 let fed = self.delay.delay(fed);
                 let reference = self.scenario.reference.at(t);
                 let out = controller
-                    .step(t, &fed, &reference, &self.failed_told)
+                    .step(&FlightInput::new(t, &fed, &reference, &self.failed_told))
                     .map_err(|source| SimError::Controller { t, source })?;
                 if out.commands.len() != self.team.len() {
                     return Err(SimError::InvalidCommand {

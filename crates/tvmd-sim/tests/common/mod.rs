@@ -3,10 +3,9 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use tvmd_plant::actuators::ActuatorCommand;
-use tvmd_plant::physics::{PlantState, TeamBody};
-use tvmd_plant::reference::ReferenceSample;
+use tvmd_plant::physics::TeamBody;
 use tvmd_sim::diagnostics::{Diagnostics, LyapunovDiagnostics};
-use tvmd_sim::flight::{FlightController, FlightOutput};
+use tvmd_sim::flight::{FlightController, FlightInput, FlightOutput};
 use tvmd_sim::GRAVITY;
 
 type BoxedError = Box<dyn std::error::Error + Send + Sync>;
@@ -54,13 +53,13 @@ impl PdHover {
 }
 
 impl FlightController for PdHover {
-    fn step(
-        &mut self,
-        t: f64,
-        s: &PlantState,
-        r: &ReferenceSample,
-        failed: &[bool],
-    ) -> Result<FlightOutput, BoxedError> {
+    fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
+        let FlightInput {
+            t,
+            state: s,
+            reference: r,
+            failed,
+        } = *input;
         let n = self.alloc.nrows();
         if self.cut_at.is_some_and(|c| t >= c) {
             return Ok(FlightOutput {
@@ -101,10 +100,8 @@ impl FlightController for PdHover {
 }
 
 /// Zero thrust always.
-pub fn zero_thrust(
-    n: usize,
-) -> impl FnMut(f64, &PlantState, &ReferenceSample, &[bool]) -> Result<FlightOutput, BoxedError> {
-    move |_, _, _, _| {
+pub fn zero_thrust(n: usize) -> impl FnMut(&FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
+    move |_| {
         Ok(FlightOutput {
             commands: vec![ActuatorCommand::default(); n],
             ..Default::default()

@@ -7,6 +7,7 @@ use tvmd_plant::physics::PlantState;
 use tvmd_plant::ReferenceConfig;
 use tvmd_scenario::{LawConfig, Scenario};
 use tvmd_sim::control::{TvmdController, LANDED_HEIGHT};
+use tvmd_sim::flight::FlightInput;
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::RunResult;
 use tvmd_sim::FlightController;
@@ -80,13 +81,16 @@ fn the_adapter_holds_the_offset_free_state_on_the_ground() {
     .at(0.0);
     let failed = [false; 4];
     let ground = PlantState::at_rest(Vector3::zeros());
-    c.step(0.0, &ground, &reference, &failed).unwrap();
+    c.step(&FlightInput::new(0.0, &ground, &reference, &failed))
+        .unwrap();
     assert!(c.core().landed());
     // A second period on the ground with the reference a metre above: nothing is learnt.
-    c.step(0.01, &ground, &reference, &failed).unwrap();
+    c.step(&FlightInput::new(0.01, &ground, &reference, &failed))
+        .unwrap();
     assert_eq!(c.core().offset_free_compensation().force, Vector3::zeros());
     let air = PlantState::at_rest(Vector3::new(0.0, 0.0, 2.0 * LANDED_HEIGHT));
-    c.step(0.02, &air, &reference, &failed).unwrap();
+    c.step(&FlightInput::new(0.02, &air, &reference, &failed))
+        .unwrap();
     assert!(!c.core().landed());
 }
 

@@ -8,7 +8,7 @@ use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceConfig;
 use tvmd_scenario::{Precision, Scenario};
 use tvmd_sim::control::{AnyTvmdController, MAX_AGENTS};
-use tvmd_sim::flight::FlightController;
+use tvmd_sim::flight::{FlightController, FlightInput};
 use tvmd_sim::runner::run_scenario;
 use tvmd_sim::sim::FlightDifference;
 
@@ -48,13 +48,17 @@ fn f32_out_of_range_input_holds_the_commands_without_nan() {
     .at(0.0);
     let state = PlantState::at_rest(Vector3::new(0.0, 0.0, 1.5));
     let failed = [false; 4];
-    let good = ctl.step(0.0, &state, &reference, &failed).unwrap();
+    let good = ctl
+        .step(&FlightInput::new(0.0, &state, &reference, &failed))
+        .unwrap();
     assert!(good.diagnostics.cycle_error.is_none());
     assert!(good.commands.iter().all(|c| c.thrust > 0.0));
     // Finite in f64, beyond f32's range: rounds to infinity, which the core rejects.
     let mut far = state;
     far.position.x = 1e39;
-    let held = ctl.step(0.01, &far, &reference, &failed).unwrap();
+    let held = ctl
+        .step(&FlightInput::new(0.01, &far, &reference, &failed))
+        .unwrap();
     let why = held.diagnostics.cycle_error.expect("cycle error reported");
     assert!(why.contains("state.position"), "{why}");
     assert_eq!(held.commands, good.commands);

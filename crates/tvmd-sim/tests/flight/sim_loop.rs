@@ -5,10 +5,9 @@ use std::rc::Rc;
 
 use crate::common::{zero_thrust, PdHover};
 use tvmd_plant::actuators::{ActuatorCommand, FailureKind};
-use tvmd_plant::physics::PlantState;
-use tvmd_plant::reference::{ReferenceConfig, ReferenceSample};
+use tvmd_plant::reference::ReferenceConfig;
 use tvmd_scenario::{Failure, Scenario, StateNoise};
-use tvmd_sim::flight::FlightOutput;
+use tvmd_sim::flight::{FlightInput, FlightOutput};
 use tvmd_sim::sim::Simulation;
 use tvmd_sim::SimError;
 
@@ -126,11 +125,8 @@ fn controller_runs_at_its_period_with_zero_order_hold() {
     s.physics.dt = 0.002;
     let times = Rc::new(RefCell::new(Vec::new()));
     let seen = times.clone();
-    let mut ctl = move |t: f64,
-                        _: &PlantState,
-                        _: &ReferenceSample,
-                        _: &[bool]|
-          -> Result<FlightOutput, BoxedError> {
+    let mut ctl = move |input: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
+        let t = input.t;
         seen.borrow_mut().push(t);
         Ok(FlightOutput {
             commands: vec![
@@ -168,12 +164,8 @@ fn failure_flags_seen(informed: bool) -> Vec<(f64, bool, f64)> {
     let mut sim = Simulation::new(&s).unwrap();
     let log = Rc::new(RefCell::new(Vec::new()));
     let l2 = log.clone();
-    let mut ctl = move |t: f64,
-                        _: &PlantState,
-                        _: &ReferenceSample,
-                        failed: &[bool]|
-          -> Result<FlightOutput, BoxedError> {
-        l2.borrow_mut().push((t, failed[2]));
+    let mut ctl = move |input: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
+        l2.borrow_mut().push((input.t, input.failed[2]));
         Ok(FlightOutput {
             commands: vec![
                 ActuatorCommand {
@@ -223,11 +215,8 @@ fn fed_positions(seed: u64) -> Vec<[f64; 3]> {
     let mut sim = Simulation::new(&s).unwrap();
     let out = Rc::new(RefCell::new(Vec::new()));
     let o2 = out.clone();
-    let mut ctl = move |_: f64,
-                        st: &PlantState,
-                        _: &ReferenceSample,
-                        _: &[bool]|
-          -> Result<FlightOutput, BoxedError> {
+    let mut ctl = move |input: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
+        let st = input.state;
         o2.borrow_mut()
             .push([st.position.x, st.position.y, st.position.z]);
         // The noisy attitude is still a rotation.
@@ -270,11 +259,8 @@ fn wind_pushes_the_team() {
 fn controller_errors_and_bad_outputs_stop_the_run() {
     let s = hover_scenario(0.0, 1.0);
     let mut sim = Simulation::new(&s).unwrap();
-    let mut bad = |t: f64,
-                   _: &PlantState,
-                   _: &ReferenceSample,
-                   _: &[bool]|
-     -> Result<FlightOutput, BoxedError> {
+    let mut bad = |input: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
+        let t = input.t;
         if t > 0.5 {
             Err("boom".into())
         } else {
@@ -290,11 +276,7 @@ fn controller_errors_and_bad_outputs_stop_the_run() {
     assert_eq!(sim.samples().len(), 51);
 
     let mut sim = Simulation::new(&s).unwrap();
-    let mut short = |_: f64,
-                     _: &PlantState,
-                     _: &ReferenceSample,
-                     _: &[bool]|
-     -> Result<FlightOutput, BoxedError> {
+    let mut short = |_: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
         Ok(FlightOutput {
             commands: vec![ActuatorCommand::default(); 3],
             ..Default::default()
@@ -306,11 +288,7 @@ fn controller_errors_and_bad_outputs_stop_the_run() {
     ));
 
     let mut sim = Simulation::new(&s).unwrap();
-    let mut nan = |_: f64,
-                   _: &PlantState,
-                   _: &ReferenceSample,
-                   _: &[bool]|
-     -> Result<FlightOutput, BoxedError> {
+    let mut nan = |_: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
         Ok(FlightOutput {
             commands: vec![
                 ActuatorCommand {

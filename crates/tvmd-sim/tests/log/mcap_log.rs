@@ -12,11 +12,11 @@ use prost_types::FileDescriptorSet;
 use tvmd_log::{proto, LogKind, RunLog};
 use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::math::rot_x;
-use tvmd_plant::physics::{PlantState, TeamBody};
-use tvmd_plant::reference::{ReferenceConfig, ReferenceSample};
+use tvmd_plant::physics::TeamBody;
+use tvmd_plant::reference::ReferenceConfig;
 use tvmd_scenario::LogSettings;
 use tvmd_scenario::Scenario;
-use tvmd_sim::flight::FlightOutput;
+use tvmd_sim::flight::{FlightInput, FlightOutput};
 use tvmd_sim::sim::Simulation;
 use tvmd_sim::McapSink;
 
@@ -170,11 +170,8 @@ fn a_run_logs_every_kind_and_a_failed_run_leaves_a_valid_file() {
     let result = {
         let mut log = RunLog::create(&path).unwrap();
         let mut sim = Simulation::new(&s).unwrap();
-        let mut ctl = |t: f64,
-                       _: &PlantState,
-                       _: &ReferenceSample,
-                       _: &[bool]|
-         -> Result<FlightOutput, BoxedError> {
+        let mut ctl = |input: &FlightInput<'_>| -> Result<FlightOutput, BoxedError> {
+            let t = input.t;
             if t > 0.25 {
                 return Err("controller gave up".into());
             }
