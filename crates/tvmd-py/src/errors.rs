@@ -143,7 +143,7 @@ impl SimErrorKind for SimError {
             SimError::Physics(e) => e.kind(),
             SimError::Log(e) => e.kind(),
             SimError::Interrupted => ErrorKind::Interrupted,
-            SimError::InvalidScenario { .. } | SimError::InvalidArgument { .. } => ErrorKind::Value,
+            SimError::InvalidArgument { .. } => ErrorKind::Value,
             _ => ErrorKind::Runtime,
         }
     }
@@ -157,8 +157,7 @@ impl SimErrorKind for StudyError {
             StudyError::Log(e) => e.kind(),
             StudyError::Physics(e) => e.kind(),
             StudyError::Io(io) => ErrorKind::Io(io),
-            StudyError::File { source, path, .. } => ErrorKind::File(source, path),
-            StudyError::InvalidTeam(_) | StudyError::InvalidArgument { .. } => ErrorKind::Value,
+            StudyError::InvalidArgument { .. } => ErrorKind::Value,
             _ => ErrorKind::Runtime,
         }
     }

@@ -7,9 +7,6 @@ use tvmd_plant::PhysicsError;
 /// Errors of a scenario: it cannot be found, read, parsed or used.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    /// The team description is not usable (for example its centre of mass is not at the origin).
-    #[error("invalid team: {0}")]
-    InvalidTeam(String),
     /// A scenario field holds a value that parses but is not acceptable.
     #[error("invalid scenario field `{field}`: {reason}")]
     InvalidScenario {

@@ -21,15 +21,6 @@ pub enum SimError {
     /// A log or an output file failed.
     #[error(transparent)]
     Log(#[from] LogError),
-    /// A scenario field that parses and validates but that this run cannot use (for example
-    /// an allocator this build lacks).
-    #[error("invalid scenario field `{field}`: {reason}")]
-    InvalidScenario {
-        /// Dotted path of the offending field.
-        field: String,
-        /// What is wrong with it.
-        reason: String,
-    },
     /// An option of a run request outside its range (`pil`, `null_space`, ...).
     #[error("invalid argument `{name}`: {reason}")]
     InvalidArgument {
@@ -46,23 +37,6 @@ pub enum SimError {
         /// The controller's error.
         source: BoxedError,
     },
-    /// The controller returned commands that cannot be applied.
-    #[error("invalid controller output at t = {t:.3} s: {reason}")]
-    InvalidCommand {
-        /// Simulation time of the call.
-        t: f64,
-        /// What is wrong with the output.
-        reason: String,
-    },
-    /// The simulated state became non-finite or left the physics' valid range
-    /// (`MAX_POSITION`, `MAX_SPEED`, `MAX_BODY_RATE`).
-    #[error("simulation diverged at t = {t:.3} s: {what}")]
-    Diverged {
-        /// Simulation time.
-        t: f64,
-        /// Which quantity, and its value.
-        what: String,
-    },
     /// The processor-in-the-loop link failed (firmware or QEMU missing, timeout, desync); the
     /// source is a `PilError`.
     #[error("processor in the loop: {0}")]
@@ -73,4 +47,15 @@ pub enum SimError {
     /// A run of a batch panicked (a bug in the simulator) or did not finish.
     #[error("internal error in tvmd-sim (please report): {0}")]
     Internal(String),
+}
+
+impl SimError {
+    /// A scenario field this run cannot use (for example an allocator this build lacks, or a
+    /// setting a PIL target cannot run): [`ScenarioError::InvalidScenario`].
+    pub fn invalid_field(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        SimError::Scenario(ScenarioError::InvalidScenario {
+            field: field.into(),
+            reason: reason.into(),
+        })
+    }
 }

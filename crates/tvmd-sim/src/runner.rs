@@ -211,21 +211,18 @@ impl RunSpec {
     ) -> Result<Self, SimError> {
         if let Some(target) = pil {
             if precision == Some(Precision::F64) {
-                return Err(SimError::InvalidScenario {
-                    field: "controller_precision".into(),
-                    reason: format!(
+                return Err(SimError::invalid_field(
+                    "controller_precision",
+                    format!(
                         "the {target} PIL firmware runs the f32 controller; drop the f64 \
                          precision or the PIL target"
                     ),
-                });
+                ));
             }
             if scenario.null_space.is_some() {
-                return Err(SimError::InvalidScenario {
-                    field: "null_space".into(),
-                    reason: format!(
+                return Err(SimError::invalid_field("null_space", format!(
                         "the {target} PIL firmware runs without the null-space stage; drop                          `null_space` or the PIL target"
-                    ),
-                });
+                    )));
             }
             scenario.controller_precision = Precision::F32;
         }
@@ -404,13 +401,13 @@ pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecordin
     sim.run(&mut controller, None)?;
     let recorder = controller.engine();
     if recorder.cycles() < cycles {
-        return Err(SimError::InvalidScenario {
-            field: "duration".into(),
-            reason: format!(
+        return Err(SimError::invalid_field(
+            "duration",
+            format!(
                 "the flight ran {} core cycles, fewer than the {cycles} to record",
                 recorder.cycles()
             ),
-        });
+        ));
     }
     Ok(recorder.recording(config, cycles))
 }

@@ -1,6 +1,6 @@
 //! The error type of the studies.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use tvmd_log::LogError;
 use tvmd_plant::PhysicsError;
@@ -24,9 +24,6 @@ pub enum StudyError {
     /// The plant refused a team.
     #[error(transparent)]
     Physics(#[from] PhysicsError),
-    /// The team description is not usable.
-    #[error("invalid team: {0}")]
-    InvalidTeam(String),
     /// An argument of a study outside its range.
     #[error("invalid argument `{name}`: {reason}")]
     InvalidArgument {
@@ -34,17 +31,6 @@ pub enum StudyError {
         name: String,
         /// What is wrong.
         reason: String,
-    },
-    /// A file could not be read or written: what was being done, the path and the cause.
-    #[error("cannot {action} `{}`: {source}", path.display())]
-    File {
-        /// What was being done (`"write the flights table"`, ...).
-        action: &'static str,
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
     },
     /// A table or an allocation set could not be encoded or decoded as JSON.
     #[error("JSON error: {0}")]
@@ -70,10 +56,18 @@ impl StudyError {
         action: &'static str,
         path: &'a Path,
     ) -> impl FnOnce(std::io::Error) -> StudyError + 'a {
-        move |source| StudyError::File {
-            action,
-            path: path.to_path_buf(),
-            source,
+        move |source| {
+            StudyError::Log(LogError::File {
+                action,
+                path: path.to_path_buf(),
+                source,
+            })
         }
+    }
+
+    /// A team (or a failure set, an allocator for it) the study cannot use:
+    /// [`PhysicsError::InvalidTeam`].
+    pub fn invalid_team(reason: impl Into<String>) -> StudyError {
+        StudyError::Physics(PhysicsError::InvalidTeam(reason.into()))
     }
 }

@@ -148,7 +148,7 @@ fn state_conversion_uses_body_velocity() {
 #[test]
 fn scenario_errors_name_the_field() {
     let field_of = |s: &Scenario| match TvmdController::<f64>::from_scenario(s).unwrap_err() {
-        SimError::InvalidScenario { field, .. } => field,
+        SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) => field,
         e => panic!("unexpected error {e}"),
     };
     let mut s = Scenario::default();

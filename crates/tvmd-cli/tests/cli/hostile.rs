@@ -298,7 +298,13 @@ fn divergence_ends_the_run_with_an_error() {
         .unwrap();
     let e = tvmd_sim::runner::run_scenario(&s, None, None).unwrap_err();
     let m = e.to_string();
-    assert!(matches!(e, tvmd_sim::SimError::Diverged { .. }), "{m}");
+    assert!(
+        matches!(
+            e,
+            tvmd_sim::SimError::Physics(tvmd_plant::PhysicsError::Diverged { .. })
+        ),
+        "{m}"
+    );
     assert!(m.contains("speed") && m.contains("300"), "{m}");
 }
 

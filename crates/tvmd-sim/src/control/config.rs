@@ -18,10 +18,7 @@ use tvmd_scenario::{
 };
 
 pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
-    SimError::InvalidScenario {
-        field: field.into(),
-        reason: reason.into(),
-    }
+    SimError::invalid_field(field, reason)
 }
 
 /// The scenario field a core configuration error refers to.

@@ -40,6 +40,7 @@ use crate::sink::{LoggedTick, SceneRecord, Tick, TickSink};
 use crate::SimError;
 use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand};
 use tvmd_plant::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
+use tvmd_plant::PhysicsError;
 use tvmd_scenario::{Failure, Payload, Scenario, StateNoise};
 
 pub use difference::FlightDifference;
@@ -51,7 +52,7 @@ pub use summary::{
     PaperMetrics, RunSummary, RunTotals, SummaryFold, Verdict, VxRise,
 };
 
-/// The valid range of the physics: beyond it a run ends with [`SimError::Diverged`] rather than
+/// The valid range of the physics: beyond it a run ends with `PhysicsError::Diverged` rather than
 /// run on in a state rapier clamps (its default caps speeds) or cannot represent. A team of the
 /// simulator's scale is far outside its flight envelope well before these.
 pub const MAX_POSITION: f64 = 1e5;
@@ -82,7 +83,10 @@ fn check_divergence(t: f64, s: &PlantState) -> Result<(), SimError> {
     } else {
         None
     };
-    what.map_or(Ok(()), |what| Err(SimError::Diverged { t, what }))
+    what.map_or(
+        Ok(()),
+        |what| Err(PhysicsError::Diverged { t, what }.into()),
+    )
 }
 
 /// Result of a run: the kept samples, the summary and the paper's metrics (both of every
@@ -396,20 +400,20 @@ impl Simulation {
                     .step(&FlightInput::new(t, &fed, &reference, &self.failed_told))
                     .map_err(|source| SimError::Controller { t, source })?;
                 if out.commands.len() != self.team.len() {
-                    return Err(SimError::InvalidCommand {
+                    return Err(SimError::Physics(PhysicsError::InvalidCommand {
                         t,
                         reason: format!(
                             "{} commands for {} agents",
                             out.commands.len(),
                             self.team.len()
                         ),
-                    });
+                    }));
                 }
                 if let Some(i) = out.commands.iter().position(|c| !c.is_finite()) {
-                    return Err(SimError::InvalidCommand {
+                    return Err(SimError::Physics(PhysicsError::InvalidCommand {
                         t,
                         reason: format!("non-finite command for agent {i}"),
-                    });
+                    }));
                 }
                 held.clone_from(&out.commands);
                 forces_stale = true;

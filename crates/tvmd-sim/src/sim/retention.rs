@@ -35,15 +35,15 @@ impl SampleRetention {
         if kept <= MAX_KEPT_SAMPLES {
             return Ok(());
         }
-        Err(SimError::InvalidScenario {
-            field: "duration".into(),
-            reason: format!(
+        Err(SimError::invalid_field(
+            "duration",
+            format!(
                 "the run has {ticks} controller ticks and would keep {kept} samples in memory, \
                  more than {MAX_KEPT_SAMPLES}; keep fewer samples (`max_samples` in Python, \
                  `SampleRetention::AtMost` or `None` in Rust; the command line keeps none, or \
                  a bounded set for --plots)"
             ),
-        })
+        ))
     }
 }
 

@@ -124,7 +124,7 @@ fn paper_experiment_height_and_yaw_errors_fall_tenfold() {
 fn the_wire_configuration_refuses_a_law_it_cannot_carry() {
     let e = tvmd_sim::control::wire_config(&Scenario::default()).unwrap_err();
     assert!(
-        matches!(&e, tvmd_sim::SimError::InvalidScenario { field, .. } if field == "law"),
+        matches!(&e, tvmd_sim::SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) if field == "law"),
         "{e}"
     );
     tvmd_sim::control::wire_config(&Scenario::builtin("paper-tilt").unwrap()).unwrap();

@@ -284,7 +284,9 @@ fn controller_errors_and_bad_outputs_stop_the_run() {
     };
     assert!(matches!(
         sim.run(&mut short, None),
-        Err(SimError::InvalidCommand { .. })
+        Err(SimError::Physics(
+            tvmd_plant::PhysicsError::InvalidCommand { .. }
+        ))
     ));
 
     let mut sim = Simulation::new(&s).unwrap();
@@ -302,6 +304,8 @@ fn controller_errors_and_bad_outputs_stop_the_run() {
     };
     assert!(matches!(
         sim.run(&mut nan, None),
-        Err(SimError::InvalidCommand { .. })
+        Err(SimError::Physics(
+            tvmd_plant::PhysicsError::InvalidCommand { .. }
+        ))
     ));
 }

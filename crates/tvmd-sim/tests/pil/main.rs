@@ -68,7 +68,7 @@ fn pil_needs_the_f32_controller_and_a_known_target() {
     let s = Scenario::builtin("paper-tilt").unwrap();
     let e = run_scenario_on(&s, Some(PilTarget::CortexM4), None, None).unwrap_err();
     assert!(
-        matches!(&e, SimError::InvalidScenario { field, .. } if field == "controller_precision"),
+        matches!(&e, SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) if field == "controller_precision"),
         "{e}"
     );
     let e = tvmd_sim::runner::RunSpec::on_target(

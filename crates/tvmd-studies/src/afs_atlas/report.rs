@@ -181,8 +181,8 @@ pub fn atlas_entry_until<const N: usize>(
     }
     let mask = FailureMask::with_failed(failed).map_err(|e| bad("failed", e.to_string()))?;
     let model = AtlasModel::new(team, &mask).map_err(|e| match e {
-        tvmd_core::ConfigError::RankDeficient { .. } => StudyError::InvalidTeam(
-            "M(Xi) is not rank 6 without these agents: not every wrench is attainable".into(),
+        tvmd_core::ConfigError::RankDeficient { .. } => StudyError::invalid_team(
+            "M(Xi) is not rank 6 without these agents: not every wrench is attainable",
         ),
         other => bad("failed", other.to_string()),
     })?;

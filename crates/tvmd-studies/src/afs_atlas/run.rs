@@ -91,7 +91,7 @@ pub fn run_until(
     for preset in presets(&args.team)? {
         let team: TeamConfig<f64, 16> = preset
             .team()
-            .map_err(|e| StudyError::InvalidTeam(e.to_string()))?;
+            .map_err(|e| StudyError::invalid_team(e.to_string()))?;
         jobs.push((preset, team, args.failed.clone(), false));
         if args.each_failure {
             jobs.extend((0..team.len()).map(|i| (preset, team, vec![i], true)));

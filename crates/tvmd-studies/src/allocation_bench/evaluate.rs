@@ -103,7 +103,7 @@ fn evaluate_with<const N: usize>(
     let effectiveness = t.effectiveness(&mask);
     let sets = [AdmissibleSet::from_limits(t.limits()); N];
     let mut allocator = AnyAllocator::<f64, N>::from_name(name, &AllocatorOptions::default())
-        .map_err(|e| StudyError::InvalidTeam(format!("allocator `{name}`: {e}")))?;
+        .map_err(|e| StudyError::invalid_team(format!("allocator `{name}`: {e}")))?;
     allocator.configure(&effectiveness);
     let mut row = EvaluationRow {
         team: team_requests.label(),

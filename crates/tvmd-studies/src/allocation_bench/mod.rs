@@ -164,13 +164,13 @@ pub fn team<const N: usize>(name: &str) -> Result<TeamConfig<f64, N>, StudyError
         "a8_inc" => presets::a8_inc(),
         "ring16_inc" => presets::ring(16, RING16_RADIUS, true, presets::paper_limits()),
         other => {
-            return Err(StudyError::InvalidTeam(format!(
+            return Err(StudyError::invalid_team(format!(
                 "unknown benchmark team `{other}` (known: {})",
                 TEAM_NAMES.join(", ")
             )))
         }
     };
-    built.map_err(|e| StudyError::InvalidTeam(format!("{name}: {e}")))
+    built.map_err(|e| StudyError::invalid_team(format!("{name}: {e}")))
 }
 
 /// The failure mask of `failed`, checked against the team (rank 6 left).
@@ -179,7 +179,7 @@ pub fn failure_mask<const N: usize>(
     failed: &[usize],
 ) -> Result<FailureMask<N>, StudyError> {
     let invalid =
-        |e: ConfigError| StudyError::InvalidTeam(format!("failed agents {failed:?}: {e}"));
+        |e: ConfigError| StudyError::invalid_team(format!("failed agents {failed:?}: {e}"));
     let mask = FailureMask::with_failed(failed).map_err(invalid)?;
     team.validate_failures(&mask).map_err(invalid)?;
     Ok(mask)

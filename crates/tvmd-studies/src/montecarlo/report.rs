@@ -114,11 +114,7 @@ pub fn write_csv<T: Serialize>(rows: &[T], path: &Path) -> Result<(), StudyError
             csv::ErrorKind::Io(e) => e,
             other => std::io::Error::other(format!("{other:?}")),
         };
-        StudyError::File {
-            action: ACTION,
-            path: path.to_path_buf(),
-            source,
-        }
+        StudyError::file(ACTION, path)(source)
     };
     tvmd_log::paths::write_via_temporary(path, ACTION, |temporary| {
         let mut w = csv::Writer::from_path(temporary).map_err(csv_err)?;
