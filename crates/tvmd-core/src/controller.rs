@@ -9,7 +9,10 @@ pub use crate::rotation::roll;
 mod guard;
 mod settings;
 
-pub use settings::ControllerSettings;
+pub use settings::{
+    ControllerSettings, ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX,
+    DAMPING_RATIO, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
+};
 
 use crate::admissible::{admissible_sets, AdmissibleSet};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};

@@ -27,18 +27,12 @@ use crate::ScenarioError;
 /// ([`LawConfig::default`]).
 pub const LAW_NAMES: &[&str] = &["paper", "offset-free"];
 
-/// Natural frequency (rad/s) of the default natural gains' position axes.
-pub const POSITION_FREQUENCY: f64 = 1.5;
-/// Natural frequency (rad/s) of the default natural gains' attitude axes.
-pub const ATTITUDE_FREQUENCY: f64 = 6.0;
-/// Default observer bandwidth `L_f = L_tau` (rad/s).
-pub const OBSERVER_BANDWIDTH: f64 = 10.0;
-/// Default bound of the offset-free torque (N m).
-pub const OFFSET_FREE_MAX_TORQUE: f64 = 5.0;
-/// Default bandwidth of the planned-rate filter (rad/s).
-pub const ATTITUDE_RATE_BANDWIDTH: f64 = 20.0;
-/// Default rate bound of the planned-rate filter (rad/s).
-pub const ATTITUDE_RATE_MAX: f64 = 5.0;
+/// The defaults of `"offset-free"`, defined once in the core
+/// (`tvmd_core::ControllerSettings::offset_free_law`).
+pub use tvmd_core::controller::{
+    ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX, DAMPING_RATIO,
+    OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
+};
 
 /// The control law's settings: gains, offset-free action, planned rates. In TOML a table, or
 /// one of the names [`LAW_NAMES`].
@@ -91,6 +85,18 @@ impl LawConfig {
                 "unknown law `{other}` (known: {}, or a table)",
                 LAW_NAMES.join(", ")
             )),
+        }
+    }
+
+    /// The name of this law: `"paper"`, `"offset-free"` (the default) or `"custom"` (any other
+    /// table).
+    pub fn name(&self) -> &'static str {
+        if self.is_paper() {
+            "paper"
+        } else if *self == Self::default() {
+            "offset-free"
+        } else {
+            "custom"
         }
     }
 
@@ -176,9 +182,9 @@ impl Default for NaturalGainsConfig {
     fn default() -> Self {
         Self {
             position_frequency: [POSITION_FREQUENCY; 3],
-            position_damping: [1.0; 3],
+            position_damping: [DAMPING_RATIO; 3],
             attitude_frequency: [ATTITUDE_FREQUENCY; 3],
-            attitude_damping: [1.0; 3],
+            attitude_damping: [DAMPING_RATIO; 3],
         }
     }
 }
@@ -244,6 +250,15 @@ impl AttitudeRateConfig {
             bandwidth: ATTITUDE_RATE_BANDWIDTH,
             max_rate: ATTITUDE_RATE_MAX,
         }
+    }
+}
+
+impl std::str::FromStr for LawConfig {
+    type Err = String;
+
+    /// One of [`LAW_NAMES`] (the command line's `--law`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::named(s.trim())
     }
 }
 

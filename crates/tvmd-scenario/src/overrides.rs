@@ -1,8 +1,8 @@
 //! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator` /
-//! `--precision` / `--team`, the Python keywords `relaxation=` / `allocator=` / `precision=`), applied
-//! with validation.
+//! `--precision` / `--team` / `--law`, the Python keywords `relaxation=` / `allocator=` /
+//! `precision=` / `law=`), applied with validation.
 
-use super::{NullSpaceConfig, Precision, Scenario};
+use super::{LawConfig, NullSpaceConfig, Precision, Scenario};
 use crate::ScenarioError;
 
 /// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
@@ -18,6 +18,9 @@ pub struct Overrides {
     pub null_space: Option<NullSpaceConfig>,
     /// A catalogue team (`team.preset`, e.g. `"a6-inc"`), replacing the scenario's team.
     pub team: Option<String>,
+    /// The control law (`[law]`), e.g. [`LawConfig::paper`] to fly a family with the paper's
+    /// law.
+    pub law: Option<LawConfig>,
 }
 
 impl Overrides {
@@ -28,6 +31,7 @@ impl Overrides {
             && self.precision.is_none()
             && self.null_space.is_none()
             && self.team.is_none()
+            && self.law.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -43,6 +47,9 @@ impl Overrides {
         }
         if let Some(n) = self.null_space {
             scenario.null_space = Some(n);
+        }
+        if let Some(law) = self.law {
+            scenario.law = law;
         }
         if let Some(team) = &self.team {
             scenario.team.preset = Some(team.clone());
@@ -72,6 +79,7 @@ mod tests {
             precision: Some(Precision::F32),
             null_space: Some("margin".parse().unwrap()),
             team: Some("a6-inc".into()),
+            law: Some(LawConfig::paper()),
         };
         assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();
@@ -79,6 +87,8 @@ mod tests {
         assert_eq!(s.allocator, "pseudo-inverse");
         assert_eq!(s.controller_precision, Precision::F32);
         assert_eq!(s.team_body().unwrap().len(), 6);
+        assert_eq!(s.law, LawConfig::paper());
+        assert_ne!(Scenario::default().law, LawConfig::paper());
         let bad = Overrides {
             team: Some("a99".into()),
             ..Overrides::default()

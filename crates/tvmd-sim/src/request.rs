@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tvmd_scenario::{NullSpaceConfig, Overrides, Precision, Scenario};
+use tvmd_scenario::{LawConfig, NullSpaceConfig, Overrides, Precision, Scenario};
 
 use crate::control::pil::PilTarget;
 use crate::runner::RunSpec;
@@ -68,6 +68,8 @@ pub struct RunRequest {
     pub null_space: Option<NullSpaceConfig>,
     /// Override of the team (a catalogue preset).
     pub team: Option<String>,
+    /// Override of the control law (`[law]`).
+    pub law: Option<LawConfig>,
     /// Override of the controller precision.
     pub precision: Option<Precision>,
     /// The processor-in-the-loop target, or `None` for the host.
@@ -85,6 +87,11 @@ impl RunRequest {
     /// The option `precision` (`f64`, `f32`); the error names `controller_precision`.
     pub fn parse_precision(text: &str) -> Result<Precision, SimError> {
         Ok(text.parse::<Precision>()?)
+    }
+
+    /// The option `law` (`paper`, `offset-free`); the error names `law`.
+    pub fn parse_law(text: &str) -> Result<LawConfig, SimError> {
+        text.parse::<LawConfig>().map_err(|e| invalid("law", e))
     }
 
     /// The option `pil` (`cortex-m4`, `cortex-m7`); the error names `pil`.
@@ -129,6 +136,7 @@ impl RunRequest {
             precision: self.precision,
             null_space: self.null_space,
             team: self.team.clone(),
+            law: self.law,
         }
     }
 

@@ -42,6 +42,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             allocator,
             null_space,
             team,
+            law,
             precision,
             pil,
             live,
@@ -59,6 +60,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             allocator,
             null_space,
             team,
+            law,
             precision,
             pil,
             live: live.then_some(LiveOptions {

@@ -10,6 +10,8 @@ pub struct RunReport<'a> {
     pub(crate) scenario: &'a str,
     pub(crate) relaxation: f64,
     pub(crate) allocator: &'a str,
+    /// The control law: `"paper"`, `"offset-free"` or `"custom"` (a `[law]` table).
+    pub(crate) law: &'a str,
     /// The null-space stage (`margin`, `inward-tilt=<rad>`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(crate) null_space: Option<String>,
@@ -43,6 +45,7 @@ pub fn print_run(r: &RunReport<'_>) {
         ("scenario", r.scenario.to_string()),
         ("relaxation s", format!("{}", r.relaxation)),
         ("allocator", r.allocator.to_string()),
+        ("law", r.law.to_string()),
         ("controller precision", r.controller_precision.to_string()),
         ("controller target", r.controller_target.to_string()),
         ("simulated time", format!("{:.3} s", s.time)),

@@ -28,6 +28,7 @@ pub struct RunArgs {
     pub(crate) allocator: Option<String>,
     pub(crate) null_space: Option<tvmd_scenario::NullSpaceConfig>,
     pub(crate) team: Option<String>,
+    pub(crate) law: Option<tvmd_scenario::LawConfig>,
     pub(crate) precision: Option<String>,
     pub(crate) pil: Option<String>,
     pub(crate) live: Option<LiveOptions>,
@@ -42,6 +43,7 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         allocator: a.allocator,
         null_space: a.null_space,
         team: a.team,
+        law: a.law,
         samples: plot_retention(a.plots.is_some()),
         ..RunRequest::default()
     }
@@ -99,6 +101,7 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         scenario: &scenario.name,
         relaxation: scenario.relaxation,
         allocator: &scenario.allocator,
+        law: scenario.law.name(),
         null_space: scenario.null_space.map(|n| n.to_string()),
         controller_precision: scenario.controller_precision,
         controller_target: &result.summary.controller_target,

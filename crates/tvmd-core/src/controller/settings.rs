@@ -4,12 +4,29 @@
 use crate::afs::Relaxation;
 use crate::allocation::NullSpaceStage;
 use crate::attitude_rate::AttitudeRateFilter;
+use crate::disturbance::DisturbanceObserver;
 use crate::error::{ConfigError, ConfigField};
 use crate::gain_schedule::GainSchedule;
 use crate::law::Gains;
 use crate::limits::RateLimits;
+use crate::natural_gains::NaturalGains;
 use crate::offset_free::OffsetFree;
 use crate::real::{lit, Real};
+
+/// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s position axes.
+pub const POSITION_FREQUENCY: f64 = 1.5;
+/// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s attitude axes.
+pub const ATTITUDE_FREQUENCY: f64 = 6.0;
+/// Damping ratio of [`ControllerSettings::offset_free_law`]'s natural gains (every axis).
+pub const DAMPING_RATIO: f64 = 1.0;
+/// Observer bandwidth `L_f = L_tau` (rad/s) of [`ControllerSettings::offset_free_law`].
+pub const OBSERVER_BANDWIDTH: f64 = 10.0;
+/// Bound of the offset-free torque (N m) of [`ControllerSettings::offset_free_law`].
+pub const OFFSET_FREE_MAX_TORQUE: f64 = 5.0;
+/// Bandwidth (rad/s) of [`ControllerSettings::offset_free_law`]'s planned-rate filter.
+pub const ATTITUDE_RATE_BANDWIDTH: f64 = 20.0;
+/// Rate bound (rad/s) of [`ControllerSettings::offset_free_law`]'s planned-rate filter.
+pub const ATTITUDE_RATE_MAX: f64 = 5.0;
 
 /// Settings of a [`crate::Controller`] besides the team and the allocator.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,6 +73,42 @@ impl<T: Real> ControllerSettings<T> {
             gain_schedule: GainSchedule::AsGiven,
             offset_free: None,
             attitude_rate: None,
+        }
+    }
+
+    /// The law that flies outside a perfect model (`law = "offset-free"` in scenarios): the
+    /// paper's settings with natural gains ([`GainSchedule::Natural`], [`POSITION_FREQUENCY`],
+    /// [`ATTITUDE_FREQUENCY`], [`DAMPING_RATIO`] on every axis, scaled by the team's mass and
+    /// inertia), the disturbance observer ([`OBSERVER_BANDWIDTH`], [`OFFSET_FREE_MAX_TORQUE`])
+    /// and the planned attitude's rates ([`ATTITUDE_RATE_BANDWIDTH`], [`ATTITUDE_RATE_MAX`]).
+    /// `docs/method.md`, "Beyond the paper", states what is proven about it and what is measured.
+    ///
+    /// ```
+    /// use tvmd_core::{ControllerSettings, GainSchedule};
+    /// let s = ControllerSettings::<f32>::offset_free_law();
+    /// assert!(matches!(s.gain_schedule, GainSchedule::Natural(_)));
+    /// assert!(s.offset_free.is_some() && s.attitude_rate.is_some());
+    /// assert_eq!(s.relaxation, ControllerSettings::<f32>::paper().relaxation);
+    /// ```
+    pub fn offset_free_law() -> Self {
+        let natural = NaturalGains::uniform(
+            (lit(POSITION_FREQUENCY), lit(DAMPING_RATIO)),
+            (lit(ATTITUDE_FREQUENCY), lit(DAMPING_RATIO)),
+        );
+        let observer = DisturbanceObserver::new(
+            lit(OBSERVER_BANDWIDTH),
+            lit(OBSERVER_BANDWIDTH),
+            lit(OFFSET_FREE_MAX_TORQUE),
+        );
+        let rates = AttitudeRateFilter::new(lit(ATTITUDE_RATE_BANDWIDTH), lit(ATTITUDE_RATE_MAX));
+        let paper = Self::paper();
+        // The constants are positive and finite, so every constructor succeeds; the fallbacks
+        // only keep this function panic-free.
+        Self {
+            gain_schedule: natural.map_or(GainSchedule::AsGiven, GainSchedule::Natural),
+            offset_free: observer.ok().map(OffsetFree::Observer),
+            attitude_rate: rates.ok(),
+            ..paper
         }
     }
 
