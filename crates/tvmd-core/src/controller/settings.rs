@@ -59,6 +59,15 @@ pub struct ControllerSettings<T: Real> {
     pub attitude_rate: Option<AttitudeRateFilter<T>>,
 }
 
+impl<T: Real> Default for ControllerSettings<T> {
+    /// The library's default: [`ControllerSettings::offset_free_law`], the law that holds its
+    /// setpoint under model error and disturbances (the paper's law leaves a steady error under
+    /// any unmodelled force). Reproduce the paper with [`ControllerSettings::paper`].
+    fn default() -> Self {
+        Self::offset_free_law()
+    }
+}
+
 impl<T: Real> ControllerSettings<T> {
     /// The paper's settings: its gains as given, `s = 0.5`, `g = 9.81`, `dt = 0.01` s, no rate
     /// limits, no null-space stage, no offset-free action, the reference's `Omega_d`.
