@@ -6,12 +6,13 @@ use tvmd_core::{
     Navigator, RateLimits, Relaxation, TeamConfig,
 };
 
-use crate::{Reader, WireController, Writer, AGENTS, ALLOCATOR_NAME_BYTES};
+use crate::{LawWords, Reader, WireController, Writer, AGENTS, ALLOCATOR_NAME_BYTES};
 
 /// Everything the simulator's f32 controller is built from, each value already rounded to f32
 /// exactly as the simulator rounds it (module `config`): the team (agent positions, quarter
 /// turns, masses, limits, navigator), the gains (`K_xi` diagonal in the order `[Omega; v]`),
-/// relaxation `s`, gravity, period, optional rate limits and the allocator's name.
+/// relaxation `s`, gravity, period, optional rate limits, the allocator's name and the law
+/// beyond the paper ([`LawWords`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CoreConfig {
     /// Agents used (`<=` [`AGENTS`]).
@@ -34,6 +35,8 @@ pub struct CoreConfig {
     pub rate_limits: Option<[f32; 2]>,
     /// Allocator name, zero-padded.
     pub allocator: [u8; ALLOCATOR_NAME_BYTES],
+    /// Gain schedule, offset-free action and planned rates ([`LawWords::PAPER`]: the paper's).
+    pub law: LawWords,
 }
 
 impl CoreConfig {
@@ -61,7 +64,8 @@ impl CoreConfig {
         }
         self.allocator
             .chunks(4)
-            .try_for_each(|c| w.u32(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+            .try_for_each(|c| w.u32(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))?;
+        self.law.put(w)
     }
 
     /// Reads a configuration written by [`CoreConfig::put`].
@@ -81,6 +85,7 @@ impl CoreConfig {
         for c in allocator.chunks_mut(4) {
             c.copy_from_slice(&r.u32()?.to_le_bytes());
         }
+        let law = LawWords::get(r)?;
         Some(Self {
             n,
             agents,
@@ -92,6 +97,7 @@ impl CoreConfig {
             period,
             rate_limits: (flag == 1).then_some(rates),
             allocator,
+            law,
         })
     }
 
@@ -123,7 +129,7 @@ impl CoreConfig {
             Some([x, y]) => Some(RateLimits::new(x, y)?),
             None => None,
         };
-        let settings = ControllerSettings {
+        let mut settings = ControllerSettings {
             gains,
             relaxation: Relaxation::new(self.relaxation)?,
             gravity: self.gravity,
@@ -134,6 +140,7 @@ impl CoreConfig {
             offset_free: None,
             attitude_rate: None,
         };
+        self.law.apply(&mut settings)?;
         let alloc = AnyAllocator::from_name(self.allocator_name(), &Default::default())?;
         Controller::new(team, settings, alloc)
     }

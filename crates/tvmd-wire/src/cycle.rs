@@ -256,3 +256,21 @@ pub fn mask_of(bits: u32) -> FailureMask<AGENTS> {
     }
     mask
 }
+
+/// Applies a recorded cycle's event word to `ctl` in the simulator's order: the landed hold
+/// ([`crate::EVENT_LANDED_SET`]), then the failure mask ([`crate::EVENT_SET`]). Returns
+/// whether a mask was set; an error if the core accepted a mask the recording says it refused,
+/// or the other way round.
+pub fn replay_event(ctl: &mut crate::WireController, event: u32) -> Result<bool, &'static str> {
+    if event & crate::EVENT_LANDED_SET != 0 {
+        ctl.set_landed(event & crate::EVENT_LANDED != 0);
+    }
+    if event & crate::EVENT_SET == 0 {
+        return Ok(false);
+    }
+    let refused = ctl.set_failures(mask_of(event)).is_err();
+    if refused != (event & crate::EVENT_REFUSED != 0) {
+        return Err("a failure mask was accepted on one side and refused on the other");
+    }
+    Ok(true)
+}

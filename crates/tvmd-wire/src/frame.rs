@@ -11,8 +11,9 @@ pub const FRAME_MAGIC: [u8; 4] = *b"TVPL";
 pub const FRAME_HEADER_BYTES: usize = 12;
 /// Largest payload of a frame.
 pub const MAX_PAYLOAD_BYTES: usize = 2048;
-/// Protocol version, the payload of `KIND_READY`.
-pub const PROTOCOL_VERSION: u32 = 1;
+/// Protocol version, the payload of `KIND_READY` (2: the configuration carries the law and
+/// `KIND_SET_LANDED` exists).
+pub const PROTOCOL_VERSION: u32 = 2;
 /// Host: configure the controller ([`CoreConfig`] words). Reply `KIND_CONFIGURED` or
 /// `KIND_REFUSED`.
 pub const KIND_CONFIGURE: u16 = 1;
@@ -21,6 +22,8 @@ pub const KIND_CONFIGURE: u16 = 1;
 pub const KIND_SET_FAILURES: u16 = 2;
 /// Host: one cycle ([`INPUT_WORDS`] words). Reply `KIND_OUTPUT` or `KIND_SKIPPED`.
 pub const KIND_STEP: u16 = 3;
+/// Host: the landed hold (one word, 0 or 1: `Controller::set_landed`). Reply `KIND_LANDED`.
+pub const KIND_SET_LANDED: u16 = 4;
 /// Target: booted (one word, [`PROTOCOL_VERSION`]).
 pub const KIND_READY: u16 = 0x80;
 /// Target: controller built (the agent count).
@@ -35,6 +38,8 @@ pub const KIND_SKIPPED: u16 = 0x84;
 pub const KIND_REFUSED: u16 = 0x85;
 /// Target: the request was malformed or arrived out of order (the message).
 pub const KIND_ERROR: u16 = 0x86;
+/// Target: the landed hold is set (one word, its value).
+pub const KIND_LANDED: u16 = 0x87;
 
 /// The header of a frame.
 pub fn frame_header(kind: u16, seq: u16, payload_bytes: u32) -> [u8; FRAME_HEADER_BYTES] {

@@ -8,7 +8,8 @@
 //! both sides encode, decode and build the controller with the same code: only `core` and
 //! `tvmd_core`, no allocation.
 //!
-//! Modules: [`words`] (the word cursors), [`config`] (the controller's configuration),
+//! Modules: [`words`] (the word cursors), [`config`] (the controller's configuration, with
+//! [`law`], the law beyond the paper),
 //! [`cycle`] (a cycle's inputs and outputs, the recording's events, failure masks) and
 //! [`frame`] (processor-in-the-loop frames and their CRC-32).
 
@@ -18,11 +19,13 @@
 mod config;
 mod cycle;
 mod frame;
+mod law;
 mod words;
 
 pub use config::CoreConfig;
 pub use cycle::*;
 pub use frame::*;
+pub use law::*;
 pub use words::{Reader, Writer};
 
 use tvmd_core::{AnyAllocator, ControlOutput, Controller};
@@ -46,8 +49,8 @@ pub const ALLOCATOR_NAME_BYTES: usize = 32;
 /// Words of a [`CoreConfig`] of `n` agents.
 pub const fn config_words(n: usize) -> usize {
     // n, then per agent x, y, z, quarter turns, mass; limits 3; navigator 1 + 9; gains 3 + 3 +
-    // 6; relaxation, gravity, period; rate-limit flag + 2; allocator name.
-    1 + 5 * n + 3 + 10 + 12 + 3 + 3 + ALLOCATOR_NAME_BYTES / 4
+    // 6; relaxation, gravity, period; rate-limit flag + 2; allocator name; the law.
+    1 + 5 * n + 3 + 10 + 12 + 3 + 3 + ALLOCATOR_NAME_BYTES / 4 + LAW_WORDS
 }
 
 /// Words of a whole [`ControlOutput`] of `n` agents ([`put_output`]).
@@ -68,14 +71,20 @@ pub const STATUS_CYCLE_ERROR: u32 = 0xff;
 
 /// First word of a cycle recording (`"TVRC"`; format in `tvmd_sim::control::recording`).
 pub const RECORDING_MAGIC: u32 = u32::from_le_bytes(*b"TVRC");
-/// Format version of a cycle recording.
-pub const RECORDING_VERSION: u32 = 1;
+/// Format version of a cycle recording (2: the configuration carries the law, [`LAW_WORDS`],
+/// and an event may set the landed hold, [`EVENT_LANDED_SET`]).
+pub const RECORDING_VERSION: u32 = 2;
 /// Words of a cycle recording's header (magic, version, agents, cycles, configuration words).
 pub const RECORDING_HEADER_WORDS: usize = 5;
 /// Recording event flag: a failure mask was set before this cycle.
 pub const EVENT_SET: u32 = 1 << 31;
 /// Recording event flag: the core refused that mask.
 pub const EVENT_REFUSED: u32 = 1 << 30;
+/// Recording event flag: `set_landed` was called before this cycle, with
+/// [`EVENT_LANDED`] as its argument.
+pub const EVENT_LANDED_SET: u32 = 1 << 29;
+/// Recording event flag: the landed argument of [`EVENT_LANDED_SET`].
+pub const EVENT_LANDED: u32 = 1 << 28;
 
 /// Words of one recorded cycle of `n` agents: event, inputs, recorded outputs.
 pub const fn cycle_words(n: usize) -> usize {

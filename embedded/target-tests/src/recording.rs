@@ -147,12 +147,7 @@ fn run() -> Result<(usize, usize, usize, Worst), &'static str> {
         let cycle = all.get(..len).ok_or("cycle")?;
         let mut r = Reader::new(cycle);
         let event = r.u32().ok_or("event")?;
-        if event & wire::EVENT_SET != 0 {
-            let refused = ctl.set_failures(wire::mask_of(event)).is_err();
-            if refused != (event & wire::EVENT_REFUSED != 0) {
-                return Err("a failure mask was accepted on one side and refused on the other");
-            }
-        }
+        wire::replay_event(&mut ctl, event)?;
         let (state, reference) = wire::get_input(&mut r).ok_or("malformed inputs")?;
         let mut got = [0u32; wire::recorded_words(AGENTS)];
         let mut w = Writer::new(&mut got);

@@ -242,19 +242,12 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 /// The f32 controller's configuration of a scenario as the words an f32 target builds it from
 /// ([`tvmd_wire::CoreConfig`]): every value rounded exactly as [`team_config`],
 /// [`controller_settings`] and [`allocator`] round it. Errors name the scenario field, as
-/// [`super::TvmdController::from_scenario`]'s do. The words carry the paper's law only (no
-/// `[law]` settings): any other `law` is refused, naming the field.
+/// [`super::TvmdController::from_scenario`]'s do. The law (`[law]`) crosses as
+/// [`tvmd_wire::LawWords`] of the f32 settings.
 pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
-    use tvmd_wire::{CoreConfig, AGENTS, ALLOCATOR_NAME_BYTES};
-    if !scenario.law.is_paper() {
-        return Err(invalid(
-            "law",
-            "the PIL firmware and the cycle recording carry the paper's law only: give \
-             law = \"paper\"",
-        ));
-    }
+    use tvmd_wire::{CoreConfig, LawWords, AGENTS, ALLOCATOR_NAME_BYTES};
     team_config::<f32>(scenario)?;
-    controller_settings::<f32>(scenario)?;
+    let settings = controller_settings::<f32>(scenario)?;
     allocator::<f32>(&scenario.allocator)?;
     let body = scenario.team_body()?;
     let mut agents = [([0.0f32; 3], 0, 0.0f32); AGENTS];
@@ -288,5 +281,6 @@ pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimErro
         period: to_core(scenario.controller_period),
         rate_limits: scenario.controller_rate_limits.map(|r| r.map(to_core)),
         allocator,
+        law: LawWords::of(&settings),
     })
 }

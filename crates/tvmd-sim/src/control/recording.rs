@@ -12,8 +12,9 @@
 //!
 //! File (little-endian `u32` words; floats as their f32 bits): [`MAGIC`], [`VERSION`], agents
 //! `n`, cycles, configuration words `c`, the [`CoreConfig`] (`c` words), then per cycle: the
-//! failure event ([`EVENT_SET`] `|` [`EVENT_REFUSED`] `|` mask bits, or 0 when no mask was set
-//! before this cycle), the [`wire::INPUT_WORDS`] input words and the
+//! event ([`EVENT_SET`] `|` [`EVENT_REFUSED`] `|` mask bits when a mask was set before this
+//! cycle; [`EVENT_LANDED_SET`] `|` [`EVENT_LANDED`] when the landed hold was set; 0 for
+//! neither), the [`wire::INPUT_WORDS`] input words and the
 //! [`wire::recorded_words`]`(n)` output words.
 
 use tvmd_core::{FailureMask, Reference, RigidState};
@@ -25,7 +26,8 @@ use crate::SimError;
 use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 
 pub use tvmd_wire::{
-    cycle_words, EVENT_REFUSED, EVENT_SET, RECORDING_MAGIC as MAGIC, RECORDING_VERSION as VERSION,
+    cycle_words, EVENT_LANDED, EVENT_LANDED_SET, EVENT_REFUSED, EVENT_SET,
+    RECORDING_MAGIC as MAGIC, RECORDING_VERSION as VERSION,
 };
 
 /// A [`CoreEngine`] that records every call it forwards to `inner`.
@@ -73,7 +75,11 @@ impl<E: CoreEngine<f32>> CoreEngine<f32> for Recorder<E> {
     ) -> Result<FailureAnswer<f32>, BoxedError> {
         let answer = self.inner.set_failures(mask)?;
         let refused = if answer.is_err() { EVENT_REFUSED } else { 0 };
-        self.event = EVENT_SET | refused | wire::mask_bits(&mask);
+        // A landed hold set before the mask in the same period is kept.
+        self.event = (self.event & (EVENT_LANDED_SET | EVENT_LANDED))
+            | EVENT_SET
+            | refused
+            | wire::mask_bits(&mask);
         Ok(answer)
     }
 
@@ -81,10 +87,13 @@ impl<E: CoreEngine<f32>> CoreEngine<f32> for Recorder<E> {
         self.inner.failures()
     }
 
-    /// Forwarded, not recorded: a recording carries the paper's law only
-    /// ([`super::wire_config`] refuses another), for which the landed hold changes nothing.
     fn set_landed(&mut self, landed: bool) -> Result<(), BoxedError> {
-        self.inner.set_landed(landed)
+        self.inner.set_landed(landed)?;
+        // Replayed before the mask, in the simulator's order (`TvmdController::step`).
+        self.event = (self.event & !(EVENT_LANDED_SET | EVENT_LANDED))
+            | EVENT_LANDED_SET
+            | if landed { EVENT_LANDED } else { 0 };
+        Ok(())
     }
 
     fn step(

@@ -118,14 +118,35 @@ fn paper_experiment_height_and_yaw_errors_fall_tenfold() {
     assert!(yaw_new <= 0.1 * yaw_paper, "{yaw_new} vs {yaw_paper}");
 }
 
-/// The PIL configuration words and the cycle recording carry the paper's law only: another is
-/// refused by name, the paper's scenarios pass.
+/// The PIL configuration words and the cycle recording carry the law: the controller built
+/// from the words of the default scenario (the offset-free law), of a table law and of
+/// paper-tilt has the f32 settings the simulator builds, and an unknown kind word is refused.
 #[test]
-fn the_wire_configuration_refuses_a_law_it_cannot_carry() {
-    let e = tvmd_sim::control::wire_config(&Scenario::default()).unwrap_err();
-    assert!(
-        matches!(&e, tvmd_sim::SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) if field == "law"),
-        "{e}"
-    );
-    tvmd_sim::control::wire_config(&Scenario::builtin("paper-tilt").unwrap()).unwrap();
+fn the_wire_configuration_carries_the_law() {
+    use tvmd_sim::control::{controller_settings, wire_config};
+    let table = Scenario::from_toml_str(
+        "[law]\ngains = \"team-scaled\"\nattitude_rate = \"off\"\n\
+         offset_free = { kind = \"integral\", k_x = [1.0, 2.0, 3.0], k_r = [0.5, 0.5, 0.25], max_torque = 4.0 }\n",
+    )
+    .unwrap();
+    assert_eq!(table.law.name(), "custom");
+    for s in [
+        Scenario::default(),
+        table,
+        Scenario::builtin("paper-tilt").unwrap(),
+    ] {
+        let words = wire_config(&s).unwrap();
+        let built = words.build().unwrap();
+        let want = controller_settings::<f32>(&s).unwrap();
+        let got = built.settings();
+        assert_eq!(
+            (got.gain_schedule, got.offset_free, got.attitude_rate),
+            (want.gain_schedule, want.offset_free, want.attitude_rate),
+            "{}",
+            s.law.name()
+        );
+    }
+    let mut words = wire_config(&Scenario::default()).unwrap();
+    words.law.offset_free = 7;
+    assert!(words.build().is_err());
 }

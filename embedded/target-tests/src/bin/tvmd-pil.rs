@@ -206,6 +206,13 @@ fn serve(kind: u16, seq: u16, words: &[u32], ctl: &mut Option<(WireController, u
                 Err(e) => send_text(wire::KIND_REFUSED, seq, &[], e),
             },
         },
+        (wire::KIND_SET_LANDED, Some((c, _))) => match r.u32() {
+            Some(flag @ (0 | 1)) => {
+                c.set_landed(flag == 1);
+                send(wire::KIND_LANDED, seq, &[flag], &[]);
+            }
+            _ => send_error(seq, "malformed landed flag"),
+        },
         (wire::KIND_STEP, Some((c, n))) => match wire::get_input(&mut r) {
             None => send_error(seq, "malformed cycle inputs"),
             Some((state, reference)) => {
@@ -223,7 +230,7 @@ fn serve(kind: u16, seq: u16, words: &[u32], ctl: &mut Option<(WireController, u
                 }
             }
         },
-        (wire::KIND_SET_FAILURES | wire::KIND_STEP, None) => {
+        (wire::KIND_SET_FAILURES | wire::KIND_SET_LANDED | wire::KIND_STEP, None) => {
             send_error(seq, "controller not configured")
         }
         _ => send_error(seq, "unknown request kind"),

@@ -328,10 +328,12 @@ impl CoreEngine<f32> for PilCore {
         self.failures
     }
 
-    /// Nothing to send: the firmware runs the paper's law only ([`super::wire_config`]
-    /// refuses another), which has no offset-free state to hold.
-    fn set_landed(&mut self, _landed: bool) -> Result<(), BoxedError> {
-        Ok(())
+    fn set_landed(&mut self, landed: bool) -> Result<(), BoxedError> {
+        let reply = self.request(wire::KIND_SET_LANDED, &[u32::from(landed)], CYCLE_TIMEOUT)?;
+        match reply.kind {
+            wire::KIND_LANDED if reply.words() == [u32::from(landed)] => Ok(()),
+            k => Err(self.unexpected("the landed hold's answer", k).into()),
+        }
     }
 
     fn step(
