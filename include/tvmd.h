@@ -12,8 +12,9 @@
 // [`actuator::TvmdActuatorOutputs`]).
 #define TVMD_MAX_AGENTS 16
 
-// The ABI version; raised on every incompatible change of a struct or function.
-#define TVMD_ABI_VERSION 1
+// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
+// of `TvmdConfig` and the compensation of `TvmdOutput`).
+#define TVMD_ABI_VERSION 2
 
 // `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
 #define TVMD_MOTOR_CURVE_ROTOR_SPEED 0
@@ -28,6 +29,29 @@
 // `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C
 // without compiler extensions).
 #define TVMD_CONTROLLER_WORDS (TVMD_CONTROLLER_SIZE / 8)
+
+// `law.gain_schedule`: the gains `config.gains` as given (the paper's reading of eq. 12).
+#define TVMD_GAINS_AS_GIVEN 0
+
+// `law.gain_schedule`: `config.gains` scaled by the team's mass (`K_x`, `K_v`) and inertia
+// (`K_R`, `K_Omega`), the authors' MATLAB reading.
+#define TVMD_GAINS_TEAM_SCALED 1
+
+// `law.gain_schedule`: gains from the closed-loop natural frequencies and damping ratios of
+// `law.position_*` and `law.attitude_*`, scaled by the team's mass and inertia (`config.gains`
+// is not used).
+#define TVMD_GAINS_NATURAL 2
+
+// `law.offset_free`: none (the paper's law, no steady-state correction).
+#define TVMD_OFFSET_FREE_OFF 0
+
+// `law.offset_free`: the disturbance observer (`force_bandwidth`, `torque_bandwidth`,
+// `max_torque`), the one of the library's default law.
+#define TVMD_OFFSET_FREE_OBSERVER 1
+
+// `law.offset_free`: integral action on the position and attitude errors (`integral_k_x`,
+// `integral_k_r`, `max_torque`).
+#define TVMD_OFFSET_FREE_INTEGRAL 2
 
 // `limits.rotor_model`: `omega` normalized to 1 at `max_thrust` (`rho d^4 c_l = max_thrust`).
 #define TVMD_ROTOR_NORMALIZED 0
@@ -180,7 +204,53 @@ typedef struct {
   float k_v[9];
 } TvmdGains;
 
-// Everything `tvmd_create` needs. `tvmd_config_paper` fills the paper's team and settings.
+// The law beyond the paper: how the gains are formed, the offset-free action and the filter of
+// the planned attitude's rates. All numbers SI. A mode reads only its own fields; the fields
+// a mode does not use are ignored (any value, even NaN). Every number a mode uses must be
+// finite (`TVMD_ERR_CONFIG_NON_FINITE`) and positive (`TVMD_ERR_CONFIG_PARAMETER`); an unknown
+// mode is `TVMD_ERR_ENUM_VALUE`. All zeros is the paper's law.
+typedef struct {
+  // One of `TVMD_GAINS_*`.
+  uint32_t gain_schedule;
+  // Closed-loop natural frequency `w_x` (rad/s) of the position axes x, y, z (inertial), with
+  // `TVMD_GAINS_NATURAL`: `K_x = m_C diag(w_x^2)`.
+  float position_frequency[3];
+  // Damping ratio `zeta_x` (dimensionless) of the position axes, with `TVMD_GAINS_NATURAL`:
+  // `K_v = m_C diag(2 zeta_x w_x)`.
+  float position_damping[3];
+  // Closed-loop natural frequency `w_R` (rad/s) of roll, pitch, yaw (body), with
+  // `TVMD_GAINS_NATURAL`: `K_R = W J_C W`, `W = diag(w_R)`.
+  float attitude_frequency[3];
+  // Damping ratio `zeta_R` (dimensionless) of roll, pitch, yaw, with `TVMD_GAINS_NATURAL`.
+  float attitude_damping[3];
+  // One of `TVMD_OFFSET_FREE_*`.
+  uint32_t offset_free;
+  // Observer bandwidth `L_f` (rad/s) of the force estimate, with
+  // `TVMD_OFFSET_FREE_OBSERVER`.
+  float force_bandwidth;
+  // Observer bandwidth `L_tau` (rad/s) of the torque estimate, with
+  // `TVMD_OFFSET_FREE_OBSERVER`.
+  float torque_bandwidth;
+  // Integral gain `K_Ix` (N/(m s)) per inertial axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+  float integral_k_x[3];
+  // Integral gain `K_IR` (N m/(rad s)) per body axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+  float integral_k_r[3];
+  // Bound (N m) on the offset-free torque, with either offset-free action (the force is
+  // bounded by the working agents' capacity `n sigma_Tf`).
+  float max_torque;
+  // Non-zero: the law's `Omega_d`, `Omega_d_dot` are the filtered rates of the planned
+  // attitude `R_d` in place of the reference's (needed whenever the planner tilts away from
+  // the reference); zero: the reference's (the paper).
+  uint32_t attitude_rate;
+  // Bandwidth (rad/s) of the planned-rate filter, with `attitude_rate`.
+  float attitude_rate_bandwidth;
+  // Bound (rad/s) on the planned rate, with `attitude_rate`.
+  float attitude_rate_max;
+} TvmdLaw;
+
+// Everything `tvmd_create` needs. `tvmd_config_default` fills the paper's team and settings
+// with the offset-free law (the library's default); `tvmd_config_paper` the same team with the
+// paper's law.
 typedef struct {
   // `sizeof(TvmdConfig)`.
   uint32_t size;
@@ -194,7 +264,8 @@ typedef struct {
   float navigator_inertia[9];
   // The agent limits.
   TvmdLimits limits;
-  // The gains.
+  // The gains of eq. (12) (used as `law.gain_schedule` says; ignored with
+  // `TVMD_GAINS_NATURAL`).
   TvmdGains gains;
   // The AFS relaxation `s` of the planner, in `(0, 1]` (eq. 8).
   float relaxation;
@@ -211,6 +282,9 @@ typedef struct {
   // Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
   // are used; ignored by the other allocators).
   float agent_weights[TVMD_MAX_AGENTS];
+  // The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
+  // zeros: the paper's law).
+  TvmdLaw law;
 } TvmdConfig;
 
 // The measured state: pose and body-frame twist.
@@ -249,8 +323,9 @@ typedef struct {
 //
 // On an error status ("hold"), `commands` are the last good period's commands (idle before
 // the first good period, or when the handle is not initialized): inside `E_f`, never NaN, to
-// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`) are NaN and
-// `planner_status`/`planner_iterations` 0 then: they were not computed this period.
+// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`,
+// `compensation_force`, `compensation_torque`) are NaN and `planner_status`/
+// `planner_iterations` 0 then: they were not computed this period.
 typedef struct {
   // `sizeof(TvmdOutput)`, set by the caller.
   uint32_t size;
@@ -270,6 +345,13 @@ typedef struct {
   uint32_t planner_status;
   // The planner's search steps.
   uint32_t planner_iterations;
+  // The offset-free force (N, inertial frame) as it stands after this period: what the
+  // next period adds to its request before its own update (the observer's estimate of the
+  // unmodelled force is its negative). Zero without an offset-free action and while landed
+  // (`tvmd_set_landed`).
+  float compensation_force[3];
+  // The offset-free torque (N m, body frame), as `compensation_force`.
+  float compensation_torque[3];
 } TvmdOutput;
 
 // Whether the working agents can hold hover with a margin (the core's `HoverCapability`),
@@ -305,8 +387,8 @@ typedef struct {
 // The handle was never created, or its last `tvmd_create` failed.
 #define TVMD_ERR_NOT_INITIALIZED 4
 
-// An enum field (`limits.rotor_model`, `map.motor_curve`) has a value this library does not
-// know.
+// An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
+// `map.motor_curve`) has a value this library does not know.
 #define TVMD_ERR_ENUM_VALUE 5
 
 // [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
@@ -332,7 +414,8 @@ typedef struct {
 // [`ConfigError::TooManyAgents`]: `agent_count` above `TVMD_MAX_AGENTS`.
 #define TVMD_ERR_CONFIG_TOO_MANY_AGENTS 21
 
-// [`ConfigError::NonFinite`]: a NaN or infinite configuration number.
+// [`ConfigError::NonFinite`]: a NaN or infinite configuration number (also a gain that the
+// gain schedule makes overflow).
 #define TVMD_ERR_CONFIG_NON_FINITE 22
 
 // [`ConfigError::GimbalLimit`]: `sigma_x` or `sigma_y` outside `(0, pi/2]`.
@@ -368,7 +451,9 @@ typedef struct {
 // [`ConfigError::Relaxation`]: the relaxation `s` outside `(0, 1]`.
 #define TVMD_ERR_CONFIG_RELAXATION 33
 
-// [`ConfigError::Parameter`]: a gravity, period, rate limit or allocator weight not positive.
+// [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
+// `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
+// planned-rate bandwidth or bound) not positive.
 #define TVMD_ERR_CONFIG_PARAMETER 34
 
 // [`ConfigError::FailureIndex`]: a failure mask bit at or beyond the team's agent count.
@@ -457,21 +542,36 @@ TvmdStatus tvmd_actuator_commands(const TvmdController *handle,
                                   TvmdAgentCommand *commands,
                                   size_t count);
 
-// The bytes of caller memory a controller needs (`sizeof(TvmdController)`).
-size_t tvmd_controller_size(void);
-
-// The alignment, in bytes, caller memory for a controller needs.
-size_t tvmd_controller_align(void);
+// Fills `config` with the library's default: the paper's team "A4 inc, 1 navigator" and
+// settings (as `tvmd_config_paper`) flown with the offset-free law (the core's
+// `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
+// damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
+// (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
+// (20 rad/s, 5 rad/s bound). This law holds its setpoint under model error and unmodelled
+// forces, where the paper's law leaves a steady error. The caller sets `config->size` first.
+//
+// # Safety
+// `config` is null or points to a writable `TvmdConfig`.
+TvmdStatus tvmd_config_default(TvmdConfig *config);
 
 // Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
 // square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
 // `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
 // no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
-// and Python interfaces). The caller sets `config->size` first.
+// and Python interfaces) and the paper's law: gains as given, no offset-free action, the
+// reference's rates (every `law` mode off; its numbers are those of `tvmd_config_default`, so
+// switching one mode on starts from the library's values). The caller sets `config->size`
+// first.
 //
 // # Safety
 // `config` is null or points to a writable `TvmdConfig`.
 TvmdStatus tvmd_config_paper(TvmdConfig *config);
+
+// The bytes of caller memory a controller needs (`sizeof(TvmdController)`).
+size_t tvmd_controller_size(void);
+
+// The alignment, in bytes, caller memory for a controller needs.
+size_t tvmd_controller_align(void);
 
 // Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
 // On an error the storage is marked not initialized, and every other entry point refuses it.
@@ -511,11 +611,24 @@ TvmdStatus tvmd_set_failures(TvmdController *handle, uint32_t failed_mask, TvmdH
 TvmdStatus tvmd_hover_capability(const TvmdController *handle, TvmdHover *hover);
 
 // Forgets the previous command: the next held command is idle, and rate limits restart from
-// a centred gimbal. Configuration and failure mask are kept.
+// a centred gimbal; the offset-free state restarts from zero and the planned-rate filter at
+// rest. Configuration, failure mask and the landed flag (`tvmd_set_landed`) are kept.
 //
 // # Safety
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_reset(TvmdController *handle);
+
+// Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
+// (zero), from the caller's contact or landing detector. While landed the offset-free state
+// is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
+// not a disturbance to compensate, and nothing winds up against it. Call it with 1 on the
+// ground before take-off and again after touch-down, and with 0 at take-off, from which the
+// offset-free state starts again from zero. Nothing else changes, and it has no effect
+// without an offset-free action (`law.offset_free`). A created handle starts not landed.
+//
+// # Safety
+// `handle` as for [`tvmd_step`].
+TvmdStatus tvmd_set_landed(TvmdController *handle, uint32_t landed);
 
 // A short static name of a status code (`"TVMD_OK"`, `"TVMD_ERR_SIZE"`, ...), NUL-terminated,
 // never null; `"TVMD_UNKNOWN_STATUS"` for a value no entry point returns.

@@ -2,7 +2,8 @@
 # The C interface (crates/tvmd-ffi, include/tvmd.h): the header compiles as C99 and C++11 with
 # warnings as errors; the C test program, linked against the staticlib, runs the paper team
 # (hover, the saturating tilt, failure masks, every error path, the actuator channel map) and
-# its record is replayed on the Rust API bit for bit; the thumbv7em staticlib builds and every
+# the default offset-free law (law_test.c: convergence under an unmodelled force, the landed
+# hold, bad law values), and its record is replayed on the Rust API bit for bit; the thumbv7em staticlib builds and every
 # entry point links there without a panic path (embedded/ffi-check). The header's staleness is
 # checked by `cargo test -p tvmd-ffi --test header` (part of `cargo test --workspace`).
 # Installs a C/C++ compiler with apt-get where one is missing.
@@ -32,7 +33,7 @@ if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then
 fi
 
 step "include/tvmd.h compiles as C99 and as C++11 (-Wall -Wextra -Werror -pedantic)"
-printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 1 ? 0 : 1; }\n' >"$out/header.c"
+printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 2 ? 0 : 1; }\n' >"$out/header.c"
 cp "$out/header.c" "$out/header.cpp"
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.c" -o "$out/header_c.o"
 c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o "$out/header_cpp.o"
@@ -40,6 +41,7 @@ c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o
 step "C test program against the staticlib, then its record replayed on the Rust API"
 cargo build --locked -p tvmd-ffi
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tvmd_test.c \
+  crates/tvmd-ffi/tests/c/law_test.c \
   "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl -o "$out/tvmd_test"
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture

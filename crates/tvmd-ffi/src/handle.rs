@@ -12,7 +12,6 @@ use tvmd_core::allocation::{
     AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
 };
-use tvmd_core::team::presets;
 use tvmd_core::{
     AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings, FailureMask, Navigator,
     RateLimits, Relaxation, TeamConfig,
@@ -68,7 +67,7 @@ pub extern "C" fn tvmd_controller_align() -> usize {
     align_of::<TvmdController>()
 }
 
-fn checked_size<T>(size: u32) -> Result<(), TvmdStatus> {
+pub(crate) fn checked_size<T>(size: u32) -> Result<(), TvmdStatus> {
     if usize::try_from(size).ok() == Some(size_of::<T>()) {
         Ok(())
     } else {
@@ -114,63 +113,6 @@ pub(crate) unsafe fn controller<'a>(
     inner(handle).map(|i| &i.controller)
 }
 
-/// Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
-/// square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
-/// `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
-/// no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
-/// and Python interfaces). The caller sets `config->size` first.
-///
-/// # Safety
-/// `config` is null or points to a writable `TvmdConfig`.
-#[no_mangle]
-pub unsafe extern "C" fn tvmd_config_paper(config: *mut TvmdConfig) -> TvmdStatus {
-    let Some(config) = config.as_mut() else {
-        return TVMD_ERR_NULL_POINTER;
-    };
-    if let Err(status) = checked_size::<TvmdConfig>(config.size) {
-        return status;
-    }
-    let team = match presets::a4_inc::<f32, TVMD_MAX_AGENTS>() {
-        Ok(team) => team,
-        Err(e) => return config_status(&e),
-    };
-    let settings = ControllerSettings::<f32>::paper();
-    let limits = team.limits();
-    let mut agents = [TvmdAgent::default(); TVMD_MAX_AGENTS];
-    for (slot, agent) in agents.iter_mut().zip(team.agents()) {
-        *slot = TvmdAgent {
-            position: agent.position.into(),
-            quarter_turns: agent.quarter_turns,
-            mass: agent.mass,
-            inertia: row_major(&agent.inertia),
-        };
-    }
-    *config = TvmdConfig {
-        size: config.size,
-        agent_count: u32::try_from(team.len()).unwrap_or(0),
-        agents,
-        navigator_mass: team.navigator().mass,
-        navigator_inertia: row_major(&team.navigator().inertia),
-        limits: TvmdLimits {
-            sigma_x: limits.sigma_x(),
-            sigma_y: limits.sigma_y(),
-            max_thrust: limits.max_thrust(),
-            min_thrust: limits.min_thrust(),
-            rotor_model: TVMD_ROTOR_NORMALIZED,
-            ..TvmdLimits::default()
-        },
-        gains: TvmdGains::from_core(&settings.gains),
-        relaxation: settings.relaxation.get(),
-        gravity: settings.gravity,
-        period: settings.period,
-        rate_limited: 0,
-        rate_limits: [0.0; 2],
-        allocator: TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
-        agent_weights: [1.0; TVMD_MAX_AGENTS],
-    };
-    TVMD_OK
-}
-
 /// The core controller a configuration describes.
 fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
     let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
@@ -197,6 +139,7 @@ fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
     } else {
         None
     };
+    let law = config.law.to_core()?;
     let settings = ControllerSettings {
         gains: config.gains.to_core()?,
         relaxation: Relaxation::new(config.relaxation)?,
@@ -204,9 +147,9 @@ fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
         period: config.period,
         rate_limits,
         null_space: None,
-        gain_schedule: tvmd_core::GainSchedule::AsGiven,
-        offset_free: None,
-        attitude_rate: None,
+        gain_schedule: law.gain_schedule,
+        offset_free: law.offset_free,
+        attitude_rate: law.attitude_rate,
     };
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,
@@ -327,6 +270,9 @@ pub unsafe extern "C" fn tvmd_step(
             out.planner_theta = o.planner.theta;
             out.planner_status = planner_status_code(o.planner.status);
             out.planner_iterations = o.planner.iterations;
+            let compensation = controller.offset_free_compensation();
+            out.compensation_force = compensation.force.into();
+            out.compensation_torque = compensation.torque.into();
             TVMD_OK
         }
         // The core's error carries the previous commands, the same as `previous_commands`.
@@ -404,7 +350,8 @@ pub unsafe extern "C" fn tvmd_hover_capability(
 }
 
 /// Forgets the previous command: the next held command is idle, and rate limits restart from
-/// a centred gimbal. Configuration and failure mask are kept.
+/// a centred gimbal; the offset-free state restarts from zero and the planned-rate filter at
+/// rest. Configuration, failure mask and the landed flag (`tvmd_set_landed`) are kept.
 ///
 /// # Safety
 /// `handle` as for [`tvmd_step`].
@@ -413,6 +360,27 @@ pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
     match inner_mut(handle) {
         Ok(inner) => {
             inner.controller.reset();
+            TVMD_OK
+        }
+        Err(status) => status,
+    }
+}
+
+/// Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
+/// (zero), from the caller's contact or landing detector. While landed the offset-free state
+/// is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
+/// not a disturbance to compensate, and nothing winds up against it. Call it with 1 on the
+/// ground before take-off and again after touch-down, and with 0 at take-off, from which the
+/// offset-free state starts again from zero. Nothing else changes, and it has no effect
+/// without an offset-free action (`law.offset_free`). A created handle starts not landed.
+///
+/// # Safety
+/// `handle` as for [`tvmd_step`].
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_set_landed(handle: *mut TvmdController, landed: u32) -> TvmdStatus {
+    match inner_mut(handle) {
+        Ok(inner) => {
+            inner.controller.set_landed(landed != 0);
             TVMD_OK
         }
         Err(status) => status,

@@ -7,8 +7,12 @@
 //! control law is re-implemented here.
 //!
 //! - [`types`]: the C structs (configuration, state, reference, output, hover capability).
+//! - [`law`]: the law beyond the paper in the configuration ([`law::TvmdLaw`]: gain schedule,
+//!   offset-free action, planned-rate filter).
+//! - [`config`]: the default configuration (the offset-free law), the paper's, and their
+//!   conversion to the core's controller.
 //! - [`handle`]: the opaque controller in caller memory ([`handle::TvmdController`]):
-//!   create, step, set failures, reset.
+//!   create, step, set failures, set landed, reset.
 //! - [`actuator`]: commands to PX4-style normalized motor and servo outputs through a channel
 //!   map, and back.
 //!
@@ -30,7 +34,9 @@
 extern crate std;
 
 pub mod actuator;
+pub mod config;
 pub mod handle;
+pub mod law;
 pub mod status;
 pub mod types;
 
@@ -38,8 +44,9 @@ pub mod types;
 /// [`actuator::TvmdActuatorOutputs`]).
 pub const TVMD_MAX_AGENTS: usize = 16;
 
-/// The ABI version; raised on every incompatible change of a struct or function.
-pub const TVMD_ABI_VERSION: u32 = 1;
+/// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
+/// of `TvmdConfig` and the compensation of `TvmdOutput`).
+pub const TVMD_ABI_VERSION: u32 = 2;
 
 /// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
 #[no_mangle]

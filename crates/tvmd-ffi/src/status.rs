@@ -19,8 +19,8 @@ pub const TVMD_ERR_SIZE: TvmdStatus = 2;
 pub const TVMD_ERR_ALIGNMENT: TvmdStatus = 3;
 /// The handle was never created, or its last `tvmd_create` failed.
 pub const TVMD_ERR_NOT_INITIALIZED: TvmdStatus = 4;
-/// An enum field (`limits.rotor_model`, `map.motor_curve`) has a value this library does not
-/// know.
+/// An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
+/// `map.motor_curve`) has a value this library does not know.
 pub const TVMD_ERR_ENUM_VALUE: TvmdStatus = 5;
 
 /// [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
@@ -40,7 +40,8 @@ pub const TVMD_ERR_INPUT_OVERFLOW: TvmdStatus = 14;
 pub const TVMD_ERR_CONFIG_NO_AGENTS: TvmdStatus = 20;
 /// [`ConfigError::TooManyAgents`]: `agent_count` above `TVMD_MAX_AGENTS`.
 pub const TVMD_ERR_CONFIG_TOO_MANY_AGENTS: TvmdStatus = 21;
-/// [`ConfigError::NonFinite`]: a NaN or infinite configuration number.
+/// [`ConfigError::NonFinite`]: a NaN or infinite configuration number (also a gain that the
+/// gain schedule makes overflow).
 pub const TVMD_ERR_CONFIG_NON_FINITE: TvmdStatus = 22;
 /// [`ConfigError::GimbalLimit`]: `sigma_x` or `sigma_y` outside `(0, pi/2]`.
 pub const TVMD_ERR_CONFIG_GIMBAL_LIMIT: TvmdStatus = 23;
@@ -64,7 +65,9 @@ pub const TVMD_ERR_CONFIG_RANK_DEFICIENT: TvmdStatus = 31;
 pub const TVMD_ERR_CONFIG_AGENT_COUNT: TvmdStatus = 32;
 /// [`ConfigError::Relaxation`]: the relaxation `s` outside `(0, 1]`.
 pub const TVMD_ERR_CONFIG_RELAXATION: TvmdStatus = 33;
-/// [`ConfigError::Parameter`]: a gravity, period, rate limit or allocator weight not positive.
+/// [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
+/// `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
+/// planned-rate bandwidth or bound) not positive.
 pub const TVMD_ERR_CONFIG_PARAMETER: TvmdStatus = 34;
 /// [`ConfigError::FailureIndex`]: a failure mask bit at or beyond the team's agent count.
 pub const TVMD_ERR_CONFIG_FAILURE_INDEX: TvmdStatus = 35;
@@ -122,6 +125,28 @@ pub fn config_status(error: &ConfigError) -> TvmdStatus {
         ConfigError::UnknownAllocator => TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR,
         ConfigError::AllocatorUnavailable { .. } => TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE,
         ConfigError::UnusedOption { .. } => TVMD_ERR_CONFIG_UNUSED_OPTION,
+    }
+}
+
+/// Why a configuration could not be converted: an enum value, or a core error.
+#[derive(Debug)]
+pub(crate) enum ConvertError {
+    EnumValue,
+    Config(ConfigError),
+}
+
+impl ConvertError {
+    pub(crate) fn status(&self) -> TvmdStatus {
+        match self {
+            Self::EnumValue => TVMD_ERR_ENUM_VALUE,
+            Self::Config(e) => config_status(e),
+        }
+    }
+}
+
+impl From<ConfigError> for ConvertError {
+    fn from(e: ConfigError) -> Self {
+        Self::Config(e)
     }
 }
 

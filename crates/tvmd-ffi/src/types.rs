@@ -11,7 +11,8 @@ use tvmd_core::{
     PlannerStatus, Reference, RigidState,
 };
 
-use crate::status::{TvmdStatus, TVMD_ERR_ENUM_VALUE};
+use crate::law::TvmdLaw;
+use crate::status::{ConvertError, TvmdStatus};
 use crate::TVMD_MAX_AGENTS;
 
 /// One agent of the team (paper, "Modeling"): its gimbal centre, yaw and mass.
@@ -84,7 +85,9 @@ pub const TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE: u32 = 2;
 /// `tvmd_set_failures` forget them).
 pub const TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION: u32 = 3;
 
-/// Everything `tvmd_create` needs. `tvmd_config_paper` fills the paper's team and settings.
+/// Everything `tvmd_create` needs. `tvmd_config_default` fills the paper's team and settings
+/// with the offset-free law (the library's default); `tvmd_config_paper` the same team with the
+/// paper's law.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TvmdConfig {
@@ -100,7 +103,8 @@ pub struct TvmdConfig {
     pub navigator_inertia: [f32; 9],
     /// The agent limits.
     pub limits: TvmdLimits,
-    /// The gains.
+    /// The gains of eq. (12) (used as `law.gain_schedule` says; ignored with
+    /// `TVMD_GAINS_NATURAL`).
     pub gains: TvmdGains,
     /// The AFS relaxation `s` of the planner, in `(0, 1]` (eq. 8).
     pub relaxation: f32,
@@ -117,6 +121,9 @@ pub struct TvmdConfig {
     /// Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
     /// are used; ignored by the other allocators).
     pub agent_weights: [f32; TVMD_MAX_AGENTS],
+    /// The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
+    /// zeros: the paper's law).
+    pub law: TvmdLaw,
 }
 
 /// The measured state: pose and body-frame twist.
@@ -193,8 +200,9 @@ pub const TVMD_PLANNER_UNREACHABLE: u32 = 3;
 ///
 /// On an error status ("hold"), `commands` are the last good period's commands (idle before
 /// the first good period, or when the handle is not initialized): inside `E_f`, never NaN, to
-/// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`) are NaN and
-/// `planner_status`/`planner_iterations` 0 then: they were not computed this period.
+/// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`,
+/// `compensation_force`, `compensation_torque`) are NaN and `planner_status`/
+/// `planner_iterations` 0 then: they were not computed this period.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TvmdOutput {
@@ -216,6 +224,13 @@ pub struct TvmdOutput {
     pub planner_status: u32,
     /// The planner's search steps.
     pub planner_iterations: u32,
+    /// The offset-free force (N, inertial frame) as it stands after this period: what the
+    /// next period adds to its request before its own update (the observer's estimate of the
+    /// unmodelled force is its negative). Zero without an offset-free action and while landed
+    /// (`tvmd_set_landed`).
+    pub compensation_force: [f32; 3],
+    /// The offset-free torque (N m, body frame), as `compensation_force`.
+    pub compensation_torque: [f32; 3],
 }
 
 impl TvmdOutput {
@@ -237,6 +252,8 @@ impl TvmdOutput {
         self.planner_theta = f32::NAN;
         self.planner_status = 0;
         self.planner_iterations = 0;
+        self.compensation_force = [f32::NAN; 3];
+        self.compensation_torque = [f32::NAN; 3];
     }
 }
 
@@ -341,27 +358,6 @@ impl TvmdAgent {
         let mut spec = AgentSpec::new(vector(&self.position), self.quarter_turns, self.mass);
         spec.inertia = matrix(&self.inertia);
         spec
-    }
-}
-
-/// Why a configuration could not be converted: an enum value, or a core error.
-pub(crate) enum ConvertError {
-    EnumValue,
-    Config(ConfigError),
-}
-
-impl ConvertError {
-    pub(crate) fn status(&self) -> TvmdStatus {
-        match self {
-            Self::EnumValue => TVMD_ERR_ENUM_VALUE,
-            Self::Config(e) => crate::status::config_status(e),
-        }
-    }
-}
-
-impl From<ConfigError> for ConvertError {
-    fn from(e: ConfigError) -> Self {
-        Self::Config(e)
     }
 }
 

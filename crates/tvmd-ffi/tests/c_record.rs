@@ -1,6 +1,8 @@
-//! Replays the record of the C test program (`crates/tvmd-ffi/tests/c/tvmd_test.c`) on the
-//! Rust API (`tvmd_core::Controller`, the paper's team and settings, f32, 16 agents) and
-//! compares every output bit for bit: the C interface adds no arithmetic of its own.
+//! Replays the record of the C test program (`crates/tvmd-ffi/tests/c/tvmd_test.c`,
+//! `law_test.c`) on the Rust API (`tvmd_core::Controller`, the paper's team, f32, 16 agents,
+//! with the paper's settings after `create` and the default, offset-free law after
+//! `create default`) and compares every output bit for bit, the offset-free compensation
+//! included: the C interface adds no arithmetic of its own.
 //!
 //! `scripts/ffi.sh` builds and runs the C program, then runs this test with
 //! `TVMD_FFI_C_RECORD` naming the record file.
@@ -37,10 +39,9 @@ fn expected_input_status(e: &InputError) -> i32 {
     }
 }
 
-fn new_controller() -> RustController {
+fn new_controller(settings: ControllerSettings<f32>) -> RustController {
     let team = presets::a4_inc::<f32, 16>().expect("paper team");
-    Controller::new(team, ControllerSettings::paper(), AnyAllocator::default())
-        .expect("paper controller")
+    Controller::new(team, settings, AnyAllocator::default()).expect("paper team controller")
 }
 
 /// Replays one `step` line; returns (status, planner status) for the summary.
@@ -51,7 +52,7 @@ fn replay_step(controller: &mut RustController, words: &[&str], line: usize) -> 
     let iterations: u32 = words[words.len() - 1].parse().expect("iterations");
     assert_eq!(
         x.len(),
-        18 + 24 + 64 + 1 + 9 + 1,
+        18 + 24 + 64 + 1 + 9 + 1 + 6,
         "line {line}: field count"
     );
     let state = RigidState {
@@ -70,6 +71,7 @@ fn replay_step(controller: &mut RustController, words: &[&str], line: usize) -> 
     };
     let c_commands = &x[42..106];
     let (e_f, r_d, theta) = (x[106], &x[107..116], x[116]);
+    let compensation = &x[117..123];
     let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
     let (rust_status, commands) = match controller.step(&state, &reference) {
         Ok(out) => {
@@ -99,11 +101,14 @@ fn replay_step(controller: &mut RustController, words: &[&str], line: usize) -> 
                 iterations, out.planner.iterations,
                 "line {line}: iterations"
             );
+            let c = controller.offset_free_compensation();
+            let rust: Vec<f32> = c.force.iter().chain(c.torque.iter()).copied().collect();
+            assert_eq!(bits(compensation), bits(&rust), "line {line}: compensation");
             (TVMD_OK, out.commands)
         }
         Err(held) => {
             assert!(
-                e_f.is_nan() && theta.is_nan(),
+                e_f.is_nan() && theta.is_nan() && compensation.iter().all(|c| c.is_nan()),
                 "line {line}: NaN diagnostics on error"
             );
             (expected_input_status(&held.error), held.commands)
@@ -187,17 +192,33 @@ fn c_outputs_equal_the_rust_api_bit_for_bit() {
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut controller = None;
     let (mut steps, mut errors, mut planned, mut masks) = (0, 0, 0, 0);
+    let (mut default_steps, mut landed) = (0, 0);
     for (i, line) in text.lines().enumerate() {
         let words: Vec<&str> = line.split_whitespace().collect();
         let c = || format!("line {}: {line:.60}", i + 1);
         match words[0] {
-            "create" => controller = Some(new_controller()),
+            "create" => {
+                controller = Some(new_controller(match words.get(1) {
+                    None => ControllerSettings::paper(),
+                    Some(&"default") => ControllerSettings::default(),
+                    Some(other) => panic!("{}: unknown configuration {other}", c()),
+                }))
+            }
+            "landed" => {
+                let flag: u32 = words[1].parse().expect("landed flag");
+                let ctrl = controller
+                    .as_mut()
+                    .unwrap_or_else(|| panic!("{}: no create", c()));
+                ctrl.set_landed(flag != 0);
+                landed += 1;
+            }
             "step" => {
                 let ctrl = controller
                     .as_mut()
                     .unwrap_or_else(|| panic!("{}: no create", c()));
                 let (status, planner) = replay_step(ctrl, &words, i + 1);
                 steps += 1;
+                default_steps += usize::from(ctrl.settings().offset_free.is_some());
                 errors += usize::from(status != TVMD_OK);
                 planned += usize::from(status == TVMD_OK && planner == 1);
             }
@@ -212,9 +233,11 @@ fn c_outputs_equal_the_rust_api_bit_for_bit() {
         }
     }
     println!(
-        "replayed {steps} steps ({errors} refused, {planned} planner-saturated), {masks} masks"
+        "replayed {steps} steps ({errors} refused, {planned} planner-saturated, \
+         {default_steps} of the offset-free law), {masks} masks, {landed} landed flags"
     );
     // The record covers what the C test is meant to: hover, the saturating planner, refused
-    // inputs and masks.
+    // inputs and masks, the offset-free law and the landed flag.
     assert!(steps >= 10 && errors >= 5 && planned >= 4 && masks >= 2);
+    assert!(default_steps >= 600 && landed >= 3);
 }

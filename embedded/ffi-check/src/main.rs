@@ -8,6 +8,7 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use tvmd_ffi::actuator::*;
+use tvmd_ffi::config::*;
 use tvmd_ffi::handle::*;
 use tvmd_ffi::types::*;
 
@@ -18,11 +19,16 @@ static mut CONTROLLER: TvmdController = TvmdController {
 static mut STATE: [f32; 18] = [0.0; 18];
 static mut REFERENCE: [f32; 24] = [0.0; 24];
 static mut MASK: u32 = 0;
+/// Which configuration to create (0: the default, offset-free law; else the paper's) and the
+/// landing detector's flag.
+static mut PAPER: u32 = 0;
+static mut LANDED: u32 = 0;
 static mut MAP_SHIFT: u32 = 0;
 /// Outputs a flight stack would read.
 static mut MOTORS: [f32; 16] = [0.0; 16];
 static mut SERVOS: [f32; 16] = [0.0; 16];
 static mut STATUS: [i32; 8] = [0; 8];
+static mut COMPENSATION: [f32; 6] = [0.0; 6];
 static mut NAME: usize = 0;
 
 fn copy(dst: &mut [f32], src: &[f32]) {
@@ -40,7 +46,11 @@ pub extern "C" fn _start() -> ! {
         let mut config: TvmdConfig = core::mem::zeroed();
         config.size = core::mem::size_of::<TvmdConfig>() as u32;
         let mut status = [0i32; 8];
-        status[0] = tvmd_ffi::handle::tvmd_config_paper(&mut config);
+        status[0] = if read_volatile(addr_of!(PAPER)) != 0 {
+            tvmd_config_paper(&mut config)
+        } else {
+            tvmd_config_default(&mut config)
+        };
         status[1] = tvmd_create(handle, core::mem::size_of::<TvmdController>(), &config);
         let mut map: TvmdActuatorMap = core::mem::zeroed();
         map.size = core::mem::size_of::<TvmdActuatorMap>() as u32;
@@ -75,7 +85,11 @@ pub extern "C" fn _start() -> ! {
             copy(&mut reference.angular_acceleration, &r[21..24]);
             let mut out: TvmdOutput = core::mem::zeroed();
             out.size = core::mem::size_of::<TvmdOutput>() as u32;
-            status[4] = tvmd_step(handle, &state, &reference, &mut out);
+            status[4] = tvmd_set_landed(handle, read_volatile(addr_of!(LANDED)));
+            status[4] += tvmd_step(handle, &state, &reference, &mut out);
+            let [f0, f1, f2] = out.compensation_force;
+            let [t0, t1, t2] = out.compensation_torque;
+            write_volatile(addr_of_mut!(COMPENSATION), [f0, f1, f2, t0, t1, t2]);
             let mask = read_volatile(addr_of!(MASK));
             if mask != 0 {
                 status[5] = tvmd_set_failures(handle, mask, &mut hover);

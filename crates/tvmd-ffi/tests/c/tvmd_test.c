@@ -1,42 +1,21 @@
 /* The C test of the tvmd C interface (run by scripts/ffi.sh).
  *
  * Links libtvmd_ffi.a and runs the paper team through hover, the tilt (the planner
- * saturating), failure masks, reset and every error path, checking what C can check alone
- * (statuses, held commands, channel placement, round trips). Every call that reaches the core
- * is also written, inputs and outputs as float bits, to the record file given as argv[1]: the
- * Rust test crates/tvmd-ffi/tests/c_record.rs replays it on the Rust API and compares exactly.
+ * saturating), failure masks, reset and every error path, then the offset-free law (law_test.c),
+ * checking what C can check alone (statuses, held commands, channel placement, round trips).
+ * Every call that reaches the core is also written, inputs and outputs as float bits, to the
+ * record file given as argv[1]: the Rust test crates/tvmd-ffi/tests/c_record.rs replays it on
+ * the Rust API and compares exactly.
  */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "tvmd.h"
+#include "check.h"
 
-static int checks = 0;
-static int failed = 0;
-static FILE *record = NULL;
-
-#define CHECK(cond)                                                              \
-  do {                                                                           \
-    ++checks;                                                                    \
-    if (!(cond)) {                                                               \
-      ++failed;                                                                  \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);   \
-    }                                                                            \
-  } while (0)
-
-#define CHECK_STATUS(call, expected)                                             \
-  do {                                                                           \
-    TvmdStatus got_ = (call);                                                    \
-    ++checks;                                                                    \
-    if (got_ != (expected)) {                                                    \
-      ++failed;                                                                  \
-      fprintf(stderr, "%s:%d: %s returned %s, expected %s\n", __FILE__, __LINE__, \
-              #call, tvmd_status_name(got_), tvmd_status_name(expected));        \
-    }                                                                            \
-  } while (0)
+int checks = 0, failed = 0;
+FILE *record = NULL;
 
 static uint32_t bits(float x) {
   uint32_t u;
@@ -49,7 +28,7 @@ static void put_floats(const float *x, size_t n) {
   for (i = 0; i < n; ++i) fprintf(record, " %08lx", (unsigned long)bits(x[i]));
 }
 
-static void identity(float m[9]) {
+void identity(float m[9]) {
   memset(m, 0, 9 * sizeof m[0]);
   m[0] = m[4] = m[8] = 1.0f;
 }
@@ -62,7 +41,7 @@ static void roll(float m[9], float phi) {
   m[8] = cosf(phi);
 }
 
-static TvmdState at_rest(float x, float y, float z) {
+TvmdState at_rest(float x, float y, float z) {
   TvmdState s;
   memset(&s, 0, sizeof s);
   s.size = sizeof s;
@@ -73,7 +52,7 @@ static TvmdState at_rest(float x, float y, float z) {
   return s;
 }
 
-static TvmdReference hover_at(float x, float y, float z) {
+TvmdReference hover_at(float x, float y, float z) {
   TvmdReference r;
   memset(&r, 0, sizeof r);
   r.size = sizeof r;
@@ -84,7 +63,7 @@ static TvmdReference hover_at(float x, float y, float z) {
   return r;
 }
 
-static TvmdOutput empty_output(void) {
+TvmdOutput empty_output(void) {
   TvmdOutput o;
   memset(&o, 0, sizeof o);
   o.size = sizeof o;
@@ -92,8 +71,8 @@ static TvmdOutput empty_output(void) {
 }
 
 /* One recorded step: "step STATUS state(18) reference(24) commands(64) e_f R_d(9) theta
- * planner_status iterations". */
-static TvmdStatus step(TvmdController *c, const TvmdState *s, const TvmdReference *r,
+ * compensation(6) planner_status iterations". */
+TvmdStatus step(TvmdController *c, const TvmdState *s, const TvmdReference *r,
                        TvmdOutput *o) {
   TvmdStatus status = tvmd_step(c, s, r, o);
   size_t i;
@@ -117,6 +96,8 @@ static TvmdStatus step(TvmdController *c, const TvmdState *s, const TvmdReferenc
   put_floats(&o->e_f, 1);
   put_floats(o->planned_attitude, 9);
   put_floats(&o->planner_theta, 1);
+  put_floats(o->compensation_force, 3);
+  put_floats(o->compensation_torque, 3);
   fprintf(record, " %u %u\n", (unsigned)o->planner_status, (unsigned)o->planner_iterations);
   return status;
 }
@@ -139,8 +120,9 @@ static int same_commands(const TvmdOutput *a, const TvmdOutput *b) {
   return memcmp(a->commands, b->commands, sizeof a->commands) == 0;
 }
 
-static int diagnostics_nan(const TvmdOutput *o) {
-  return isnan(o->e_f) && isnan(o->planner_theta) && isnan(o->planned_attitude[0]);
+int diagnostics_nan(const TvmdOutput *o) {
+  return isnan(o->e_f) && isnan(o->planner_theta) && isnan(o->planned_attitude[0]) &&
+         isnan(o->compensation_force[0]) && isnan(o->compensation_torque[2]);
 }
 
 static TvmdConfig paper_config(void) {
@@ -509,6 +491,7 @@ int main(int argc, char **argv) {
   CHECK(o.commands[0].thrust == 0.0f && o.commands[3].eta_y == 0.0f);
   s = at_rest(0.0f, 0.0f, 1.5f);
   CHECK_STATUS(step(c, &s, &r, &o), TVMD_OK);
+  test_law();
 
   fclose(record);
   printf("tvmd C test: %d checks, %d failed\n", checks, failed);
