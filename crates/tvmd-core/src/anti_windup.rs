@@ -5,7 +5,7 @@
 
 use nalgebra::Vector3;
 
-use crate::linalg::{clamp_norm, norm};
+use crate::linalg::clamp_norm;
 use crate::real::Real;
 
 /// Which parts of the requested wrench the team could not deliver in one period.
@@ -60,7 +60,7 @@ pub(crate) fn guarded<T: Real>(
     bound: T,
 ) -> Vector3<T> {
     let finite = candidate.iter().all(|x| x.is_finite());
-    let grows = norm(candidate) > norm(old);
+    let grows = candidate.norm_squared() > old.norm_squared();
     let next = if !finite || (saturated && grows) {
         old
     } else {

@@ -88,6 +88,9 @@ pub struct ObserverState<T: Real> {
     force: Vector3<T>,
     torque: Vector3<T>,
     last: Option<Sample<T>>,
+    /// `(m_C x_dot, J_C Omega)` of this period's state, from [`Self::measure`] for
+    /// [`Self::record`] (the same state: computed once per period).
+    momenta: Option<(Vector3<T>, Vector3<T>)>,
     /// The saturation of the last period, for the update that measures it.
     saturation: Saturation,
 }
@@ -106,6 +109,7 @@ impl<T: Real> ObserverState<T> {
             force: Vector3::zeros(),
             torque: Vector3::zeros(),
             last: None,
+            momenta: None,
             saturation: Saturation::NONE,
         }
     }
@@ -126,6 +130,7 @@ impl<T: Real> ObserverState<T> {
         self.force = Vector3::zeros();
         self.torque = Vector3::zeros();
         self.last = None;
+        self.momenta = None;
         self.saturation = Saturation::NONE;
     }
 
@@ -138,10 +143,11 @@ impl<T: Real> ObserverState<T> {
     /// updates the estimates (under the anti-windup rule with the last period's saturation).
     /// Without a sample (first period, after a reset) nothing changes.
     pub fn measure(&mut self, plant: &Plant<T>, state: &RigidState<T>, force_bound: T) {
+        let (momentum, angular_momentum) = momenta(plant, state);
+        self.momenta = Some((momentum, angular_momentum));
         let Some(last) = self.last else {
             return;
         };
-        let (momentum, angular_momentum) = momenta(plant, state);
         let dt = self.period;
         let d_f = (momentum - last.momentum) / dt - last.force;
         let d_tau = (angular_momentum - last.angular_momentum) / dt - last.torque;
@@ -158,7 +164,8 @@ impl<T: Real> ObserverState<T> {
     }
 
     /// End of a period: records the state and the allocated wrench `u = [u_tau; u_f]` (`{C}`)
-    /// sent for the coming period, and this period's saturation.
+    /// sent for the coming period, and this period's saturation. `state` is the one this
+    /// period's [`Self::measure`] was given (its momenta are reused).
     pub fn record(
         &mut self,
         plant: &Plant<T>,
@@ -166,7 +173,8 @@ impl<T: Real> ObserverState<T> {
         wrench: &Vector6<T>,
         saturation: Saturation,
     ) {
-        let (momentum, angular_momentum) = momenta(plant, state);
+        let (momentum, angular_momentum) =
+            self.momenta.take().unwrap_or_else(|| momenta(plant, state));
         let u_tau = wrench.fixed_rows::<3>(0).into_owned();
         let u_f = wrench.fixed_rows::<3>(3).into_owned();
         let weight = Vector3::new(T::zero(), T::zero(), plant.weight());
