@@ -1,18 +1,20 @@
-//! `tvmd.Controller` (one `step` per control period) and its `StepOutput`.
+//! `tvmd.Controller`: one `step` per control period (its output in [`crate::step_output`]),
+//! with the law the `law` argument names (default the offset-free law).
 
 use pyo3::prelude::*;
 
-use tvmd_core::{AnyAllocator, ControlOutput, Controller, ControllerSettings, NullSpaceReport};
-use tvmd_scenario::NullSpaceConfig;
+use tvmd_core::{AnyAllocator, Controller, ControllerSettings};
+use tvmd_scenario::{LawConfig, NullSpaceConfig};
+use tvmd_sim::control::law_settings;
 
-use crate::afs::{PyAfs, PyForceProjection};
-use crate::allocation::{make_allocator, rate_limits_arg, AllocationData, PyAllocation};
-use crate::convert::{class_arg, commands_array, iteration_cap, matrix, null_space_arg};
+use crate::afs::PyAfs;
+use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
+use crate::convert::{class_arg, commands_array, iteration_cap, law_arg, matrix, null_space_arg};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, value_error, OrRaise};
-use crate::law::{gains_arg, reference_arg, state_arg, PyGains, PyLawOutput};
-use crate::planner::{planner, PyPlannerResult};
-use crate::record::record;
+use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
+use crate::planner::planner;
+use crate::step_output::{PyStepOutput, StepData};
 use crate::team::{failure_mask, PyHoverCapability, PyTeam};
 
 /// The controller borrowed for a call; a clear error if another thread holds it (only possible
@@ -38,12 +40,19 @@ pub struct PyController {
     inner: Controller<f64, CAPACITY, AnyAllocator<f64, CAPACITY>>,
     max_iterations: u32,
     null_space: Option<NullSpaceConfig>,
+    /// The law as asked for (`law`), whose settings the core holds.
+    law: LawConfig,
 }
 
 #[pymethods]
 impl PyController {
+    // `law = None` is the offset-free law (a default here must be of the argument's type); the
+    // text signature (kept equal to `signature`, checked by stubtest) shows it by its name.
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None, law = None))]
+    #[pyo3(
+        text_signature = "(team, gains=None, relaxation=None, gravity=9.81, period=0.01, allocator=\"exact-boundary-redistribution\", rate_limits=None, failed=None, weights=None, regularization=None, planner_tolerance=None, planner_max_iterations=None, *, s=None, null_space=None, law=\"offset-free\")"
+    )]
     #[allow(clippy::too_many_arguments)]
     fn new(
         team: &Bound<'_, PyAny>,
@@ -60,6 +69,7 @@ impl PyController {
         planner_max_iterations: Option<Int>,
         s: Option<f64>,
         null_space: Option<&str>,
+        law: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
@@ -68,6 +78,9 @@ impl PyController {
             Some(c) => Some(c.stage::<f64>().map_err(value_error)?),
             None => None,
         };
+        let law = law.map_or(Ok(LawConfig::default()), |l| law_arg(l, "law"))?;
+        let (gain_schedule, offset_free, attitude_rate) =
+            law_settings::<f64>(&law).map_err(value_error)?;
         let settings = ControllerSettings {
             gains: gains_arg(gains)?,
             relaxation,
@@ -75,9 +88,9 @@ impl PyController {
             period,
             rate_limits: rate_limits_arg(rate_limits)?,
             null_space: stage,
-            gain_schedule: tvmd_core::GainSchedule::AsGiven,
-            offset_free: None,
-            attitude_rate: None,
+            gain_schedule,
+            offset_free,
+            attitude_rate,
         };
         let allocator = make_allocator(allocator, weights, regularization, team.len())?;
         let mask = failure_mask(&team, failed)?;
@@ -92,6 +105,7 @@ impl PyController {
             inner,
             max_iterations,
             null_space,
+            law,
         })
     }
 
@@ -118,9 +132,52 @@ impl PyController {
         }
     }
 
-    /// Forgets the previous command.
+    /// Forgets the previous command, the offset-free state and the planned-rate filter (not
+    /// the landed flag).
     fn reset(&mut self) {
         self.inner.reset();
+    }
+
+    /// Whether the team stands on the ground: while landed the offset-free state is cleared
+    /// and held at zero. See the stub.
+    fn set_landed(&mut self, landed: bool) {
+        self.inner.set_landed(landed);
+    }
+
+    /// Whether the landed hold is on (`set_landed`).
+    #[getter]
+    fn landed(&self) -> bool {
+        self.inner.landed()
+    }
+
+    /// `(force, torque)`: the wrench the offset-free state adds to the next period's request,
+    /// force (3,) (N) in the inertial frame, torque (3,) (N m) in the body frame.
+    #[getter]
+    fn offset_free_compensation<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let c = self.inner.offset_free_compensation();
+        Ok((matrix(py, &c.force)?, matrix(py, &c.torque)?))
+    }
+
+    /// `(Omega_d, Omega_d_dot)` of the planned attitude in the last period (rad/s, rad/s^2,
+    /// body frame), or None without the planned-rate filter.
+    #[getter]
+    fn planned_rates<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
+        self.inner
+            .planned_rates()
+            .map(|r| Ok((matrix(py, &r.omega_d)?, matrix(py, &r.omega_d_dot)?)))
+            .transpose()
+    }
+
+    /// The law's name: "paper", "offset-free" or "custom".
+    #[getter]
+    fn law(&self) -> &'static str {
+        self.law.name()
     }
 
     /// One control period. See the stub for arguments.
@@ -138,11 +195,7 @@ impl PyController {
         match this.inner.step(&state, &reference) {
             Ok(out) => {
                 let allocation = AllocationData::new(out.allocation, n, this.inner.allocator());
-                let inner = StepData {
-                    out: Box::new(out),
-                    n,
-                    allocation,
-                };
+                let inner = StepData::new(out, n, allocation);
                 Ok(PyStepOutput { inner })
             }
             Err(error) => {
@@ -160,11 +213,12 @@ impl PyController {
         }
     }
 
-    /// The gains.
+    /// The law's gains: `gains` as given (law "paper"), scaled by the team ("team-scaled") or
+    /// from the natural frequencies ("offset-free").
     #[getter]
     fn gains(&self) -> PyGains {
         PyGains {
-            inner: self.inner.settings().gains,
+            inner: *self.inner.gains(),
         }
     }
 
@@ -234,8 +288,9 @@ impl PyController {
 
     fn __repr__(&self) -> String {
         format!(
-            "Controller(n={}, relaxation={}, allocator='{}', failed={:?})",
+            "Controller(n={}, law='{}', relaxation={}, allocator='{}', failed={:?})",
             self.inner.team().len(),
+            self.law(),
             self.relaxation(),
             self.allocator(),
             self.failed()
@@ -243,61 +298,8 @@ impl PyController {
     }
 }
 
-/// One `Controller.step`: the core's output, the agent count and the allocation record.
-pub(crate) struct StepData {
-    out: Box<ControlOutput<f64, CAPACITY>>,
-    n: usize,
-    allocation: AllocationData,
-}
-
-record! {
-    /// Everything one `Controller.step` computed, nested like the core's `ControlOutput`.
-    "StepOutput" in "tvmd" => PyStepOutput(StepData) |py, o| {
-        /// The planner's result (eqs. 9-11).
-        planner => PyPlannerResult { inner: o.out.planner },
-        /// The force projection `K_f` (eqs. 12-13).
-        projection => PyForceProjection { inner: o.out.projection },
-        /// (3,) `t_Tf R u_fr` (inertial).
-        f_r => matrix(py, &o.out.f_r)?,
-        /// The control law's output (eq. 12).
-        law => PyLawOutput { inner: o.out.law },
-        /// The allocation (eqs. 4 and 6).
-        allocation => PyAllocation { inner: o.allocation.clone() },
-        /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
-        commands => commands_array(py, &o.out.commands, o.n)?,
-        /// Largest clamp of the command inversion (normalized).
-        command_clamp => o.out.command_clamp,
-        /// What the null-space stage changed.
-        null_space => PyNullSpaceReport { inner: o.out.null_space },
-    }
-}
-
-record! {
-    /// What the null-space stage changed in one period. See the stub.
-    "NullSpaceReport" in "tvmd" => PyNullSpaceReport(NullSpaceReport<f64>) |py, o| {
-        /// The stage ran on this period's allocation.
-        ran => o.ran,
-        /// Accepted steps (0: the allocator's forces unchanged).
-        iterations => o.iterations,
-        /// The objective at the allocator's forces.
-        objective_before => o.objective_before,
-        /// The objective at the returned forces.
-        objective_after => o.objective_after,
-        /// Smallest normalized margin to the admissible boundary at the allocator's forces.
-        margin_before => o.margin_before,
-        /// The same at the returned forces.
-        margin_after => o.margin_after,
-        /// Largest change of one agent's force (N).
-        largest_force_change => o.largest_force_change,
-        /// `||M f' - M f||`, the wrench the stage moved (round-off).
-        wrench_drift => o.wrench_drift,
-    }
-}
-
 /// Registers the controller classes.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyController>()?;
-    m.add_class::<PyStepOutput>()?;
-    m.add_class::<PyNullSpaceReport>()?;
     Ok(())
 }

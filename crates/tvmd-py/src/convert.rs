@@ -1,7 +1,8 @@
 //! The one conversion layer at the Python boundary: array-likes in, NumPy arrays out
 //! (conventions in the stub `python/tvmd/_tvmd.pyi`), and the parsers of the plain arguments
-//! (relaxation, iteration cap, null-space stage, sample retention, scenario). Nothing here
-//! panics: every shape is checked. It imports only [`crate::errors`].
+//! (relaxation, iteration cap, null-space stage, sample retention, scenario) and, in [`law`],
+//! of the control law. Nothing here panics: every shape is checked. It imports only
+//! [`crate::errors`].
 
 use std::path::PathBuf;
 
@@ -19,6 +20,10 @@ use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::ScenarioSource;
 
 use crate::errors::{sim_error, value_error, OrRaise, READ};
+
+mod law;
+
+pub(crate) use law::law_arg;
 
 /// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
 pub(crate) const CAPACITY: usize = 64;

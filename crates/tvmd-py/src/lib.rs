@@ -8,7 +8,8 @@
 //! Modules import one way (no circle; `a <- b` reads "b imports a"): `errors` and `record`
 //! import no module of the crate, nor does `interrupt` (Ctrl-C for long calls), `convert` only `errors`, and every other module imports
 //! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
-//! `afs, allocation, law, planner, team <- controller`, and for the simulator
+//! `afs, allocation, law, planner <- step_output`,
+//! `afs, allocation, law, planner, step_output, team <- controller`, and for the simulator
 //! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert`, `errors` and
 //! `interrupt`. This file imports every module and no module imports it.
 #![deny(
@@ -39,6 +40,7 @@ mod record;
 mod runs;
 mod sim;
 mod sim_result;
+mod step_output;
 mod team;
 
 use convert::CAPACITY;
@@ -59,6 +61,7 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     law::register(m)?;
     allocation::register(m)?;
     controller::register(m)?;
+    step_output::register(m)?;
     atlas::register(m)?;
     // The submodule `tvmd._tvmd.sim`.
     let sim = PyModule::new(py, "tvmd.sim")?;

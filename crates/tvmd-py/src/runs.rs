@@ -9,12 +9,12 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
+use tvmd_scenario::LawConfig;
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{RunRequest, ScenarioSource};
 
-use crate::convert::Int;
-use crate::convert::{retention_arg, scalars, scenario_source, shape_error};
+use crate::convert::{law_arg, retention_arg, scalars, scenario_source, shape_error, Int};
 use crate::errors::{sim_error, value_error, WRITE};
 use crate::interrupt::{interruptible, Ended};
 use crate::sim_result::{PySimResult, SimData};
@@ -31,6 +31,7 @@ const RUN_KEYS: &[&str] = &[
     "pil",
     "null_space",
     "max_samples",
+    "law",
 ];
 
 /// The arguments of one run, as `run` takes them.
@@ -47,6 +48,8 @@ pub(crate) struct RunArgs<'a, 'py> {
     /// The converted `max_samples` ([`retention_arg`]).
     pub(crate) samples: SampleRetention,
     pub(crate) team: Option<String>,
+    /// The converted `law` ([`law_arg`]), or None for the scenario's.
+    pub(crate) law: Option<LawConfig>,
 }
 
 impl RunArgs<'_, '_> {
@@ -68,6 +71,7 @@ impl RunArgs<'_, '_> {
             relaxation: self.relaxation,
             allocator: self.allocator,
             team: self.team,
+            law: self.law,
             log: self.mcap,
             samples: self.samples,
             ..RunRequest::default()
@@ -152,6 +156,10 @@ pub(crate) fn run_request(
     let scenario = dict.get_item("scenario")?;
     let max_samples = opt::<Int>(dict, &name, "max_samples")?;
     let samples = retention_arg(max_samples.as_ref(), &format!("{name}['max_samples']"))?;
+    let law = match dict.get_item("law")? {
+        Some(l) if !l.is_none() => Some(law_arg(&l, &format!("{name}['law']"))?),
+        _ => None,
+    };
     let request = RunArgs {
         scenario: scenario.as_ref(),
         toml: opt(dict, &name, "toml")?,
@@ -163,6 +171,7 @@ pub(crate) fn run_request(
         pil: opt(dict, &name, "pil")?,
         samples,
         team: opt(dict, &name, "team")?,
+        law,
     }
     .request(&format!("{name}['scenario']"))?;
     checked(request)

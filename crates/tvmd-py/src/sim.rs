@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use tvmd_scenario::{Scenario, BUILTIN_NAMES};
 
-use crate::convert::{jobs_arg, retention_arg, Int};
+use crate::convert::{jobs_arg, law_arg, retention_arg, Int};
 use crate::errors::value_error;
 use crate::runs::RunArgs;
 use crate::runs::{batch_label, run_items, run_specs, sweep_label, sweep_run_specs};
@@ -34,7 +34,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 /// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None, law = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -48,8 +48,10 @@ fn run(
     null_space: Option<String>,
     max_samples: Option<Int>,
     team: Option<String>,
+    law: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PySimResult> {
     let samples = retention_arg(max_samples.as_ref(), "max_samples")?;
+    let law = law.map(|l| law_arg(l, "law")).transpose()?;
     let spec = RunArgs {
         scenario,
         toml,
@@ -61,6 +63,7 @@ fn run(
         pil,
         samples,
         team,
+        law,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?

@@ -117,9 +117,10 @@ impl SimData {
     fn repr(&self) -> String {
         let mcap = self.mcap_string();
         format!(
-            "SimResult(scenario_name='{}', relaxation={}, allocator='{}', precision='{}', \
-             samples={}, n_agents={}, mcap_path={})",
+            "SimResult(scenario_name='{}', law='{}', relaxation={}, allocator='{}', \
+             precision='{}', samples={}, n_agents={}, mcap_path={})",
             self.scenario.name,
+            self.scenario.law.name(),
             self.scenario.relaxation,
             self.scenario.allocator,
             self.scenario.controller_precision,
@@ -141,6 +142,8 @@ record! {
         allocator => o.scenario.allocator.as_str(),
         /// The null-space stage of the run ("margin", "inward-tilt=<rad>"), or None.
         null_space => o.scenario.null_space.map(|n| n.to_string()),
+        /// The control law that flew: "paper", "offset-free" or "custom".
+        law => o.scenario.law.name(),
         /// The float type the controller flew in, "f64" or "f32".
         precision => o.scenario.controller_precision.as_str(),
         /// Where the controller ran: "host", or the emulated target of a processor-in-the-loop

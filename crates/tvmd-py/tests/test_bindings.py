@@ -546,8 +546,11 @@ def test_clarabel_sequential_allocation():
 @pytest.mark.parametrize("team", [tvmd.Team.a4_inc(), tvmd.Team.a4_con(), tvmd.Team.ring(7, 0.6, True)],
                          ids=["a4_inc", "a4_con", "ring7"])  # fmt: skip
 @pytest.mark.parametrize("allocator", ["pseudo-inverse", "redistributed-pseudo-inverse"])
-def test_controller_hover_equilibrium(team, allocator, agreement):
-    ctrl = tvmd.Controller(team, allocator=allocator)
+@pytest.mark.parametrize("law", ["paper", "offset-free"])
+def test_controller_hover_equilibrium(team, allocator, law, agreement):
+    # Both laws hold an exact hover from rest (the offset-free state starts at zero).
+    ctrl = tvmd.Controller(team, allocator=allocator, law=law)
+    assert ctrl.law == law
     x = np.array([0.3, -0.2, 1.5])
     out = ctrl.step(tvmd.State(x), tvmd.Reference.hover(x))
     mg = team.mass * 9.81
@@ -571,7 +574,9 @@ def test_controller_step_matches_reference(agreement):
         team_ref = _ref_team(team)
         gains = _random_gains(rng)
         s = rng.uniform(0.1, 1.0)
-        ctrl = tvmd.Controller(team, gains=gains, relaxation=s, allocator="pseudo-inverse", planner_tolerance=1e-12)
+        # The paper's law: the reference is the paper's eq. (12) with `gains` as given.
+        ctrl = tvmd.Controller(team, gains=gains, relaxation=s, allocator="pseudo-inverse", planner_tolerance=1e-12,
+                               law="paper")  # fmt: skip
         state, reference = _random_state_reference(rng, scale=0.3)
         out = ctrl.step(state, reference)
         ref = _ref_law(team_ref, gains, state, reference, s)

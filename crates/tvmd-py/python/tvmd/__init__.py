@@ -17,7 +17,9 @@ UAV*). Equation numbers refer to the paper.
 * :func:`allocate` -- the allocators (exact-boundary redistribution, the default; redistributed,
   pseudo-inverse, weighted, Clarabel).
 * :class:`Controller` -- one ``step`` per control period, returning a :class:`StepOutput`
-  (``out.planner``, ``out.projection``, ``out.law``, ``out.allocation``, ``out.commands``).
+  (``out.planner``, ``out.projection``, ``out.law``, ``out.allocation``, ``out.commands``);
+  by default with the offset-free law (``law="offset-free"``: natural gains, a disturbance
+  observer, the planned attitude's rates), ``law="paper"`` for the paper's eq. (12).
 * :mod:`tvmd.sim` -- the simulator ``tvmd-sim`` (the paper's simulation, relaxation study).
 
 Arrays are float64 NumPy arrays, SI units, z up, twist ``xi = [Omega; v]`` in the body frame,

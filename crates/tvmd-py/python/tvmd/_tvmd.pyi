@@ -34,6 +34,9 @@ _Bool = NDArray[np.bool_]
 _Failed = Optional[Iterable[int]]
 _StateLike = Union["State", Mapping[str, ArrayLike]]
 _ReferenceLike = Union["Reference", Mapping[str, ArrayLike]]
+# A control law: a name, or a dict with the keys of a scenario's TOML ``[law]`` table.
+_LawArg = Union[Literal["paper", "offset-free"], Mapping[str, Any]]
+_LawName = Literal["paper", "offset-free", "custom"]
 
 AllocatorName = Literal[
     "exact-boundary-redistribution",
@@ -899,6 +902,14 @@ class Controller:
     torque part of the law (eq. 12), the allocation and the inversion into gimbal angles and
     rotor speeds inside ``E_f`` (eq. 6).
 
+    The law: by default the offset-free law (``law="offset-free"``, ``tvmd_core::ControllerSettings::
+    offset_free_law``; docs/method.md "Beyond the paper"), the one that holds its setpoint under
+    model error and unmodelled forces: natural gains (1.5 rad/s position, 6 rad/s attitude,
+    damping 1, scaled by the team's mass and inertia), a disturbance observer (10 rad/s, torque
+    bound 5 N m) and the planned attitude's rates. ``law="paper"`` is the paper's eq. (12) bit for
+    bit (``gains`` as given, no offset-free action, the reference's ``Omega_d``); under any
+    unmodelled force it leaves a steady error.
+
     Threads: a controller may be shared between threads. Its calls run one at a time (the GIL);
     arguments are converted before the controller is borrowed, so a conversion that runs
     Python code (an ``__array__`` method) never finds it busy. The order of two threads' steps is
@@ -906,11 +917,15 @@ class Controller:
 
     Args:
         team: the ``Team``.
-        gains: ``Gains``; None for the paper's (``Gains.paper()``).
+        gains: ``Gains``; None for the paper's (``Gains.paper()``). Used as given with
+            ``law="paper"`` (and a ``law`` dict whose ``gains`` is ``"paper"``; multiplied by the
+            team's mass and inertia for ``"team-scaled"``); unused with natural gains, which the
+            default ``law="offset-free"`` has (``Controller.gains`` shows the gains in use).
         relaxation: AFS relaxation ``s`` of the planner, in (0, 1]; default 0.5 (``s=`` is an
             alias).
         gravity: ``g`` (m/s^2).
-        period: control period ``dt`` (s) (used by the rate limits).
+        period: control period ``dt`` (s) (used by the rate limits, the offset-free state and the
+            planned rates).
         allocator: allocator name (see ``tvmd.ALLOCATORS`` and ``tvmd.allocate``).
         rate_limits: optional ``(eta_x_rate, eta_y_rate)`` gimbal rate limits (rad/s).
         failed: None or failed agent indices.
@@ -923,13 +938,27 @@ class Controller:
             (tilt each thrust toward the team's centre); moves the forces inside ``null(M)``, so
             the wrench is unchanged to round-off, and never outside ``E_f``. None (default): off.
             ``StepOutput.null_space`` reports what it changed.
+        law: the control law (keyword only): ``"offset-free"`` (default), ``"paper"``, or a dict
+            with the keys of a scenario's TOML ``[law]`` table, a key left out taking the
+            offset-free law's value: ``gains`` (``"paper"``, ``"team-scaled"`` or
+            ``{"natural": {"position_frequency": [wx, wy, wz], "position_damping": [..],
+            "attitude_frequency": [..], "attitude_damping": [..]}}``, rad/s and ratios, each
+            > 0), ``offset_free`` (``"off"``, ``{"kind": "observer", "force_bandwidth": 10.0,
+            "torque_bandwidth": 10.0, "max_torque": 5.0}`` in rad/s and N m, or ``{"kind":
+            "integral", "k_x": [..], "k_r": [..], "max_torque": 5.0}`` in N/(m s), N m/(rad s)),
+            ``attitude_rate`` (``"off"`` or ``{"bandwidth": 20.0, "max_rate": 5.0}`` in rad/s).
+            Lists may be NumPy arrays. ``Controller.law`` names it.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
             produce every wrench.
         ValueError: unknown allocator, "clarabel" or "clarabel-sequential" without the cargo
             feature, wrong shapes, an unknown null-space objective or a tilt that is missing, not
-            finite or not below ``pi/2``.
+            finite or not below ``pi/2``; an unknown ``law`` name or key, a missing or misplaced
+            setting, or a value that is not finite and > 0 (the message names the field, e.g.
+            ``law.offset_free.force_bandwidth``).
+        TypeError: ``law`` neither a str nor a dict, or a value in it of the wrong type (a str
+            for a number, a number for a table).
     """
 
     def __new__(
@@ -949,6 +978,7 @@ class Controller:
         *,
         s: Optional[float] = None,
         null_space: Optional[str] = None,
+        law: _LawArg = "offset-free",
     ) -> "Controller": ...
     def set_failures(self, failed: _Failed = None) -> "HoverCapability":
         """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``
@@ -968,8 +998,36 @@ class Controller:
         team's after construction)."""
     def reset(self) -> None:
         """Forgets the previous command (rate limits restart from centred gimbals; a rejected
-        cycle then holds idle commands).
+        cycle then holds idle commands), whatever the allocator kept, the offset-free state (the
+        observer's estimate or the integral back to zero) and the planned-rate filter (at rest).
+        The landed flag (``set_landed``) is kept.
         """
+    def set_landed(self, landed: bool) -> None:
+        """Tells the controller whether the team stands on the ground (the caller's contact or
+        landing detector). While landed the offset-free state is cleared and held at zero (the
+        ground's reaction is no disturbance to compensate); after ``set_landed(False)`` it starts
+        again from zero. No effect on anything else, and none with ``law="paper"``.
+        """
+    @property
+    def landed(self) -> bool:
+        """Whether the landed hold is on (``set_landed``); False after construction."""
+    @property
+    def offset_free_compensation(self) -> Tuple[_F64, _F64]:
+        """``(force, torque)``: the wrench the offset-free state adds to the next period's request
+        (before it measures that period): ``force`` (3,) in N in the inertial frame ``{I}``,
+        ``torque`` (3,) in N m in the body frame ``{C}``. Zeros with ``law="paper"`` (no
+        offset-free action) and while landed. The observer's estimate of the unmodelled
+        disturbance is its negative: under a constant unmodelled force ``F`` the force converges to
+        ``-F``.
+        """
+    @property
+    def planned_rates(self) -> Optional[Tuple[_F64, _F64]]:
+        """``(Omega_d, Omega_d_dot)``: the planned attitude's rates of the last period, (3,) each,
+        body frame, rad/s and rad/s^2; None without the planned-rate filter (``law="paper"``)."""
+    @property
+    def law(self) -> _LawName:
+        """The control law's name: ``"paper"``, ``"offset-free"`` (the default) or ``"custom"``
+        (any other ``law`` dict)."""
     def step(self, state: _StateLike, reference: _ReferenceLike) -> "StepOutput":
         """One control period.
 
@@ -994,7 +1052,8 @@ class Controller:
         """The team."""
     @property
     def gains(self) -> Gains:
-        """The gains."""
+        """The gains the law uses: ``gains`` as given (``law="paper"``), scaled by the team
+        (``"team-scaled"``) or made from the natural frequencies (the default law)."""
     @property
     def relaxation(self) -> float:
         """The planner relaxation ``s``."""

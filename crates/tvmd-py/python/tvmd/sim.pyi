@@ -32,6 +32,8 @@ _F64 = NDArray[np.float64]
 _ScenarioArg = Union[str, "os.PathLike[str]"]
 _PathArg = Union[str, "os.PathLike[str]"]
 _RunItem = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+# A control law: a name, or a dict with the keys of a scenario's TOML ``[law]`` table.
+_LawArg = Union[Literal["paper", "offset-free"], Mapping[str, Any]]
 # The controller's float type: "f32" flies ``tvmd_core::Controller<f32, ..>`` (the flight
 # configuration), "f64" the default; the physics is f64 either way.
 _Precision = Literal["f32", "f64"]
@@ -50,7 +52,8 @@ class SimResult:
     not report at a tick (a skipped cycle) are NaN.
 
     Attributes:
-        scenario_name, relaxation (``s``), allocator, null_space (the null-space stage or None),
+        scenario_name, law (the control law that flew: ``"paper"``, ``"offset-free"`` or
+        ``"custom"``), relaxation (``s``), allocator, null_space (the null-space stage or None),
         precision (``"f64"`` or ``"f32"``, the
         controller's float type), controller_target (``"host"`` or the PIL target), mcap_path
         (str or None), n_agents,
@@ -84,6 +87,10 @@ class SimResult:
     @property
     def scenario_name(self) -> str:
         """Name of the scenario that ran."""
+    @property
+    def law(self) -> Literal["paper", "offset-free", "custom"]:
+        """The control law that flew (the scenario's ``law``, or ``run``'s override):
+        ``"paper"``, ``"offset-free"`` or ``"custom"`` (any other ``[law]`` table)."""
     @property
     def relaxation(self) -> float:
         """Planner relaxation ``s`` of the run."""
@@ -228,6 +235,7 @@ def run(
     null_space: Optional[str] = None,
     max_samples: Optional[int] = None,
     team: Optional[str] = None,
+    law: Optional[_LawArg] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -239,7 +247,8 @@ def run(
             ``"paper-tilt"``: the paper's simulation (A4-Inc, ascent, roll tilt towards the
             infeasible ``pi/3``, descent; ``s = 0.5``).
         toml: inline TOML scenario text instead of ``scenario`` (fields left out take the
-            paper-tilt defaults; see ``scenario_toml("paper-tilt")``).
+            paper-tilt defaults, except ``law``: the offset-free law unless the text or ``law``
+            names one; see ``scenario_toml("paper-tilt")``).
         mcap: write an MCAP log there (parent directories are created; open it in Foxglove).
             Every channel is protobuf with its schema in the file; read it with ``mcap`` and
             ``mcap-protobuf-support``: ``make_reader(f, decoder_factories=[DecoderFactory()])``.
@@ -272,14 +281,24 @@ def run(
             the scenario families (``"hover"``, ``"wind"``, ``"payload"``, ``"model-error"``,
             ``"reference-jump"``, ``"sine"``, ``"figure-eight"``, ``"initial-attitude-<rad>"``)
             are built for any of them (docs/method.md "Scenario families").
+        law: override the scenario's control law (scenario field ``law``): ``"paper"`` (the
+            paper's eq. 12), ``"offset-free"`` (natural gains, disturbance observer, planned
+            rates), or a dict with the keys of the TOML ``[law]`` table (as
+            ``tvmd.Controller``'s ``law``). Default None: the scenario's own (the built-in
+            paper scenarios fly ``"paper"``; the families and any TOML that names no ``law``,
+            ``toml=`` text included, ``"offset-free"``).
+            ``SimResult.law`` says which flew. Not with ``pil`` unless ``"paper"``.
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
             message names the field, e.g. ``physics.dt``), a bad override, both ``scenario`` and
             ``toml``, an unknown ``pil`` target or ``pil`` with ``precision="f64"``, an unknown
             ``null_space`` objective or a bad tilt (``null_space.tilt``), ``null_space`` with ``pil``,
-            ``max_samples < 0``, a run that would keep more than 2,000,000 samples.
-        TypeError: an argument of the wrong type.
+            ``max_samples < 0``, a run that would keep more than 2,000,000 samples, an unknown
+            ``law`` name or key or a law setting out of range (the message names the field, e.g.
+            ``law.attitude_rate.bandwidth``).
+        TypeError: an argument of the wrong type (also a ``law`` neither a str nor a dict, or a
+            value of the wrong type in it).
         OSError: the scenario file cannot be read (also: not a regular file, over 1 MiB) or the
             log cannot be written; the message names the path.
         KeyboardInterrupt: Ctrl-C while flying; the log holds what was simulated.
@@ -298,8 +317,9 @@ def run_many(
         runs: a sequence whose items are each a scenario (a built-in name or a TOML file, as
             ``run``'s ``scenario``) or a dict of ``run``'s keyword arguments, e.g.
             ``{"scenario": "a4-con", "relaxation": 1.0}``, ``{"toml": text, "mcap": "x.mcap"}`` or
-            ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"`` and ``"null_space"``
-            too, as ``run``; ``"max_samples"`` bounds that run's samples).
+            ``{"scenario": "paper-tilt", "precision": "f32"}`` (``"pil"``, ``"null_space"`` and
+            ``"law"`` too, as ``run``; ``"max_samples"`` bounds that run's samples); errors name
+            the item's key, e.g. ``runs[1]['law'].offset_free``.
         jobs: worker threads (default: the available cores), at most ``len(runs)``.
         executor: fly on any ``concurrent.futures.Executor`` instead of this process's
             threads (``ProcessPoolExecutor``, a Dask ``Client.get_executor()``): one task per

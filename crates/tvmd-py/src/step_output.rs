@@ -1,0 +1,85 @@
+//! `tvmd.StepOutput`, everything one `Controller.step` computed, and its `NullSpaceReport`.
+
+use pyo3::prelude::*;
+
+use tvmd_core::{ControlOutput, NullSpaceReport};
+
+use crate::afs::PyForceProjection;
+use crate::allocation::{AllocationData, PyAllocation};
+use crate::convert::{commands_array, matrix, CAPACITY};
+use crate::law::PyLawOutput;
+use crate::planner::PyPlannerResult;
+use crate::record::record;
+
+/// One `Controller.step`: the core's output, the agent count and the allocation record.
+pub(crate) struct StepData {
+    out: Box<ControlOutput<f64, CAPACITY>>,
+    n: usize,
+    allocation: AllocationData,
+}
+
+impl StepData {
+    /// The output of one step of a controller of `n` agents and its allocator's record.
+    pub(crate) fn new(
+        out: ControlOutput<f64, CAPACITY>,
+        n: usize,
+        allocation: AllocationData,
+    ) -> Self {
+        Self {
+            out: Box::new(out),
+            n,
+            allocation,
+        }
+    }
+}
+
+record! {
+    /// Everything one `Controller.step` computed, nested like the core's `ControlOutput`.
+    "StepOutput" in "tvmd" => PyStepOutput(StepData) |py, o| {
+        /// The planner's result (eqs. 9-11).
+        planner => PyPlannerResult { inner: o.out.planner },
+        /// The force projection `K_f` (eqs. 12-13).
+        projection => PyForceProjection { inner: o.out.projection },
+        /// (3,) `t_Tf R u_fr` (inertial).
+        f_r => matrix(py, &o.out.f_r)?,
+        /// The control law's output (eq. 12).
+        law => PyLawOutput { inner: o.out.law },
+        /// The allocation (eqs. 4 and 6).
+        allocation => PyAllocation { inner: o.allocation.clone() },
+        /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
+        commands => commands_array(py, &o.out.commands, o.n)?,
+        /// Largest clamp of the command inversion (normalized).
+        command_clamp => o.out.command_clamp,
+        /// What the null-space stage changed.
+        null_space => PyNullSpaceReport { inner: o.out.null_space },
+    }
+}
+
+record! {
+    /// What the null-space stage changed in one period. See the stub.
+    "NullSpaceReport" in "tvmd" => PyNullSpaceReport(NullSpaceReport<f64>) |py, o| {
+        /// The stage ran on this period's allocation.
+        ran => o.ran,
+        /// Accepted steps (0: the allocator's forces unchanged).
+        iterations => o.iterations,
+        /// The objective at the allocator's forces.
+        objective_before => o.objective_before,
+        /// The objective at the returned forces.
+        objective_after => o.objective_after,
+        /// Smallest normalized margin to the admissible boundary at the allocator's forces.
+        margin_before => o.margin_before,
+        /// The same at the returned forces.
+        margin_after => o.margin_after,
+        /// Largest change of one agent's force (N).
+        largest_force_change => o.largest_force_change,
+        /// `||M f' - M f||`, the wrench the stage moved (round-off).
+        wrench_drift => o.wrench_drift,
+    }
+}
+
+/// Registers the step's classes.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyStepOutput>()?;
+    m.add_class::<PyNullSpaceReport>()?;
+    Ok(())
+}
