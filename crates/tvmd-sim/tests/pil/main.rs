@@ -111,7 +111,13 @@ fn pil_flight_of_the_offset_free_paper_experiment_matches_the_host() {
         "cortex-m4 PIL vs host f32, paper-experiment-offset-free: whole {whole:#?}, 16-20 s {d:#?}"
     );
     assert_eq!(d.samples, 400);
-    assert!(d.position < 1e-3 && d.attitude < 1e-2, "{d:?}");
+    // About 10x the differences measured on the Cortex-M4F over 16-20 s: 4.8e-6 m, 1.4e-8 rad,
+    // 9.2e-7 rad of gimbal, 2.4e-6 N (over the whole flight: 3.4 cm, a gimbal of an idle agent
+    // by pi/2 and 10 N at 7.2 s, inside stage B's saturation).
+    assert!(
+        d.position < 5e-5 && d.attitude < 1e-6 && d.gimbal < 1e-5 && d.thrust < 1e-4,
+        "{d:?}"
+    );
     let steady = |r: &tvmd_sim::sim::RunResult| {
         r.summary
             .metrics
@@ -123,7 +129,7 @@ fn pil_flight_of_the_offset_free_paper_experiment_matches_the_host() {
     };
     let (h, p) = (steady(&host), steady(&pil));
     eprintln!("steady-state position error: host {h}, cortex-m4 {p}");
-    assert!(p < 0.01 && (p - h).abs() < 1e-3, "{p} vs {h}");
+    assert!(p < 0.01 && (p - h).abs() < 1e-5, "{p} vs {h}");
 }
 
 /// A failure mask crosses the link: A4-Inc loses agent 0 at t = 5 s (controller informed); the
