@@ -146,7 +146,8 @@ pub struct Diagnostics {
     /// The controller skipped this cycle and held its previous commands, for this reason.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_error: Option<String>,
-    /// A note on the failure mask (e.g. the controller could not use the reported failures).
+    /// A note on the failure mask (e.g. the controller could not use the reported failures) or
+    /// on the disarm after touchdown (`control::Touchdown`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure_note: Option<String>,
     /// The hover classification, at the tick a new failure mask was accepted.

@@ -103,7 +103,7 @@ impl Default for ReferenceConfig {
 /// `(h/2)(1 - cos(pi (t - t0)/T))` on `[t0, t1]` (0 before, `h` after), with derivatives.
 fn cosine_ramp(t: f64, [t0, t1]: [f64; 2], h: f64) -> (f64, f64, f64) {
     let big_t = t1 - t0;
-    if t <= t0 {
+    if t < t0 {
         return (0.0, 0.0, 0.0);
     }
     if t >= t1 || big_t <= 0.0 {

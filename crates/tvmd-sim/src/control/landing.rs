@@ -3,7 +3,8 @@
 //! classified, falling with a constant downward acceleration `a` to the rest height `z = 0`
 //! (the team resting on the ground, see `tvmd_plant::physics`); once the reference is down and
 //! the team is within [`TOUCHDOWN_HEIGHT`] of it, the rotors go idle (disarmed, as PX4's land
-//! detector does).
+//! detector does). [`Touchdown`] disarms every commanded landing so, the scenario's own descent
+//! to the ground included.
 //!
 //! Why an accelerating descent and not a constant rate: a team classified not hover-capable
 //! has no margin at the hover wrench (A4-Inc minus one: two agents at `sigma_Tf`, one at zero),
@@ -26,6 +27,36 @@ pub const TOUCHDOWN_HEIGHT: f64 = 0.05;
 /// is well above the ground contact's jitter and the state noise of the scenarios.
 pub const LANDED_HEIGHT: f64 = 0.02;
 
+/// The simulated flight stack's disarm on touchdown: once the team has flown (its centre of
+/// mass above [`TOUCHDOWN_HEIGHT`]), a reference that asks to be on the ground (at or under
+/// [`LANDED_HEIGHT`]) and a team on the ground (at or under [`LANDED_HEIGHT`] too) disarm it
+/// for the rest of the flight: the rotors idle, as PX4's land detector does.
+///
+/// Why: a team that reaches the ground a little ahead of its reference (any tracking lag below
+/// it) would push the descent's final deceleration, more than its weight, against the ground
+/// and be thrown up again; a flight stack cuts the rotors at contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Touchdown {
+    airborne: bool,
+    disarmed: bool,
+}
+
+impl Touchdown {
+    /// Updates the detector with the fed-back centre of mass `position` and this tick's
+    /// `reference`; returns whether the team is disarmed.
+    pub fn update(&mut self, position: &Vector3<f64>, reference: &ReferenceSample) -> bool {
+        self.airborne |= position.z > TOUCHDOWN_HEIGHT;
+        self.disarmed |=
+            self.airborne && reference.position.z <= LANDED_HEIGHT && position.z <= LANDED_HEIGHT;
+        self.disarmed
+    }
+
+    /// Whether the team has been disarmed.
+    pub fn disarmed(&self) -> bool {
+        self.disarmed
+    }
+}
+
 /// A landing started at time `start` from `from`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Landing {
@@ -35,8 +66,6 @@ pub struct Landing {
     pub from: Vector3<f64>,
     /// Downward acceleration of the reference (m/s^2), `> 0`.
     pub acceleration: f64,
-    /// Touched down: the rotors are idle from then on.
-    pub disarmed: bool,
 }
 
 impl Landing {
@@ -46,14 +75,7 @@ impl Landing {
             start: t,
             from: *position,
             acceleration,
-            disarmed: false,
         }
-    }
-
-    /// Whether the team has touched down at time `t`: the reference is down and the team's
-    /// centre of mass is within `TOUCHDOWN_HEIGHT` (0.05 m) of the rest height.
-    pub fn touched_down(&self, t: f64, position: &Vector3<f64>) -> bool {
-        t >= self.touchdown_time() && position.z <= TOUCHDOWN_HEIGHT
     }
 
     /// Time (s) the reference reaches `z = 0`: `start + sqrt(2 z_0 / a)`.
@@ -108,8 +130,22 @@ mod tests {
         let after = l.reference(8.0);
         assert_eq!(after.position.z, 0.0);
         assert_eq!(after.velocity, Vector3::zeros());
-        assert!(!l.touched_down(6.9, &Vector3::new(0.0, 0.0, 0.0)));
-        assert!(!l.touched_down(8.0, &Vector3::new(0.0, 0.0, 0.2)));
-        assert!(l.touched_down(8.0, &Vector3::new(0.0, 0.0, 0.01)));
+        let mut detector = Touchdown::default();
+        let ground = Vector3::new(0.0, 0.0, 0.01);
+        assert!(!detector.update(&ground, &after), "not flown yet");
+        assert!(!detector.update(&Vector3::new(0.0, 0.0, 1.0), &mid));
+        assert!(
+            !detector.update(&ground, &l.reference(6.9)),
+            "reference still 0.2 m high"
+        );
+        assert!(
+            !detector.update(&Vector3::new(0.0, 0.0, 0.03), &after),
+            "not down yet"
+        );
+        assert!(detector.update(&ground, &after));
+        assert!(
+            detector.update(&Vector3::new(0.0, 0.0, 0.3), &mid),
+            "disarmed for good"
+        );
     }
 }

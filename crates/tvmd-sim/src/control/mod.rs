@@ -45,7 +45,7 @@ pub mod pil;
 pub mod recording;
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-pub use landing::{Landing, LANDED_HEIGHT};
+pub use landing::{Landing, Touchdown, LANDED_HEIGHT};
 
 pub use config::{
     allocator, controller_settings, hover_roll_limit, law_settings, team_config, wire_config,
@@ -89,6 +89,8 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     /// The last mask the core refused: reported once, not asked for again until it changes.
     refused: Option<Vec<bool>>,
     landing: Option<Landing>,
+    /// The disarm on touchdown after a commanded landing.
+    touchdown: Touchdown,
     /// What the core was last told by `set_landed`.
     landed: bool,
 }
@@ -133,6 +135,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             hover: None,
             refused: None,
             landing: None,
+            touchdown: Touchdown::default(),
             landed: false,
         }
     }
@@ -229,23 +232,23 @@ impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
         }
         self.update_failures(t, state, failed)?;
         let n = self.n;
-        if let Some(landing) = &mut self.landing {
-            landing.disarmed |= landing.touched_down(t, &state.position);
-            if landing.disarmed {
-                return Ok(FlightOutput {
-                    commands: vec![sim_command(&tvmd_core::AgentCommand::<T>::idle()); n],
-                    diagnostics: Diagnostics {
-                        failure_note: Some(
-                            "landed after a hover-capability loss: rotors idle".into(),
-                        ),
-                        hover: self.hover.take(),
-                        ..Default::default()
-                    },
-                });
-            }
-        }
         let landing_reference = self.landing.as_ref().map(|l| l.reference(t));
         let reference = landing_reference.as_ref().unwrap_or(reference);
+        if self.touchdown.update(&state.position, reference) {
+            let note = if self.landing.is_some() {
+                "landed after a hover-capability loss: rotors idle"
+            } else {
+                "landed: rotors idle"
+            };
+            return Ok(FlightOutput {
+                commands: vec![sim_command(&tvmd_core::AgentCommand::<T>::idle()); n],
+                diagnostics: Diagnostics {
+                    failure_note: Some(note.into()),
+                    hover: self.hover.take(),
+                    ..Default::default()
+                },
+            });
+        }
         let hover = self.hover.take();
         match self.inner.step(
             &convert::core_state(state),

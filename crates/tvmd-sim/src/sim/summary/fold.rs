@@ -29,7 +29,8 @@ type AtTime = Nearest<(f64, Option<f64>)>;
 struct Last {
     t: f64,
     position_error: f64,
-    v_x: Option<f64>,
+    /// `(t, V_x)` of the law's last period.
+    v_x: Option<(f64, f64)>,
     v_r: Option<f64>,
 }
 
@@ -216,11 +217,17 @@ impl SummaryFold {
         if let Some(v) = x.v_x {
             self.max_v_x_rise.push(t, v);
         }
+        // The Lyapunov values of the law's last period: a disarmed team (on the ground after a
+        // landing) reports none, and keeps the last ones with their time.
+        let (v_x, v_r) = match (x.v_x, x.v_r, self.last) {
+            (None, None, Some(previous)) => (previous.v_x, previous.v_r),
+            (v_x, v_r, _) => (v_x.map(|v| (t, v)), v_r),
+        };
         self.last = Some(Last {
             t,
             position_error: error,
-            v_x: x.v_x,
-            v_r: x.v_r,
+            v_x,
+            v_r,
         });
     }
 
@@ -257,7 +264,7 @@ impl SummaryFold {
             max_e_f: e_f.map(|(_, e)| e),
             max_e_f_time: e_f.map(|(t, _)| t),
             max_e_f_over_weight: e_f.map(|(_, e)| e / weight),
-            final_v_x: last.and_then(|x| x.v_x),
+            final_v_x: last.and_then(|x| x.v_x).map(|(_, v)| v),
             final_v_r: last.and_then(|x| x.v_r),
             min_thrust: self.min_thrust.get(),
             max_thrust: self.max_thrust.get(),
@@ -293,7 +300,7 @@ impl SummaryFold {
                 v.map(|v| (t, v))
             })
             .collect();
-        if let Some((t, v)) = self.last.and_then(|x| x.v_x.map(|v| (x.t, v))) {
+        if let Some((t, v)) = self.last.and_then(|x| x.v_x) {
             v_x_at.push((t, v));
         }
         PaperMetrics {

@@ -144,9 +144,10 @@ pub struct RunSummary {
     pub max_e_f_time: Option<f64>,
     /// Largest `e_f / (m_C g)`, if reported.
     pub max_e_f_over_weight: Option<f64>,
-    /// `V_x` at the last sample, if reported.
+    /// `V_x` of the last sample that reports it (the law's last period: a team disarmed on the
+    /// ground reports none after its touchdown).
     pub final_v_x: Option<f64>,
-    /// `V_R` at the last sample, if reported.
+    /// `V_R` of the last sample that reports it.
     pub final_v_r: Option<f64>,
     /// Smallest commanded thrust of a working agent (N).
     pub min_thrust: Option<f64>,

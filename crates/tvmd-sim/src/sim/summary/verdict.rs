@@ -42,9 +42,11 @@ impl Verdict {
         );
         within(
             "steady-state attitude error",
+            // To the planned attitude while the controller ran in the window; to the reference
+            // when it did not (disarmed on the ground).
             m.planned_attitude
-                .or(m.attitude)
-                .and_then(|a| a.steady_state),
+                .and_then(|a| a.steady_state)
+                .or(m.attitude.and_then(|a| a.steady_state)),
             bounds.max_steady_state_attitude_error,
             "rad",
         );
