@@ -100,7 +100,8 @@ impl Default for ReferenceConfig {
     }
 }
 
-/// `(h/2)(1 - cos(pi (t - t0)/T))` on `[t0, t1]` (0 before, `h` after), with derivatives.
+/// `(h/2)(1 - cos(pi (t - t0)/T))` on `[t0, t1)` (0 before, `h` from `t1`), with derivatives:
+/// the first instant carries the ramp's acceleration, so a controller ticking at `t0` gets it.
 fn cosine_ramp(t: f64, [t0, t1]: [f64; 2], h: f64) -> (f64, f64, f64) {
     let big_t = t1 - t0;
     if t < t0 {
@@ -192,6 +193,19 @@ mod tests {
         assert!((p.at(13.0).position.z - 0.75).abs() < 1e-12);
         assert!(p.at(14.0).position.z.abs() < 1e-12 && p.at(16.0).position.z.abs() < 1e-12);
         assert_eq!(p.at(6.0).omega, Vector3::zeros());
+    }
+
+    /// A ramp is evaluated on `[t0, t1)`: its first instant carries the full feed-forward
+    /// `a = (h/2)(pi/T)^2` (1.85 m/s^2 for paper-tilt), its end none.
+    #[test]
+    fn ramps_start_with_their_acceleration() {
+        let p = PaperTilt::default();
+        let a = 0.5 * 1.5 * (PI / 2.0) * (PI / 2.0);
+        assert!((p.at(0.0).acceleration.z - a).abs() < 1e-12);
+        assert!((p.at(12.0).acceleration.z + a).abs() < 1e-12);
+        assert_eq!(p.at(12.0).position.z, 1.5);
+        assert_eq!(p.at(14.0).acceleration.z, 0.0);
+        assert_eq!(p.at(-0.01).acceleration.z, 0.0);
     }
 
     #[test]
