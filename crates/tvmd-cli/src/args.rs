@@ -64,8 +64,8 @@ pub enum Command {
         /// Override the scenario's control law (`[law]`): offset-free (natural gains, the
         /// disturbance observer, the planned rates; the default of families and of files that
         /// name no law) or paper (the paper's law as published; docs/method.md).
-        #[arg(long, value_name = "LAW")]
-        law: Option<tvmd_scenario::LawConfig>,
+        #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(tvmd_scenario::LAW_NAMES))]
+        law: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]

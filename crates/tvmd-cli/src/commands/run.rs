@@ -28,7 +28,7 @@ pub struct RunArgs {
     pub(crate) allocator: Option<String>,
     pub(crate) null_space: Option<tvmd_scenario::NullSpaceConfig>,
     pub(crate) team: Option<String>,
-    pub(crate) law: Option<tvmd_scenario::LawConfig>,
+    pub(crate) law: Option<String>,
     pub(crate) precision: Option<String>,
     pub(crate) pil: Option<String>,
     pub(crate) live: Option<LiveOptions>,
@@ -43,7 +43,7 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         allocator: a.allocator,
         null_space: a.null_space,
         team: a.team,
-        law: a.law,
+        law: a.law.as_deref().map(RunRequest::parse_law).transpose()?,
         samples: plot_retention(a.plots.is_some()),
         ..RunRequest::default()
     }
