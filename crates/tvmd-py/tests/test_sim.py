@@ -104,19 +104,30 @@ def test_paper_shapes_and_metadata(paper):
     assert math.isclose(paper.mass, 4 * 0.7)
     assert paper.gravity == tvmd.GRAVITY
     np.testing.assert_allclose(paper.t, 0.01 * np.arange(K), atol=1e-9)
+    # The law runs until the team touches down (13.9 s) and is disarmed: its quantities are
+    # NaN from then on ("not computed"), the physics' stay finite.
+    armed = np.isfinite(paper.theta)
+    first_off = int(np.argmin(armed))
+    assert not armed[first_off] and np.all(armed[:first_off]) and not np.any(armed[first_off:])
+    assert 13.8 <= paper.t[first_off] <= 14.0, paper.t[first_off]
     for name in ("position", "velocity", "reference_position", "attitude_rpy", "reference_rpy",
                  "planned_rpy"):  # fmt: skip
         a = getattr(paper, name)
         assert a.shape == (K, 3) and a.dtype == np.float64, name
-        assert np.all(np.isfinite(a)), name
+        rows = armed if name == "planned_rpy" else slice(None)
+        assert np.all(np.isfinite(a[rows])), name
     for name in ("reference_roll", "planned_roll", "attitude_error", "theta", "e_f", "V_x", "V_R"):
         a = getattr(paper, name)
         assert a.shape == (K,) and a.dtype == np.float64, name
-        assert np.all(np.isfinite(a)), name
+        assert np.all(np.isfinite(a[armed])), name
+        if name != "reference_roll":
+            assert np.all(np.isnan(a[~armed])), name
     assert paper.commands.shape == (K, 4, 3) and paper.actual.shape == (K, 4, 3)
     assert paper.failed.shape == (K, 4) and paper.failed.dtype == np.bool_
     assert not paper.failed.any() and not paper.cycle_error.any()
-    assert paper.saturated_agents.dtype == np.int64 and np.all(paper.saturated_agents == 0)
+    # -1: not reported (the law did not run after the disarm at touchdown).
+    assert paper.saturated_agents.dtype == np.int64
+    assert np.all(paper.saturated_agents[armed] == 0) and np.all(paper.saturated_agents[~armed] == -1)
     # The true initial state and the paper's reference (docs/method.md): x_0 = [0.5, -0.5, 0] at rest,
     # phi_r peaks at pi/3 at t = 7 s.
     np.testing.assert_allclose(paper.position[0], [0.5, -0.5, 0.0], atol=1e-9)
@@ -127,7 +138,7 @@ def test_paper_shapes_and_metadata(paper):
 def test_paper_planned_roll_saturates_at_hover_limit(paper):
     limit = hover_roll_limit(PAPER_S)
     assert math.isclose(paper.hover_roll_limit, limit, rel_tol=1e-12)
-    max_planned = float(np.max(np.abs(paper.planned_roll)))
+    max_planned = float(np.nanmax(np.abs(paper.planned_roll)))
     assert abs(max_planned - limit) < 0.01, (max_planned, limit)
     assert paper.summary["max_planned_roll"] == max_planned
     # The reference itself goes far beyond: the planner, not the reference, limits the roll.
@@ -153,11 +164,14 @@ def test_paper_position_errors_match_calibration(paper):
 
 def test_paper_allocation_error_and_lyapunov(paper):
     weight = paper.mass * paper.gravity
-    assert np.max(paper.e_f) <= 1e-6 * weight
+    assert np.nanmax(paper.e_f) <= 1e-6 * weight
     assert paper.summary["max_e_f_over_weight"] <= 1e-6
     assert paper.paper_metrics["e_f_onset"] is None
-    # V_x decreases overall and converges.
-    assert paper.V_x[-1] < 0.01 * paper.V_x[0]
+    # V_x decreases overall and converges (its last value, at touchdown; after it the team is
+    # disarmed and the law no longer runs).
+    last_v_x = paper.V_x[np.isfinite(paper.V_x)][-1]
+    assert last_v_x < 0.02 * paper.V_x[0]
+    assert paper.summary["final_v_x"] == last_v_x
     # Commands stay in E_f (eq. 6): |eta_x| <= pi/6, |eta_y| <= pi/4, 0 <= T <= 2 m_i g.
     c = paper.commands
     assert np.all(np.abs(c[..., 0]) <= math.pi / 6 + 1e-9)
@@ -173,14 +187,15 @@ def test_paper_summary_and_dict(paper):
     assert s["scenario"] == "paper-tilt"
     assert s["controller_calls"] == len(paper) and s["physics_steps"] == 16000
     assert math.isclose(s["time"], 16.0)
-    assert s["max_e_f"] == float(np.max(paper.e_f))
-    # The flight metrics fold the same samples (docs/method.md, "Flight metrics").
+    assert s["max_e_f"] == float(np.nanmax(paper.e_f))
+    # The flight metrics fold the same samples (docs/method.md, "Flight metrics"); the law's
+    # quantities are NaN once the team is disarmed at touchdown.
     m = s["metrics"]
     assert m["force_error"]["max"] == s["max_e_f"]
-    assert m["moment_error"]["max"] == float(np.max(paper.e_tau))
-    assert m["thrust_efficiency"]["min"] == float(np.min(paper.thrust_efficiency))
+    assert m["moment_error"]["max"] == float(np.nanmax(paper.e_tau))
+    assert m["thrust_efficiency"]["min"] == float(np.nanmin(paper.thrust_efficiency))
     assert m["attitude"]["peak"] == float(np.max(paper.reference_attitude_error))
-    assert m["planned_attitude"]["peak"] == float(np.max(paper.attitude_error))
+    assert m["planned_attitude"]["peak"] == float(np.nanmax(paper.attitude_error))
     assert s["verdict"] == {"success": True, "failures": []}
     # The final state is the physics' after the last step, one tick after the last sample.
     np.testing.assert_allclose(s["final_position"], paper.position[-1], atol=1e-3)
@@ -260,7 +275,7 @@ def test_relaxation_sweep_order_and_planned_roll(sweep):
     assert [r.relaxation for r in sweep] == list(SWEEP)
     assert [r.scenario_name for r in sweep] == ["paper-tilt-s0.25", "paper-tilt-s0.5",
                                                 "paper-tilt-s0.75", "paper-tilt-s1"]  # fmt: skip
-    rolls = [float(np.max(np.abs(r.planned_roll))) for r in sweep]
+    rolls = [float(np.nanmax(np.abs(r.planned_roll))) for r in sweep]
     assert all(a < b for a, b in zip(rolls, rolls[1:])), rolls
     for r, roll in zip(sweep, rolls):
         assert abs(roll - hover_roll_limit(r.relaxation)) < 0.01, (r.relaxation, roll)
