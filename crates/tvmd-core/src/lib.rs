@@ -89,7 +89,9 @@ pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};
 pub use anti_windup::Saturation;
 pub use attitude_rate::{AttitudeRateFilter, PlannedRates};
 pub use command::AgentCommand;
-pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
+pub use controller::{
+    AllocationStage, ControlOutput, Controller, ControllerSettings, CycleError, LawStage,
+};
 pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
