@@ -14,7 +14,7 @@
 
 // The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 // of `TvmdConfig` and the compensation of `TvmdOutput`).
-#define TVMD_ABI_VERSION 2
+#define TVMD_ABI_VERSION 3
 
 // `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
 #define TVMD_MOTOR_CURVE_ROTOR_SPEED 0
@@ -371,6 +371,81 @@ typedef struct {
   float weight;
 } TvmdHover;
 
+// What `tvmd_law` returns: the body wrench for `tvmd_allocate` and the law's diagnostics. On
+// an error every number is NaN and `planner_status`/`planner_iterations` are 0.
+typedef struct {
+  // `sizeof(TvmdLawOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_law` returned.
+  int32_t status;
+  // `u_tau_d` (N m), body frame: the torque to allocate.
+  float torque[3];
+  // `u_fd = K_f u_fr` (N), body frame: the force to allocate.
+  float force[3];
+  // `R_d`, the planned attitude, row-major.
+  float planned_attitude[9];
+  // `theta*` (rad).
+  float planner_theta;
+  // One of `TVMD_PLANNER_*`.
+  uint32_t planner_status;
+  // The planner's search steps.
+  uint32_t planner_iterations;
+  // `e_x = x - x_r` (m), inertial frame.
+  float position_error[3];
+  // `e_R` against `R_d` (rad), body frame.
+  float attitude_error[3];
+} TvmdLawOutput;
+
+// A body wrench `[u_tau; u_f]` in the team's body frame `{C}` (z up, as the state).
+typedef struct {
+  // `sizeof(TvmdWrench)`.
+  uint32_t size;
+  // `u_tau` (N m), body frame.
+  float torque[3];
+  // `u_f` (N), body frame.
+  float force[3];
+} TvmdWrench;
+
+// What `tvmd_allocate` returns. On an error `commands` are the held ones (as `tvmd_step`'s)
+// and every number is NaN, `saturated` 0.
+typedef struct {
+  // `sizeof(TvmdAllocationOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_allocate` returned.
+  int32_t status;
+  // `n`; commands beyond it are idle.
+  uint32_t agent_count;
+  // Per-agent commands inside `E_f` (idle for failed agents).
+  TvmdAgentCommand commands[TVMD_MAX_AGENTS];
+  // The allocated torque `u_tau = (M f)_tau` (N m), body frame.
+  float allocated_torque[3];
+  // The allocated force `u_f = (M f)_f` (N), body frame.
+  float allocated_force[3];
+  // `||u_fd - u_f||` (N), the force the team could not deliver (`e_f`).
+  float force_error;
+  // `||u_tau_d - u_tau||` (N m), the torque the team could not deliver.
+  float torque_error;
+  // Bit `i` set: agent `i`'s force lies on the boundary of its admissible set (a gimbal or
+  // thrust limit holds it).
+  uint32_t saturated;
+} TvmdAllocationOutput;
+
+// What `tvmd_plan` returns. On an error the numbers are NaN and the counts 0.
+typedef struct {
+  // `sizeof(TvmdPlanOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_plan` returned.
+  int32_t status;
+  // `R_d`, the planned attitude, row-major.
+  float planned_attitude[9];
+  // `theta*` (rad).
+  float theta;
+  // One of `TVMD_PLANNER_*`.
+  uint32_t planner_status;
+  // The planner's search steps.
+  uint32_t iterations;
+} TvmdPlanOutput;
+
 // Success.
 #define TVMD_OK 0
 
@@ -629,6 +704,42 @@ TvmdStatus tvmd_reset(TvmdController *handle);
 // # Safety
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_set_landed(TvmdController *handle, uint32_t landed);
+
+// The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
+// the caller). With an offset-free action the next `tvmd_allocate` records the delivered
+// wrench for the observer (run the allocation after each law period). Errors: as
+// `tvmd_step`'s input checks; nothing is held (the law sends no commands).
+//
+// # Safety
+// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+TvmdStatus tvmd_law(TvmdController *handle,
+                    const TvmdState *state,
+                    const TvmdReference *reference,
+                    TvmdLawOutput *out);
+
+// The allocation stage: the body wrench `wrench` to per-agent commands inside `E_f`, which
+// become the held commands (the drop-in for a flight stack's control allocation, e.g. at the
+// rate loop's rate). Fills `out` (its `size` set by the caller). On an error after `out` was
+// found usable, `out.commands` are the held ones: a null or wrongly sized `wrench`, a
+// non-finite wrench (`TVMD_ERR_NON_FINITE`), zero thrust on every agent for a non-zero force.
+//
+// # Safety
+// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+TvmdStatus tvmd_allocate(TvmdController *handle,
+                         const TvmdWrench *wrench,
+                         TvmdAllocationOutput *out);
+
+// The planner alone: the attitude `R_d` closest to `reference_attitude` (9 floats, row-major,
+// a rotation) whose attainable force space holds `force` (3 floats, N, inertial frame), at
+// the controller's relaxation and failure mask. Reads the controller, changes nothing.
+//
+// # Safety
+// `reference_attitude` is null or points to 9 floats, `force` to 3; `handle` as for
+// `tvmd_create`; `out` is null or points to a `TvmdPlanOutput`.
+TvmdStatus tvmd_plan(const TvmdController *handle,
+                     const float *reference_attitude,
+                     const float *force,
+                     TvmdPlanOutput *out);
 
 // A short static name of a status code (`"TVMD_OK"`, `"TVMD_ERR_SIZE"`, ...), NUL-terminated,
 // never null; `"TVMD_UNKNOWN_STATUS"` for a value no entry point returns.

@@ -8,6 +8,7 @@ pub use crate::rotation::roll;
 
 mod cycle;
 mod guard;
+mod reconfigure;
 mod settings;
 
 pub use cycle::{AllocationStage, LawStage};

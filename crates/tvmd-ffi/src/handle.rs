@@ -37,9 +37,9 @@ pub const TVMD_CONTROLLER_WORDS: usize = TVMD_CONTROLLER_SIZE / 8;
 const MAGIC: u64 = 0x7476_6d64_6666_6931;
 
 /// What the storage holds.
-struct Inner {
+pub(crate) struct Inner {
     magic: u64,
-    controller: FfiController,
+    pub(crate) controller: FfiController,
 }
 
 // The header's size and alignment hold the real controller, on the target that compiles this.
@@ -79,7 +79,7 @@ pub(crate) fn checked_size<T>(size: u32) -> Result<(), TvmdStatus> {
 ///
 /// # Safety
 /// `handle` is null or points to a `TvmdController` (possibly never created).
-unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStatus> {
+pub(crate) unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStatus> {
     if handle.is_null() {
         return Err(TVMD_ERR_NULL_POINTER);
     }
@@ -98,7 +98,9 @@ unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStat
 ///
 /// # Safety
 /// As [`inner`], and no other reference to the handle is alive.
-unsafe fn inner_mut<'a>(handle: *mut TvmdController) -> Result<&'a mut Inner, TvmdStatus> {
+pub(crate) unsafe fn inner_mut<'a>(
+    handle: *mut TvmdController,
+) -> Result<&'a mut Inner, TvmdStatus> {
     inner(handle)?;
     Ok(&mut *handle.cast::<Inner>())
 }
