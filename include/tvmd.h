@@ -466,6 +466,10 @@ typedef struct {
 // `map.motor_curve`) has a value this library does not know.
 #define TVMD_ERR_ENUM_VALUE 5
 
+// The handle's storage was overwritten: its start says created, but the guard at its end
+// does not hold (a neighbouring buffer overran it). Create the controller again.
+#define TVMD_ERR_CORRUPTED 6
+
 // [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
 #define TVMD_ERR_INPUT_NON_FINITE 10
 
@@ -693,6 +697,14 @@ TvmdStatus tvmd_hover_capability(const TvmdController *handle, TvmdHover *hover)
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_reset(TvmdController *handle);
 
+// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+// otherwise (every other entry point makes the same check first).
+//
+// # Safety
+// `handle` as for [`tvmd_step`].
+TvmdStatus tvmd_check(const TvmdController *handle);
+
 // Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
 // (zero), from the caller's contact or landing detector. While landed the offset-free state
 // is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
@@ -704,6 +716,61 @@ TvmdStatus tvmd_reset(TvmdController *handle);
 // # Safety
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_set_landed(TvmdController *handle, uint32_t landed);
+
+// Checks `config` as `tvmd_create` would (every field, the team's rank, the law), without
+// creating anything: `TVMD_OK` or the status `tvmd_create` would return. Builds the
+// controller on the stack to check it, so it costs what `tvmd_create` costs: call it before
+// flight or from a task with that stack, not from the control loop.
+//
+// # Safety
+// `config` is null or points to a `TvmdConfig`.
+TvmdStatus tvmd_validate_config(const TvmdConfig *config);
+
+// Replaces the running controller's configuration, all or nothing: the new controller is
+// built and given the running one's failure mask, landed flag, held commands (agent by agent,
+// where admissible for the new configuration; otherwise idle) and offset-free estimate (when
+// both run the same kind of action); only then does it replace the running one. On any error
+// the running controller is untouched and steps exactly as before. As `tvmd_validate_config`,
+// it costs what `tvmd_create` costs.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `config` is null or points to a `TvmdConfig`.
+TvmdStatus tvmd_reconfigure(TvmdController *handle, const TvmdConfig *config);
+
+// New gains of eq. (12) for the running controller (resolved by its law's gain schedule).
+// A gain that is not symmetric positive definite is refused and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `gains` is null or points to a `TvmdGains`.
+TvmdStatus tvmd_set_gains(TvmdController *handle, const TvmdGains *gains);
+
+// A new AFS relaxation `s` in `(0, 1]` for the planner, from the next period on. Anything
+// else is refused (`TVMD_ERR_CONFIG_RELAXATION`) and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`.
+TvmdStatus tvmd_set_relaxation(TvmdController *handle, float relaxation);
+
+// Gimbal rate limits `[eta_x, eta_y]` (rad/s, positive) from the next period on when
+// `enabled` is non-zero (`limits` then points to 2 floats), none when it is zero (`limits`
+// may be null). A bad limit is refused and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `limits` is null or points to 2 floats.
+TvmdStatus tvmd_set_rate_limits(TvmdController *handle, uint32_t enabled, const float *limits);
+
+// The commands the vehicle flies now (at a switch from another controller) become the held
+// ones: what a refused period repeats and where the rate limits start. `commands` holds
+// `count` entries, `count` = the team's agent count; each working agent's command must lie in
+// its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+// command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
+// `count`: `TVMD_ERR_SIZE`) and the held commands stay.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `commands` is null or points to `count` `TvmdAgentCommand`s.
+TvmdStatus tvmd_seed_commands(TvmdController *handle,
+                              const TvmdAgentCommand *commands,
+                              uint32_t count);
 
 // The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
 // the caller). With an offset-free action the next `tvmd_allocate` records the delivered
@@ -721,7 +788,7 @@ TvmdStatus tvmd_law(TvmdController *handle,
 // become the held commands (the drop-in for a flight stack's control allocation, e.g. at the
 // rate loop's rate). Fills `out` (its `size` set by the caller). On an error after `out` was
 // found usable, `out.commands` are the held ones: a null or wrongly sized `wrench`, a
-// non-finite wrench (`TVMD_ERR_NON_FINITE`), zero thrust on every agent for a non-zero force.
+// non-finite wrench (`TVMD_ERR_INPUT_NON_FINITE`), zero thrust on every agent for a non-zero force.
 //
 // # Safety
 // Each pointer is null or points to its struct; `handle` as for `tvmd_create`.

@@ -13,6 +13,8 @@
 //!   conversion to the core's controller.
 //! - [`handle`]: the opaque controller in caller memory ([`handle::TvmdController`]):
 //!   create, step, set failures, set landed, reset.
+//! - [`reconfigure`]: validate a configuration, reconfigure all or nothing, set gains,
+//!   relaxation and rate limits, seed the held commands at a mode switch.
 //! - [`stages`]: the cycle's stages on the same handle, each at its own rate: `tvmd_law`
 //!   (the body wrench), `tvmd_allocate` (a body wrench to commands) and `tvmd_plan`.
 //! - [`actuator`]: commands to PX4-style normalized motor and servo outputs through a channel
@@ -39,6 +41,7 @@ pub mod actuator;
 pub mod config;
 pub mod handle;
 pub mod law;
+pub mod reconfigure;
 pub mod stages;
 pub mod status;
 pub mod types;

@@ -92,7 +92,13 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         settings: ControllerSettings<T>,
         allocator: A,
     ) -> Result<(), ConfigError> {
-        let mut next = Self::new(team, settings, allocator)?;
+        self.take_over(Self::new(team, settings, allocator)?)
+    }
+
+    /// As [`Self::reconfigure`] with the new controller already built: `next` is given this
+    /// one's failure mask, landed flag, held commands and offset-free estimate, then replaces
+    /// it. On an error (the mask does not fit `next`'s team) nothing changes.
+    pub fn take_over(&mut self, mut next: Self) -> Result<(), ConfigError> {
         next.set_failures(self.failures)?;
         next.set_landed(self.landed());
         next.offset_free.carry_over(&self.offset_free);

@@ -3,6 +3,7 @@
 //! landed hold, and the stages (module `stages`; the C program in `tests/c` covers the same
 //! from C).
 
+mod reconfigure;
 mod stages;
 
 use std::mem::size_of;
@@ -50,7 +51,7 @@ pub(crate) fn identity() -> [f32; 9] {
     [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
 }
 
-fn step(handle: &mut TvmdController, x: f32) -> (TvmdStatus, TvmdOutput) {
+pub(crate) fn step(handle: &mut TvmdController, x: f32) -> (TvmdStatus, TvmdOutput) {
     let state = TvmdState {
         size: size_of::<TvmdState>() as u32,
         position: [x, 0.0, 1.5],
