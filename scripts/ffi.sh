@@ -41,7 +41,7 @@ c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o
 step "C test program against the staticlib, then its record replayed on the Rust API"
 cargo build --locked -p tvmd-ffi
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tvmd_test.c \
-  crates/tvmd-ffi/tests/c/law_test.c \
+  crates/tvmd-ffi/tests/c/law_test.c crates/tvmd-ffi/tests/c/stages_test.c \
   "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl -o "$out/tvmd_test"
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
