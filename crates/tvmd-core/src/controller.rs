@@ -15,7 +15,8 @@ pub use cycle::{AllocationStage, LawStage};
 
 pub use settings::{
     ControllerSettings, ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX,
-    DAMPING_RATIO, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
+    DAMPING_RATIO, MAX_PERIOD, MIN_PERIOD, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE,
+    POSITION_FREQUENCY,
 };
 
 use crate::admissible::{admissible_sets, AdmissibleSet};
