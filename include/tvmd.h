@@ -371,6 +371,18 @@ typedef struct {
   float weight;
 } TvmdHover;
 
+// What `tvmd_attitude` returns. On an error the numbers are NaN.
+typedef struct {
+  // `sizeof(TvmdAttitudeOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_attitude` returned.
+  int32_t status;
+  // `u_tau_d` (N m), body frame.
+  float torque[3];
+  // `e_R` against the planned attitude (rad), body frame.
+  float attitude_error[3];
+} TvmdAttitudeOutput;
+
 // What `tvmd_law` returns: the body wrench for `tvmd_allocate` and the law's diagnostics. On
 // an error every number is NaN and `planner_status`/`planner_iterations` are 0.
 typedef struct {
@@ -771,6 +783,22 @@ TvmdStatus tvmd_set_rate_limits(TvmdController *handle, uint32_t enabled, const 
 TvmdStatus tvmd_seed_commands(TvmdController *handle,
                               const TvmdAgentCommand *commands,
                               uint32_t count);
+
+// The attitude stage alone: eq. (12)'s torque for `planned_attitude` (9 floats, row-major:
+// the last `tvmd_law`'s `planned_attitude`) from this `state`, with `reference`'s angular
+// velocity and acceleration (the planned ones with the law's rate filter) and the offset-free
+// torque. Pair it with the last law period's force rotated into this state's body frame
+// (`R^T R_law u_fd`) and call `tvmd_allocate`: an attitude and allocation loop faster than the
+// law's. Changes nothing.
+//
+// # Safety
+// Each pointer is null or points to its struct (`planned_attitude` to 9 floats); `handle` as
+// for `tvmd_create`.
+TvmdStatus tvmd_attitude(const TvmdController *handle,
+                         const TvmdState *state,
+                         const float *planned_attitude,
+                         const TvmdReference *reference,
+                         TvmdAttitudeOutput *out);
 
 // The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
 // the caller). With an offset-free action the next `tvmd_allocate` records the delivered

@@ -46,6 +46,12 @@ cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tv
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
 
+step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"
+c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \
+  crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/px4_test"
+"$out/px4_test"
+
 step "staticlib for thumbv7em-none-eabihf (no_std) and its size"
 cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release
 lib="$target_dir/thumbv7em-none-eabihf/release/libtvmd_ffi.a"

@@ -100,7 +100,7 @@ pub use gain_schedule::GainSchedule;
 pub use gimbal::GimbalCommand;
 pub use hover::{HoverCapability, HoverLimit};
 pub use integral::IntegralAction;
-pub use law::{Gains, LawOutput, Reference, RigidState};
+pub use law::{AttitudeLaw, Gains, LawOutput, Reference, RigidState};
 pub use limits::{AgentLimits, RateLimits};
 pub use natural_gains::NaturalGains;
 pub use offset_free::{Compensation, OffsetFree};

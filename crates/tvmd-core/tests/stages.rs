@@ -46,6 +46,12 @@ fn law_then_allocate_is_the_step_bit_for_bit() {
             let state = body.state();
             let out = whole.step(&state, &reference).unwrap();
             let law = staged.law(&state, &reference).unwrap();
+            // The attitude stage alone gives the law stage's torque for its planned attitude.
+            let attitude = staged
+                .attitude(&state, &law.planner.r_d, &reference)
+                .unwrap();
+            assert_eq!(attitude.u_tau.as_slice(), &law.law.u_d.as_slice()[..3]);
+            assert_eq!(attitude.e_r, law.law.e_r);
             let alloc = staged.allocate(&law.law.u_d).unwrap();
             assert_eq!(law.planner, out.planner, "period {k}");
             assert_eq!(law.projection, out.projection);

@@ -1,8 +1,9 @@
 //! The cycle's stages as entry points on the same handle, so that each runs at its own rate
 //! (a flight stack's position and attitude loops, then its control allocation): `tvmd_law`
 //! (state and reference in, the body wrench out), `tvmd_allocate` (a body wrench in, commands
-//! out: the drop-in for a flight stack's control allocation) and `tvmd_plan` (the planner
-//! alone). `tvmd_step` is `tvmd_law` then `tvmd_allocate`, bit for bit.
+//! out: the drop-in for a flight stack's control allocation), `tvmd_attitude` (the torque
+//! for a planned attitude: a faster attitude loop between law periods) and `tvmd_plan` (the
+//! planner alone). `tvmd_step` is `tvmd_law` then `tvmd_allocate`, bit for bit.
 
 use tvmd_core::nalgebra::Vector6;
 
@@ -74,6 +75,87 @@ pub struct TvmdAllocationOutput {
     /// Bit `i` set: agent `i`'s force lies on the boundary of its admissible set (a gimbal or
     /// thrust limit holds it).
     pub saturated: u32,
+}
+
+/// What `tvmd_attitude` returns. On an error the numbers are NaN.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TvmdAttitudeOutput {
+    /// `sizeof(TvmdAttitudeOutput)`, set by the caller.
+    pub size: u32,
+    /// The status `tvmd_attitude` returned.
+    pub status: i32,
+    /// `u_tau_d` (N m), body frame.
+    pub torque: [f32; 3],
+    /// `e_R` against the planned attitude (rad), body frame.
+    pub attitude_error: [f32; 3],
+}
+
+/// The attitude stage alone: eq. (12)'s torque for `planned_attitude` (9 floats, row-major:
+/// the last `tvmd_law`'s `planned_attitude`) from this `state`, with `reference`'s angular
+/// velocity and acceleration (the planned ones with the law's rate filter) and the offset-free
+/// torque. Pair it with the last law period's force rotated into this state's body frame
+/// (`R^T R_law u_fd`) and call `tvmd_allocate`: an attitude and allocation loop faster than the
+/// law's. Changes nothing.
+///
+/// # Safety
+/// Each pointer is null or points to its struct (`planned_attitude` to 9 floats); `handle` as
+/// for `tvmd_create`.
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_attitude(
+    handle: *const crate::handle::TvmdController,
+    state: *const TvmdState,
+    planned_attitude: *const f32,
+    reference: *const TvmdReference,
+    out: *mut TvmdAttitudeOutput,
+) -> TvmdStatus {
+    let Some(out) = out.as_mut() else {
+        return TVMD_ERR_NULL_POINTER;
+    };
+    if let Err(status) = checked_size::<TvmdAttitudeOutput>(out.size) {
+        return status;
+    }
+    let status = attitude_into(handle, state, planned_attitude, reference, out);
+    if status != TVMD_OK {
+        out.status = status;
+        out.torque = [f32::NAN; 3];
+        out.attitude_error = [f32::NAN; 3];
+    }
+    status
+}
+
+unsafe fn attitude_into(
+    handle: *const crate::handle::TvmdController,
+    state: *const TvmdState,
+    planned_attitude: *const f32,
+    reference: *const TvmdReference,
+    out: &mut TvmdAttitudeOutput,
+) -> TvmdStatus {
+    let controller = match inner_ref(handle) {
+        Ok(inner) => &inner.controller,
+        Err(status) => return status,
+    };
+    let (Some(state), Some(r_d), Some(reference)) = (
+        state.as_ref(),
+        planned_attitude.cast::<[f32; 9]>().as_ref(),
+        reference.as_ref(),
+    ) else {
+        return TVMD_ERR_NULL_POINTER;
+    };
+    if let Err(status) = checked_size::<TvmdState>(state.size)
+        .and_then(|()| checked_size::<TvmdReference>(reference.size))
+    {
+        return status;
+    }
+    match controller.attitude(&state.to_core(), &matrix(r_d), &reference.to_core()) {
+        Ok(law) => {
+            out.status = TVMD_OK;
+            out.torque = law.u_tau.into();
+            out.attitude_error = law.e_r.into();
+            TVMD_OK
+        }
+        Err(e) => input_status(&e),
+    }
 }
 
 /// What `tvmd_plan` returns. On an error the numbers are NaN and the counts 0.

@@ -102,6 +102,15 @@ pub extern "C" fn _start() -> ! {
             let mut alloc: TvmdAllocationOutput = core::mem::zeroed();
             alloc.size = core::mem::size_of::<TvmdAllocationOutput>() as u32;
             status[4] += tvmd_allocate(handle, &wrench, &mut alloc);
+            let mut att: TvmdAttitudeOutput = core::mem::zeroed();
+            att.size = core::mem::size_of::<TvmdAttitudeOutput>() as u32;
+            status[4] += tvmd_attitude(
+                handle,
+                &state,
+                law.planned_attitude.as_ptr(),
+                &reference,
+                &mut att,
+            );
             let mut plan: TvmdPlanOutput = core::mem::zeroed();
             plan.size = core::mem::size_of::<TvmdPlanOutput>() as u32;
             status[4] += tvmd_plan(

@@ -13,12 +13,14 @@ use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceRepor
 use crate::anti_windup::Saturation;
 use crate::command::{invert, AgentCommand};
 use crate::error::InputError;
-use crate::law::{control_wrench, force_request, LawOutput, Reference, RigidState};
+use crate::law::{attitude_law, control_wrench, force_request, AttitudeLaw, LawOutput};
+use crate::law::{Reference, RigidState};
 use crate::linalg::norm;
 use crate::offset_free::CycleRecord;
 use crate::planner::{PlannerOutput, PlannerStatus};
 use crate::projection::{project_force_in, ForceProjection};
 use crate::real::Real;
+use crate::rotation::validate_rotation;
 
 /// What the law stage produces ([`Controller::law`]): the planner's `R_d`, the projection, `f_r`
 /// and the law, whose `law.u_d = [u_tau_d; u_fd]` (`{C}`) is the body wrench for
@@ -92,6 +94,38 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         reference: &Reference<T>,
     ) -> Result<LawStage<T>, CycleError<T, N>> {
         self.law_stage(state, reference).map(|(stage, _)| stage)
+    }
+
+    /// The attitude stage alone (a flight stack's attitude loop, run faster than the law stage
+    /// that planned `r_d`): eq. (12)'s torque for the planned attitude `r_d` from this
+    /// `state`, with `reference`'s `Omega_d`, `Omega_d_dot` (the planned ones of the last law
+    /// stage when the rate filter is on) and the offset-free torque. The body force to pair it
+    /// with is the law stage's inertial force rotated into this state's body frame. Changes
+    /// nothing.
+    ///
+    /// Errors: a non-finite or non-rotation `state` or `r_d`, non-finite reference rates.
+    pub fn attitude(
+        &self,
+        state: &RigidState<T>,
+        r_d: &Matrix3<T>,
+        reference: &Reference<T>,
+    ) -> Result<AttitudeLaw<T>, InputError> {
+        state.validate()?;
+        validate_rotation(r_d, "planner.r_d")?;
+        reference.validate()?;
+        let rates = match self.planned_rates() {
+            Some(p) => Reference {
+                angular_velocity: p.omega_d,
+                angular_acceleration: p.omega_d_dot,
+                ..*reference
+            },
+            None => *reference,
+        };
+        let mut law = attitude_law(&self.plant, &self.gains, state, &rates, r_d);
+        if self.offset_free.is_on() {
+            law.u_tau += self.offset_free.compensation().torque;
+        }
+        Ok(law)
     }
 
     /// The allocation stage of a period: `wrench = [u_tau; u_f]` (N m, N; `{C}`) to per-agent
