@@ -14,7 +14,7 @@
 
 // The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 // of `TvmdConfig` and the compensation of `TvmdOutput`).
-#define TVMD_ABI_VERSION 2
+#define TVMD_ABI_VERSION 3
 
 // `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
 #define TVMD_MOTOR_CURVE_ROTOR_SPEED 0
@@ -371,6 +371,93 @@ typedef struct {
   float weight;
 } TvmdHover;
 
+// What `tvmd_attitude` returns. On an error the numbers are NaN.
+typedef struct {
+  // `sizeof(TvmdAttitudeOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_attitude` returned.
+  int32_t status;
+  // `u_tau_d` (N m), body frame.
+  float torque[3];
+  // `e_R` against the planned attitude (rad), body frame.
+  float attitude_error[3];
+} TvmdAttitudeOutput;
+
+// What `tvmd_law` returns: the body wrench for `tvmd_allocate` and the law's diagnostics. On
+// an error every number is NaN and `planner_status`/`planner_iterations` are 0.
+typedef struct {
+  // `sizeof(TvmdLawOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_law` returned.
+  int32_t status;
+  // `u_tau_d` (N m), body frame: the torque to allocate.
+  float torque[3];
+  // `u_fd = K_f u_fr` (N), body frame: the force to allocate.
+  float force[3];
+  // `R_d`, the planned attitude, row-major.
+  float planned_attitude[9];
+  // `theta*` (rad).
+  float planner_theta;
+  // One of `TVMD_PLANNER_*`.
+  uint32_t planner_status;
+  // The planner's search steps.
+  uint32_t planner_iterations;
+  // `e_x = x - x_r` (m), inertial frame.
+  float position_error[3];
+  // `e_R` against `R_d` (rad), body frame.
+  float attitude_error[3];
+} TvmdLawOutput;
+
+// A body wrench `[u_tau; u_f]` in the team's body frame `{C}` (z up, as the state).
+typedef struct {
+  // `sizeof(TvmdWrench)`.
+  uint32_t size;
+  // `u_tau` (N m), body frame.
+  float torque[3];
+  // `u_f` (N), body frame.
+  float force[3];
+} TvmdWrench;
+
+// What `tvmd_allocate` returns. On an error `commands` are the held ones (as `tvmd_step`'s)
+// and every number is NaN, `saturated` 0.
+typedef struct {
+  // `sizeof(TvmdAllocationOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_allocate` returned.
+  int32_t status;
+  // `n`; commands beyond it are idle.
+  uint32_t agent_count;
+  // Per-agent commands inside `E_f` (idle for failed agents).
+  TvmdAgentCommand commands[TVMD_MAX_AGENTS];
+  // The allocated torque `u_tau = (M f)_tau` (N m), body frame.
+  float allocated_torque[3];
+  // The allocated force `u_f = (M f)_f` (N), body frame.
+  float allocated_force[3];
+  // `||u_fd - u_f||` (N), the force the team could not deliver (`e_f`).
+  float force_error;
+  // `||u_tau_d - u_tau||` (N m), the torque the team could not deliver.
+  float torque_error;
+  // Bit `i` set: agent `i`'s force lies on the boundary of its admissible set (a gimbal or
+  // thrust limit holds it).
+  uint32_t saturated;
+} TvmdAllocationOutput;
+
+// What `tvmd_plan` returns. On an error the numbers are NaN and the counts 0.
+typedef struct {
+  // `sizeof(TvmdPlanOutput)`, set by the caller.
+  uint32_t size;
+  // The status `tvmd_plan` returned.
+  int32_t status;
+  // `R_d`, the planned attitude, row-major.
+  float planned_attitude[9];
+  // `theta*` (rad).
+  float theta;
+  // One of `TVMD_PLANNER_*`.
+  uint32_t planner_status;
+  // The planner's search steps.
+  uint32_t iterations;
+} TvmdPlanOutput;
+
 // Success.
 #define TVMD_OK 0
 
@@ -390,6 +477,10 @@ typedef struct {
 // An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
 // `map.motor_curve`) has a value this library does not know.
 #define TVMD_ERR_ENUM_VALUE 5
+
+// The handle's storage was overwritten: its start says created, but the guard at its end
+// does not hold (a neighbouring buffer overran it). Create the controller again.
+#define TVMD_ERR_CORRUPTED 6
 
 // [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
 #define TVMD_ERR_INPUT_NON_FINITE 10
@@ -618,6 +709,14 @@ TvmdStatus tvmd_hover_capability(const TvmdController *handle, TvmdHover *hover)
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_reset(TvmdController *handle);
 
+// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+// otherwise (every other entry point makes the same check first).
+//
+// # Safety
+// `handle` as for [`tvmd_step`].
+TvmdStatus tvmd_check(const TvmdController *handle);
+
 // Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
 // (zero), from the caller's contact or landing detector. While landed the offset-free state
 // is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
@@ -629,6 +728,113 @@ TvmdStatus tvmd_reset(TvmdController *handle);
 // # Safety
 // `handle` as for [`tvmd_step`].
 TvmdStatus tvmd_set_landed(TvmdController *handle, uint32_t landed);
+
+// Checks `config` as `tvmd_create` would (every field, the team's rank, the law), without
+// creating anything: `TVMD_OK` or the status `tvmd_create` would return. Builds the
+// controller on the stack to check it, so it costs what `tvmd_create` costs: call it before
+// flight or from a task with that stack, not from the control loop.
+//
+// # Safety
+// `config` is null or points to a `TvmdConfig`.
+TvmdStatus tvmd_validate_config(const TvmdConfig *config);
+
+// Replaces the running controller's configuration, all or nothing: the new controller is
+// built and given the running one's failure mask, landed flag, held commands (agent by agent,
+// where admissible for the new configuration; otherwise idle) and offset-free estimate (when
+// both run the same kind of action); only then does it replace the running one. On any error
+// the running controller is untouched and steps exactly as before. As `tvmd_validate_config`,
+// it costs what `tvmd_create` costs.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `config` is null or points to a `TvmdConfig`.
+TvmdStatus tvmd_reconfigure(TvmdController *handle, const TvmdConfig *config);
+
+// New gains of eq. (12) for the running controller (resolved by its law's gain schedule).
+// A gain that is not symmetric positive definite is refused and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `gains` is null or points to a `TvmdGains`.
+TvmdStatus tvmd_set_gains(TvmdController *handle, const TvmdGains *gains);
+
+// A new AFS relaxation `s` in `(0, 1]` for the planner, from the next period on. Anything
+// else is refused (`TVMD_ERR_CONFIG_RELAXATION`) and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`.
+TvmdStatus tvmd_set_relaxation(TvmdController *handle, float relaxation);
+
+// Gimbal rate limits `[eta_x, eta_y]` (rad/s, positive) from the next period on when
+// `enabled` is non-zero (`limits` then points to 2 floats), none when it is zero (`limits`
+// may be null). A bad limit is refused and nothing changes.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `limits` is null or points to 2 floats.
+TvmdStatus tvmd_set_rate_limits(TvmdController *handle, uint32_t enabled, const float *limits);
+
+// The commands the vehicle flies now (at a switch from another controller) become the held
+// ones: what a refused period repeats and where the rate limits start. `commands` holds
+// `count` entries, `count` = the team's agent count; each working agent's command must lie in
+// its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+// command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
+// `count`: `TVMD_ERR_SIZE`) and the held commands stay.
+//
+// # Safety
+// `handle` as for `tvmd_step`; `commands` is null or points to `count` `TvmdAgentCommand`s.
+TvmdStatus tvmd_seed_commands(TvmdController *handle,
+                              const TvmdAgentCommand *commands,
+                              uint32_t count);
+
+// The attitude stage alone: eq. (12)'s torque for `planned_attitude` (9 floats, row-major:
+// the last `tvmd_law`'s `planned_attitude`) from this `state`, with `reference`'s angular
+// velocity and acceleration (the planned ones with the law's rate filter) and the offset-free
+// torque. Pair it with the last law period's force rotated into this state's body frame
+// (`R^T R_law u_fd`) and call `tvmd_allocate`: an attitude and allocation loop faster than the
+// law's. Changes nothing.
+//
+// # Safety
+// Each pointer is null or points to its struct (`planned_attitude` to 9 floats); `handle` as
+// for `tvmd_create`.
+TvmdStatus tvmd_attitude(const TvmdController *handle,
+                         const TvmdState *state,
+                         const float *planned_attitude,
+                         const TvmdReference *reference,
+                         TvmdAttitudeOutput *out);
+
+// The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
+// the caller). With an offset-free action the next `tvmd_allocate` records the delivered
+// wrench for the observer (run the allocation after each law period). Errors: as
+// `tvmd_step`'s input checks; nothing is held (the law sends no commands).
+//
+// # Safety
+// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+TvmdStatus tvmd_law(TvmdController *handle,
+                    const TvmdState *state,
+                    const TvmdReference *reference,
+                    TvmdLawOutput *out);
+
+// The allocation stage: the body wrench `wrench` to per-agent commands inside `E_f`, which
+// become the held commands (the drop-in for a flight stack's control allocation, e.g. at the
+// rate loop's rate). Fills `out` (its `size` set by the caller). On an error after `out` was
+// found usable, `out.commands` are the held ones: a null or wrongly sized `wrench`, a
+// non-finite wrench (`TVMD_ERR_INPUT_NON_FINITE`), zero thrust on every agent for a non-zero force.
+//
+// # Safety
+// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+TvmdStatus tvmd_allocate(TvmdController *handle,
+                         const TvmdWrench *wrench,
+                         TvmdAllocationOutput *out);
+
+// The planner alone: the attitude `R_d` closest to `reference_attitude` (9 floats, row-major,
+// a rotation) whose attainable force space holds `force` (3 floats, N, inertial frame), at
+// the controller's relaxation and failure mask. Reads the controller, changes nothing.
+//
+// # Safety
+// `reference_attitude` is null or points to 9 floats, `force` to 3; `handle` as for
+// `tvmd_create`; `out` is null or points to a `TvmdPlanOutput`.
+TvmdStatus tvmd_plan(const TvmdController *handle,
+                     const float *reference_attitude,
+                     const float *force,
+                     TvmdPlanOutput *out);
 
 // A short static name of a status code (`"TVMD_OK"`, `"TVMD_ERR_SIZE"`, ...), NUL-terminated,
 // never null; `"TVMD_UNKNOWN_STATUS"` for a value no entry point returns.

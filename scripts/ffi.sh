@@ -33,7 +33,7 @@ if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then
 fi
 
 step "include/tvmd.h compiles as C99 and as C++11 (-Wall -Wextra -Werror -pedantic)"
-printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 2 ? 0 : 1; }\n' >"$out/header.c"
+printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 3 ? 0 : 1; }\n' >"$out/header.c"
 cp "$out/header.c" "$out/header.cpp"
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.c" -o "$out/header_c.o"
 c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o "$out/header_cpp.o"
@@ -41,10 +41,16 @@ c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o
 step "C test program against the staticlib, then its record replayed on the Rust API"
 cargo build --locked -p tvmd-ffi
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tvmd_test.c \
-  crates/tvmd-ffi/tests/c/law_test.c \
+  crates/tvmd-ffi/tests/c/law_test.c crates/tvmd-ffi/tests/c/stages_test.c \
   "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl -o "$out/tvmd_test"
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
+
+step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"
+c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \
+  crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/px4_test"
+"$out/px4_test"
 
 step "staticlib for thumbv7em-none-eabihf (no_std) and its size"
 cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release

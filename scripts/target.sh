@@ -69,6 +69,18 @@ done
 # Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
 # tvmd-pil firmware, built above with the target tests) on both boards, compared with the
 # in-process f32 flight (crates/tvmd-sim/tests/pil/main.rs, #[ignore]d in plain cargo test).
+ffi_stack_elf="$target_dir/thumbv7em-none-eabihf/release/ffi_stack"
+for machine in mps2-an386 mps2-an500; do
+  echo "==> $machine: painted stack of every C entry point (tvmd-ffi)"
+  rc=0
+  timeout 120 qemu-system-arm -machine "$machine" -nographic -monitor none \
+    -semihosting-config enable=on,target=native -kernel "$ffi_stack_elf" || rc=$?
+  if [ "$rc" -ne 0 ]; then
+    echo "error: $machine: a C entry point's stack grew past its bound (exit status $rc)" >&2
+    status=1
+  fi
+done
+
 echo "==> processor in the loop (tvmd-sim --pil cortex-m4, cortex-m7)"
 pil_elf=$(realpath "$target_dir/thumbv7em-none-eabihf/release/tvmd-pil")
 TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored --nocapture || {

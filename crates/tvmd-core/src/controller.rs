@@ -6,31 +6,34 @@ use nalgebra::Vector3;
 /// The roll `R_x(phi)`, at its old path (now in [`crate::rotation`]).
 pub use crate::rotation::roll;
 
+mod cycle;
 mod guard;
+mod reconfigure;
 mod settings;
+
+pub use cycle::{AllocationStage, LawStage};
 
 pub use settings::{
     ControllerSettings, ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX,
-    DAMPING_RATIO, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
+    DAMPING_RATIO, MAX_PERIOD, MIN_PERIOD, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE,
+    POSITION_FREQUENCY,
 };
 
 use crate::admissible::{admissible_sets, AdmissibleSet};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceReport};
-use crate::anti_windup::Saturation;
+use crate::allocation::{Allocation, Allocator, NullSpaceReport};
 use crate::attitude_rate::{AttitudeRateState, PlannedRates};
-use crate::command::{invert, AgentCommand};
+use crate::command::AgentCommand;
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, InputError};
 use crate::hover::{hover_capability, HoverCapability};
-use crate::law::{control_wrench, force_request, Gains, LawOutput, Plant, Reference, RigidState};
-use crate::linalg::norm;
-use crate::offset_free::{Compensation, CycleRecord, OffsetFreeState};
-use crate::planner::{AttitudePlanner, PlannerOutput, PlannerStatus};
-use crate::projection::{project_force_in, ForceProjection};
+use crate::law::{Gains, LawOutput, Plant};
+use crate::offset_free::{Compensation, OffsetFreeState};
+use crate::planner::{AttitudePlanner, PlannerOutput};
+use crate::projection::ForceProjection;
 use crate::real::Real;
 use crate::team::{FailureMask, TeamConfig};
-use guard::{check_range, first_non_finite, input_limit};
+use guard::input_limit;
 
 /// Every quantity of one control period.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +94,8 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     offset_free: OffsetFreeState<T>,
     /// The planned-rate filter (`None` when `settings.attitude_rate` is).
     attitude_rate: Option<AttitudeRateState<T>>,
+    /// What the offset-free state records once the law stage's wrench is allocated.
+    pending: Option<cycle::PendingRecord<T>>,
     plant: Plant<T>,
     planner: AttitudePlanner<T>,
     allocator: A,
@@ -144,6 +149,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             gains,
             offset_free,
             attitude_rate,
+            pending: None,
             full_cone: afs.cone(Relaxation::none()),
             planner_cone: afs.cone(settings.relaxation),
             afs,
@@ -216,6 +222,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.previous = [AgentCommand::idle(); N];
         self.allocator.reset();
         self.offset_free.reset();
+        self.pending = None;
         if let Some(rates) = &mut self.attitude_rate {
             rates.reset();
         }
@@ -315,167 +322,5 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                 .map(|r| (r, self.settings.period)),
             self.previous.iter().map(AgentCommand::gimbal),
         )
-    }
-
-    /// One control period: `u_fr`, projection `t_Tf`, planner (`R_d`), `K_f` and the torque part,
-    /// allocation, and inversion to commands inside `E_f`.
-    ///
-    /// A non-finite or non-rotation input, or a component beyond [`Self::input_limit`]
-    /// ([`InputError::OutOfRange`]), is rejected with a [`CycleError`] that carries the previous
-    /// commands to hold. So is a period whose only answer to a finite, non-zero force request
-    /// `u_fr` is zero thrust on every agent ([`InputError::Unattainable`]: never a silent free
-    /// fall), and, as a safety net, one with a non-finite output ([`InputError::Overflow`]).
-    ///
-    /// ```
-    /// use tvmd_core::nalgebra::Vector3;
-    /// use tvmd_core::rotation::roll;
-    /// use tvmd_core::{team::presets, Controller, ControllerSettings, RedistributedPseudoInverse};
-    /// use tvmd_core::{PlannerStatus, Reference, RigidState};
-    /// let team = presets::a4_inc::<f32, 4>()?;
-    /// let mut controller =
-    ///     Controller::new(team, ControllerSettings::paper(), RedistributedPseudoInverse)?;
-    /// let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
-    /// reference.attitude = roll(1.0); // beyond what the team can hold
-    /// let state = RigidState::at_rest(Vector3::new(0.2, 0.0, 1.5));
-    /// let out = controller.step(&state, &reference).unwrap();
-    /// assert_eq!(out.planner.status, PlannerStatus::Planned);
-    /// assert!(out.command_clamp <= tvmd_core::command::command_tolerance());
-    /// // A NaN state is refused; the previous (admissible) commands are held.
-    /// let mut bad = state;
-    /// bad.position.x = f32::NAN;
-    /// let held = controller.step(&bad, &reference).unwrap_err();
-    /// assert_eq!(held.commands, out.commands);
-    /// # Ok::<(), tvmd_core::ConfigError>(())
-    /// ```
-    pub fn step(
-        &mut self,
-        state: &RigidState<T>,
-        reference: &Reference<T>,
-    ) -> Result<ControlOutput<T, N>, CycleError<T, N>> {
-        let reject = |error| CycleError {
-            error,
-            commands: self.previous,
-        };
-        state.validate().map_err(reject)?;
-        reference.validate().map_err(reject)?;
-        check_range(self.input_limit, state, reference).map_err(reject)?;
-        let gains = &self.gains;
-        let mut u_fr = force_request(&self.plant, gains, state, reference);
-        // Offset-free: the compensation joins the request before the projection and the
-        // planner (skipped entirely when off, so the paper's cycle is bit for bit unchanged).
-        let compensation = if self.offset_free.is_on() {
-            self.offset_free.begin(&self.plant, state);
-            let c = self.offset_free.compensation();
-            u_fr += state.attitude.transpose() * c.force;
-            Some(c)
-        } else {
-            None
-        };
-        let projection = project_force_in(&self.full_cone, &u_fr);
-        let f_r = state.attitude * u_fr * projection.t_tf;
-        // `reference.attitude` passed `reference.validate()` above.
-        let planner = self
-            .planner
-            .plan_in_valid_attitude(&self.planner_cone, &reference.attitude, &f_r)
-            .map_err(reject)?;
-        // The planned attitude's rates replace the reference's when the filter is on.
-        let planned = self.attitude_rate.as_mut().map(|f| f.update(&planner.r_d));
-        // One call per case: a `Reference` copied only when the planned rates replace the
-        // reference's (about 140 instructions and 90 B of stack less on the Cortex-M4F).
-        let law_of = |law_reference: &Reference<T>| {
-            control_wrench(
-                &self.plant,
-                gains,
-                state,
-                law_reference,
-                &planner.r_d,
-                &u_fr,
-                &projection.gain(),
-            )
-        };
-        let mut law = match planned {
-            Some(rates) => law_of(&Reference {
-                angular_velocity: rates.omega_d,
-                angular_acceleration: rates.omega_d_dot,
-                ..*reference
-            }),
-            None => law_of(reference),
-        };
-        if let Some(c) = &compensation {
-            add_torque(&mut law, &c.torque);
-        }
-        let sets = self.admissible_sets();
-        let request = AllocationRequest {
-            effectiveness: &self.effectiveness,
-            sets: &sets,
-            wrench: law.u_d,
-        };
-        let allocation = self.allocator.allocate(&request);
-        let (allocation, null_space) = match &self.settings.null_space {
-            Some(stage) => stage.refine(&request, &allocation),
-            None => (allocation, NullSpaceReport::off()),
-        };
-        let mut commands = [AgentCommand::idle(); N];
-        let mut command_clamp = T::zero();
-        for (i, ((cmd, force), set)) in commands
-            .iter_mut()
-            .zip(&allocation.forces)
-            .zip(&sets)
-            .enumerate()
-        {
-            if self.effectiveness.block(i).is_some() {
-                let (c, clamp) = invert(force, set, self.team.limits());
-                *cmd = c;
-                command_clamp = command_clamp.max(clamp);
-            }
-        }
-        let output = ControlOutput {
-            planner,
-            projection,
-            f_r,
-            law,
-            allocation,
-            null_space,
-            commands,
-            command_clamp,
-        };
-        // Never a silent free fall: zero thrust everywhere for a finite, non-zero request.
-        if u_fr != Vector3::zeros() && commands.iter().all(|c| c.thrust == T::zero()) {
-            return Err(reject(InputError::Unattainable {
-                field: "force_request",
-            }));
-        }
-        if let Some(field) = first_non_finite(&output) {
-            return Err(reject(InputError::Overflow { field }));
-        }
-        self.previous = commands;
-        if compensation.is_some() {
-            let saturation = Saturation::from_cycle(
-                output.projection.t_tf,
-                output.projection.t_eta,
-                output.planner.status == PlannerStatus::Unreachable,
-                output.allocation.wrench_error,
-                norm(&output.law.u_d),
-            );
-            let record = CycleRecord {
-                e_x: output.law.e_x,
-                e_r: output.law.e_r,
-                wrench: output.allocation.wrench,
-                saturation,
-            };
-            self.offset_free.end(&self.plant, state, &record);
-        }
-        Ok(output)
-    }
-}
-
-/// Adds the offset-free torque to `u_tau_r` in `u_r` and `u_d` (`K_f` leaves the torque part
-/// as it is, eq. 12).
-fn add_torque<T: Real>(law: &mut LawOutput<T>, torque: &Vector3<T>) {
-    for (k, t) in torque.iter().enumerate() {
-        if let (Some(r), Some(d)) = (law.u_r.get_mut(k), law.u_d.get_mut(k)) {
-            *r += *t;
-            *d += *t;
-        }
     }
 }

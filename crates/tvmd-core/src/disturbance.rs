@@ -134,6 +134,16 @@ impl<T: Real> ObserverState<T> {
         self.saturation = Saturation::NONE;
     }
 
+    /// The estimates and the last sample of `old` (another observer's, e.g. before a
+    /// reconfiguration), the torque clamped onto this observer's bound.
+    pub fn carry_over(&mut self, old: &Self) {
+        self.force = old.force;
+        self.torque = guarded(&old.torque, &old.torque, false, self.observer.max_torque);
+        self.last = old.last;
+        self.momenta = None;
+        self.saturation = old.saturation;
+    }
+
     /// Clamps the force estimate onto a new bound (e.g. a smaller team after a failure).
     pub fn rebound(&mut self, force_bound: T) {
         self.force = guarded(&self.force, &self.force, false, force_bound);

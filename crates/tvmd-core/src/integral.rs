@@ -91,6 +91,13 @@ impl<T: Real> IntegralState<T> {
         self.torque = Vector3::zeros();
     }
 
+    /// The integral terms of `old` (another integral's, e.g. before a reconfiguration), the
+    /// torque clamped onto this action's bound.
+    pub fn carry_over(&mut self, old: &Self) {
+        self.force = old.force;
+        self.torque = guarded(&old.torque, &old.torque, false, self.action.max_torque);
+    }
+
     /// Clamps the force term onto a new bound (e.g. a smaller team after a failure).
     pub fn rebound(&mut self, force_bound: T) {
         self.force = guarded(&self.force, &self.force, false, force_bound);

@@ -287,6 +287,45 @@ pub struct LawOutput<T: Real> {
     pub v_x: T,
 }
 
+/// The attitude part of eq. (12): `e_R`, `e_Omega` and the torque `u_tau_d` for the planned
+/// attitude `r_d`, with `reference`'s `Omega_d`, `Omega_d_dot` (only those of `reference`
+/// are read).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudeLaw<T: Real> {
+    /// `e_R = (R_d^T R - R^T R_d)^vee / 2` (rad, `{C}`).
+    pub e_r: Vector3<T>,
+    /// `e_Omega = Omega - R^T R_d Omega_d` (rad/s).
+    pub e_omega: Vector3<T>,
+    /// `u_tau_d` (N m, `{C}`).
+    pub u_tau: Vector3<T>,
+}
+
+/// The attitude part of eq. (12) alone (see [`AttitudeLaw`]); [`control_wrench`] uses it.
+pub fn attitude_law<T: Real>(
+    plant: &Plant<T>,
+    gains: &Gains<T>,
+    state: &RigidState<T>,
+    reference: &Reference<T>,
+    r_d: &Matrix3<T>,
+) -> AttitudeLaw<T> {
+    let r = &state.attitude;
+    let rtrd = r.transpose() * r_d;
+    let half: T = lit(0.5);
+    let e_r = vee(&(r_d.transpose() * r - rtrd)) * half;
+    let omega = state.angular_velocity;
+    let omega_d = rtrd * reference.angular_velocity;
+    let e_omega = omega - omega_d;
+    let omega_d_dot = -omega.cross(&omega_d) + rtrd * reference.angular_acceleration;
+    let j = plant.inertia;
+    let u_tau =
+        j * omega_d_dot - (j * omega).cross(&omega_d) - gains.k_omega * e_omega - gains.k_r * e_r;
+    AttitudeLaw {
+        e_r,
+        e_omega,
+        u_tau,
+    }
+}
+
 /// The torque part of eq. (12) with the planned `R_d`, and the full `u_r`, `u_d`:
 /// `u_tau_r = J xi_dot_dOmega - [J Omega]x Omega_d' - K_Omega e_Omega - K_R e_R`, with
 /// `Omega_d' = R^T R_d Omega_d`, `xi_dot_dOmega = -Omega x Omega_d' + R^T R_d Omega_d_dot`
@@ -323,15 +362,11 @@ pub fn control_wrench<T: Real>(
     let half: T = lit(0.5);
     let e_x = state.position - reference.position;
     let e_v = state.velocity - rt * reference.velocity;
-    let rtrd = rt * r_d;
-    let e_r = vee(&(r_d.transpose() * r - rtrd)) * half;
-    let omega = state.angular_velocity;
-    let omega_d = rtrd * reference.angular_velocity;
-    let e_omega = omega - omega_d;
-    let omega_d_dot = -omega.cross(&omega_d) + rtrd * reference.angular_acceleration;
-    let j = plant.inertia;
-    let u_tau =
-        j * omega_d_dot - (j * omega).cross(&omega_d) - gains.k_omega * e_omega - gains.k_r * e_r;
+    let AttitudeLaw {
+        e_r,
+        e_omega,
+        u_tau,
+    } = attitude_law(plant, gains, state, reference, r_d);
     let psi = (gains.k_r * (Matrix3::identity() - r_d.transpose() * r)).trace() * half;
     let quad = |k: &Matrix3<T>, a: &Vector3<T>| a.dot(&(k * a)) * half;
     let u_f = k_f * u_fr;

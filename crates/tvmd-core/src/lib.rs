@@ -89,7 +89,9 @@ pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};
 pub use anti_windup::Saturation;
 pub use attitude_rate::{AttitudeRateFilter, PlannedRates};
 pub use command::AgentCommand;
-pub use controller::{ControlOutput, Controller, ControllerSettings, CycleError};
+pub use controller::{
+    AllocationStage, ControlOutput, Controller, ControllerSettings, CycleError, LawStage,
+};
 pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
@@ -98,7 +100,7 @@ pub use gain_schedule::GainSchedule;
 pub use gimbal::GimbalCommand;
 pub use hover::{HoverCapability, HoverLimit};
 pub use integral::IntegralAction;
-pub use law::{Gains, LawOutput, Reference, RigidState};
+pub use law::{AttitudeLaw, Gains, LawOutput, Reference, RigidState};
 pub use limits::{AgentLimits, RateLimits};
 pub use natural_gains::NaturalGains;
 pub use offset_free::{Compensation, OffsetFree};

@@ -108,6 +108,20 @@ impl<T: Real> OffsetFreeState<T> {
         self.landed = landed;
     }
 
+    /// Carries the landed flag and the estimate (or integral) of `old` into this state when
+    /// both run the same kind of action (a reconfiguration while flying), clamped onto this
+    /// state's bounds; another kind starts from zero.
+    pub fn carry_over(&mut self, old: &Self) {
+        self.landed = old.landed;
+        match (&mut self.kind, &old.kind) {
+            (Kind::Observer(new), Kind::Observer(old)) => new.carry_over(old),
+            (Kind::Integral(new), Kind::Integral(old)) => new.carry_over(old),
+            _ => {}
+        }
+        let bound = self.force_bound;
+        self.set_force_bound(bound);
+    }
+
     /// A new force bound (a failure changed the team's capacity): the force part is clamped
     /// onto it, the rest kept.
     pub fn set_force_bound(&mut self, force_bound: T) {

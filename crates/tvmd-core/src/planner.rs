@@ -130,6 +130,11 @@ impl<T: Real> AttitudePlanner<T> {
         self.tolerance
     }
 
+    /// The iteration cap of the search.
+    pub fn max_iterations(&self) -> u32 {
+        self.max_iterations
+    }
+
     /// Plans `R_d` for the reference attitude `r_r` and the inertial force request `f_r`
     /// (eq. 9: `f_r = t_Tf R u_fr`). Errors: [`InputError::NonFinite`] for a non-finite input,
     /// [`InputError::NotRotation`] when `r_r` is not a rotation (the check of

@@ -233,3 +233,26 @@ fn controller_gravity_is_bounded_by_the_weight() {
     let e = Controller::new(team32, settings, RedistributedPseudoInverse).unwrap_err();
     assert_eq!(overflow_field(e), ConfigField::Gravity);
 }
+
+/// A control period outside [1e-6, 1] s is refused, naming the period (a C caller's 1e-30 s).
+#[test]
+fn controller_period_is_bounded() {
+    let team = presets::a4_inc::<f32, 4>().unwrap();
+    let with_period = |period: f32| {
+        let settings = ControllerSettings {
+            period,
+            ..ControllerSettings::paper()
+        };
+        Controller::new(team, settings, RedistributedPseudoInverse).map(|_| ())
+    };
+    for bad in [1e-30, 0.0, -0.01, 2.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(
+            with_period(bad).unwrap_err().field(),
+            Some(ConfigField::Period),
+            "{bad}"
+        );
+    }
+    for good in [1e-6, 0.0025, 0.01, 1.0] {
+        assert!(with_period(good).is_ok(), "{good}");
+    }
+}

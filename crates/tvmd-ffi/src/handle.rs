@@ -33,17 +33,28 @@ pub const TVMD_CONTROLLER_SIZE: usize = 4096;
 /// without compiler extensions).
 pub const TVMD_CONTROLLER_WORDS: usize = TVMD_CONTROLLER_SIZE / 8;
 
-/// Written by a successful `tvmd_create`; anything else means "not initialized".
+/// Written by a successful `tvmd_create` at the start of the storage; anything else means
+/// "not initialized".
 const MAGIC: u64 = 0x7476_6d64_6666_6931;
 
-/// What the storage holds.
-struct Inner {
+/// Written by a successful `tvmd_create` in the storage's last 8 bytes: a write running over
+/// the storage from the next buffer (or from the previous one into the start) changes one of
+/// the two guards, and every entry point then refuses the handle (`TVMD_ERR_CORRUPTED`).
+const TAIL: u64 = 0x6474_7664_6e65_6421;
+
+/// The byte offset of the tail guard.
+const TAIL_OFFSET: usize = TVMD_CONTROLLER_SIZE - 8;
+
+/// What the storage holds, the magic first (declaration order is layout order).
+#[repr(C)]
+pub(crate) struct Inner {
     magic: u64,
-    controller: FfiController,
+    pub(crate) controller: FfiController,
 }
 
-// The header's size and alignment hold the real controller, on the target that compiles this.
-const _: () = assert!(size_of::<Inner>() <= TVMD_CONTROLLER_SIZE);
+// The header's size and alignment hold the real controller and the tail guard, on the target
+// that compiles this.
+const _: () = assert!(size_of::<Inner>() <= TAIL_OFFSET);
 const _: () = assert!(align_of::<Inner>() <= align_of::<TvmdController>());
 const _: () = assert!(TVMD_CONTROLLER_SIZE % 8 == 0);
 
@@ -79,7 +90,7 @@ pub(crate) fn checked_size<T>(size: u32) -> Result<(), TvmdStatus> {
 ///
 /// # Safety
 /// `handle` is null or points to a `TvmdController` (possibly never created).
-unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStatus> {
+pub(crate) unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStatus> {
     if handle.is_null() {
         return Err(TVMD_ERR_NULL_POINTER);
     }
@@ -87,18 +98,24 @@ unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inner, TvmdStat
         return Err(TVMD_ERR_ALIGNMENT);
     }
     let inner = &*handle.cast::<Inner>();
-    if inner.magic == MAGIC {
-        Ok(inner)
-    } else {
-        Err(TVMD_ERR_NOT_INITIALIZED)
+    if inner.magic != MAGIC {
+        return Err(TVMD_ERR_NOT_INITIALIZED);
     }
+    // In bounds: the storage is TVMD_CONTROLLER_SIZE bytes and 8-byte aligned.
+    let tail = handle.cast::<u8>().add(TAIL_OFFSET).cast::<u64>().read();
+    if tail != TAIL {
+        return Err(TVMD_ERR_CORRUPTED);
+    }
+    Ok(inner)
 }
 
 /// As [`inner`], mutable.
 ///
 /// # Safety
 /// As [`inner`], and no other reference to the handle is alive.
-unsafe fn inner_mut<'a>(handle: *mut TvmdController) -> Result<&'a mut Inner, TvmdStatus> {
+pub(crate) unsafe fn inner_mut<'a>(
+    handle: *mut TvmdController,
+) -> Result<&'a mut Inner, TvmdStatus> {
     inner(handle)?;
     Ok(&mut *handle.cast::<Inner>())
 }
@@ -114,7 +131,7 @@ pub(crate) unsafe fn controller<'a>(
 }
 
 /// The core controller a configuration describes.
-fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
+pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
     let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
     let Some(agents) = config.agents.get(..count) else {
         return Err(ConfigError::TooManyAgents {
@@ -206,6 +223,11 @@ pub unsafe extern "C" fn tvmd_create(
                 magic: MAGIC,
                 controller,
             });
+            storage
+                .cast::<u8>()
+                .add(TAIL_OFFSET)
+                .cast::<u64>()
+                .write(TAIL);
             TVMD_OK
         }
         Err(e) => e.status(),
@@ -362,6 +384,20 @@ pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
             inner.controller.reset();
             TVMD_OK
         }
+        Err(status) => status,
+    }
+}
+
+/// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+/// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+/// otherwise (every other entry point makes the same check first).
+///
+/// # Safety
+/// `handle` as for [`tvmd_step`].
+#[no_mangle]
+pub unsafe extern "C" fn tvmd_check(handle: *const TvmdController) -> TvmdStatus {
+    match inner(handle) {
+        Ok(_) => TVMD_OK,
         Err(status) => status,
     }
 }

@@ -13,6 +13,10 @@
 //!   conversion to the core's controller.
 //! - [`handle`]: the opaque controller in caller memory ([`handle::TvmdController`]):
 //!   create, step, set failures, set landed, reset.
+//! - [`reconfigure`]: validate a configuration, reconfigure all or nothing, set gains,
+//!   relaxation and rate limits, seed the held commands at a mode switch.
+//! - [`stages`]: the cycle's stages on the same handle, each at its own rate: `tvmd_law`
+//!   (the body wrench), `tvmd_allocate` (a body wrench to commands) and `tvmd_plan`.
 //! - [`actuator`]: commands to PX4-style normalized motor and servo outputs through a channel
 //!   map, and back.
 //!
@@ -37,6 +41,8 @@ pub mod actuator;
 pub mod config;
 pub mod handle;
 pub mod law;
+pub mod reconfigure;
+pub mod stages;
 pub mod status;
 pub mod types;
 
@@ -46,7 +52,7 @@ pub const TVMD_MAX_AGENTS: usize = 16;
 
 /// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 /// of `TvmdConfig` and the compensation of `TvmdOutput`).
-pub const TVMD_ABI_VERSION: u32 = 2;
+pub const TVMD_ABI_VERSION: u32 = 3;
 
 /// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
 #[no_mangle]

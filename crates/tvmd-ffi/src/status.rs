@@ -22,6 +22,9 @@ pub const TVMD_ERR_NOT_INITIALIZED: TvmdStatus = 4;
 /// An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
 /// `map.motor_curve`) has a value this library does not know.
 pub const TVMD_ERR_ENUM_VALUE: TvmdStatus = 5;
+/// The handle's storage was overwritten: its start says created, but the guard at its end
+/// does not hold (a neighbouring buffer overran it). Create the controller again.
+pub const TVMD_ERR_CORRUPTED: TvmdStatus = 6;
 
 /// [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
 pub const TVMD_ERR_INPUT_NON_FINITE: TvmdStatus = 10;
@@ -161,6 +164,7 @@ pub extern "C" fn tvmd_status_name(status: TvmdStatus) -> *const core::ffi::c_ch
         TVMD_ERR_ALIGNMENT => "TVMD_ERR_ALIGNMENT\0",
         TVMD_ERR_NOT_INITIALIZED => "TVMD_ERR_NOT_INITIALIZED\0",
         TVMD_ERR_ENUM_VALUE => "TVMD_ERR_ENUM_VALUE\0",
+        TVMD_ERR_CORRUPTED => "TVMD_ERR_CORRUPTED\0",
         TVMD_ERR_INPUT_NON_FINITE => "TVMD_ERR_INPUT_NON_FINITE\0",
         TVMD_ERR_INPUT_NOT_ROTATION => "TVMD_ERR_INPUT_NOT_ROTATION\0",
         TVMD_ERR_INPUT_OUT_OF_RANGE => "TVMD_ERR_INPUT_OUT_OF_RANGE\0",

@@ -9,11 +9,13 @@ use tvmd_sim::control::law_settings;
 
 use crate::afs::PyAfs;
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
-use crate::convert::{class_arg, commands_array, iteration_cap, law_arg, matrix, null_space_arg};
+use crate::convert::null_space_arg;
+use crate::convert::{class_arg, commands_array, finite, iteration_cap, law_arg, matrix};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, value_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
-use crate::planner::planner;
+use crate::planner::{planner, PyPlannerResult};
+use crate::step_output::{AllocationStageData, PyAllocationStage, PyLawStage};
 use crate::step_output::{PyStepOutput, StepData};
 use crate::team::{failure_mask, PyHoverCapability, PyTeam};
 
@@ -203,6 +205,63 @@ impl PyController {
                 Err(cycle_error(py, &error, commands))
             }
         }
+    }
+
+    /// The law stage of one period (state and reference in, the body wrench out). See the stub.
+    fn law_stage(
+        slf: &Bound<'_, Self>,
+        py: Python<'_>,
+        state: &Bound<'_, PyAny>,
+        reference: &Bound<'_, PyAny>,
+    ) -> PyResult<PyLawStage> {
+        let (state, reference) = (state_arg(state)?, reference_arg(reference)?);
+        let mut this = borrow_mut(slf)?;
+        let n = this.inner.team().len();
+        match this.inner.law(&state, &reference) {
+            Ok(inner) => Ok(PyLawStage { inner }),
+            Err(error) => Err(cycle_error(
+                py,
+                &error,
+                commands_array(py, &error.commands, n),
+            )),
+        }
+    }
+
+    /// The allocation stage: a (6,) body wrench `[u_tau; u_f]` to commands. See the stub.
+    fn allocate(
+        slf: &Bound<'_, Self>,
+        py: Python<'_>,
+        wrench: &Bound<'_, PyAny>,
+    ) -> PyResult<PyAllocationStage> {
+        let wrench = finite::<6, 1>(wrench, "wrench")?;
+        let mut this = borrow_mut(slf)?;
+        let this = &mut *this;
+        let n = this.inner.team().len();
+        match this.inner.allocate(&wrench) {
+            Ok(stage) => {
+                let allocation = AllocationData::new(stage.allocation, n, this.inner.allocator());
+                Ok(PyAllocationStage {
+                    inner: AllocationStageData::new(stage, n, allocation),
+                })
+            }
+            Err(error) => Err(cycle_error(
+                py,
+                &error,
+                commands_array(py, &error.commands, n),
+            )),
+        }
+    }
+
+    /// The planner alone for a reference attitude and an inertial force. See the stub.
+    fn plan(
+        &self,
+        reference_attitude: &Bound<'_, PyAny>,
+        force: &Bound<'_, PyAny>,
+    ) -> PyResult<PyPlannerResult> {
+        let r_r = finite::<3, 3>(reference_attitude, "reference_attitude")?;
+        let f = finite::<3, 1>(force, "force")?;
+        let inner = self.inner.plan(&r_r, &f).or_raise()?;
+        Ok(PyPlannerResult { inner })
     }
 
     /// The team.

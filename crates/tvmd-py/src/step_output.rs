@@ -1,8 +1,9 @@
-//! `tvmd.StepOutput`, everything one `Controller.step` computed, and its `NullSpaceReport`.
+//! `tvmd.StepOutput`, everything one `Controller.step` computed, and its `NullSpaceReport`;
+//! the stages' `LawStage` and `AllocationStage` (`Controller.law_stage`, `Controller.allocate`).
 
 use pyo3::prelude::*;
 
-use tvmd_core::{ControlOutput, NullSpaceReport};
+use tvmd_core::{AllocationStage, ControlOutput, LawStage, NullSpaceReport};
 
 use crate::afs::PyForceProjection;
 use crate::allocation::{AllocationData, PyAllocation};
@@ -77,9 +78,67 @@ record! {
     }
 }
 
+record! {
+    /// The law stage of one period (`Controller.law_stage`): its planner, projection, `f_r`,
+    /// law, and the body wrench to allocate.
+    "LawStage" in "tvmd" => PyLawStage(LawStage<f64>) |py, o| {
+        /// The planner's result (eqs. 9-11).
+        planner => PyPlannerResult { inner: o.planner },
+        /// The force projection `K_f` (eqs. 12-13).
+        projection => PyForceProjection { inner: o.projection },
+        /// (3,) `t_Tf R u_fr` (inertial).
+        f_r => matrix(py, &o.f_r)?,
+        /// The control law's output (eq. 12).
+        law => PyLawOutput { inner: o.law },
+        /// (6,) `u_d = [u_tau; u_f]` (N m, N; body frame): the wrench for `allocate`.
+        wrench => matrix(py, &o.law.u_d)?,
+    }
+}
+
+/// One `Controller.allocate`: the stage's output, the agent count and the allocation record.
+pub(crate) struct AllocationStageData {
+    stage: Box<AllocationStage<f64, CAPACITY>>,
+    n: usize,
+    allocation: AllocationData,
+}
+
+impl AllocationStageData {
+    /// The stage of a controller of `n` agents and its allocator's record.
+    pub(crate) fn new(
+        stage: AllocationStage<f64, CAPACITY>,
+        n: usize,
+        allocation: AllocationData,
+    ) -> Self {
+        Self {
+            stage: Box::new(stage),
+            n,
+            allocation,
+        }
+    }
+}
+
+record! {
+    /// The allocation stage of one period (`Controller.allocate`): a body wrench to commands.
+    "AllocationStage" in "tvmd" => PyAllocationStage(AllocationStageData) |py, o| {
+        /// The allocation (eqs. 4 and 6): forces, `wrench = M f`, `e_f` (the force error),
+        /// `wrench_error`, rounds, saturated agents.
+        allocation => PyAllocation { inner: o.allocation.clone() },
+        /// `||u_tau_d - u_tau||` (N m), the torque the team could not deliver.
+        torque_error => o.stage.torque_error,
+        /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
+        commands => commands_array(py, &o.stage.commands, o.n)?,
+        /// Largest clamp of the command inversion (normalized).
+        command_clamp => o.stage.command_clamp,
+        /// What the null-space stage changed.
+        null_space => PyNullSpaceReport { inner: o.stage.null_space },
+    }
+}
+
 /// Registers the step's classes.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyStepOutput>()?;
+    m.add_class::<PyLawStage>()?;
+    m.add_class::<PyAllocationStage>()?;
     m.add_class::<PyNullSpaceReport>()?;
     Ok(())
 }

@@ -10,6 +10,8 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 use tvmd_ffi::actuator::*;
 use tvmd_ffi::config::*;
 use tvmd_ffi::handle::*;
+use tvmd_ffi::reconfigure::*;
+use tvmd_ffi::stages::*;
 use tvmd_ffi::types::*;
 
 static mut CONTROLLER: TvmdController = TvmdController {
@@ -58,6 +60,7 @@ pub extern "C" fn _start() -> ! {
         let mut hover: TvmdHover = core::mem::zeroed();
         hover.size = core::mem::size_of::<TvmdHover>() as u32;
         status[3] = tvmd_hover_capability(handle, &mut hover);
+        status[3] += tvmd_validate_config(&config) + tvmd_check(handle);
         write_volatile(
             addr_of_mut!(NAME),
             tvmd_ffi::status::tvmd_status_name(status[1]) as usize
@@ -87,6 +90,35 @@ pub extern "C" fn _start() -> ! {
             out.size = core::mem::size_of::<TvmdOutput>() as u32;
             status[4] = tvmd_set_landed(handle, read_volatile(addr_of!(LANDED)));
             status[4] += tvmd_step(handle, &state, &reference, &mut out);
+            // The stages, as a flight stack's loops would call them.
+            let mut law: TvmdLawOutput = core::mem::zeroed();
+            law.size = core::mem::size_of::<TvmdLawOutput>() as u32;
+            status[4] += tvmd_law(handle, &state, &reference, &mut law);
+            let wrench = TvmdWrench {
+                size: core::mem::size_of::<TvmdWrench>() as u32,
+                torque: law.torque,
+                force: law.force,
+            };
+            let mut alloc: TvmdAllocationOutput = core::mem::zeroed();
+            alloc.size = core::mem::size_of::<TvmdAllocationOutput>() as u32;
+            status[4] += tvmd_allocate(handle, &wrench, &mut alloc);
+            let mut att: TvmdAttitudeOutput = core::mem::zeroed();
+            att.size = core::mem::size_of::<TvmdAttitudeOutput>() as u32;
+            status[4] += tvmd_attitude(
+                handle,
+                &state,
+                law.planned_attitude.as_ptr(),
+                &reference,
+                &mut att,
+            );
+            let mut plan: TvmdPlanOutput = core::mem::zeroed();
+            plan.size = core::mem::size_of::<TvmdPlanOutput>() as u32;
+            status[4] += tvmd_plan(
+                handle,
+                reference.attitude.as_ptr(),
+                law.force.as_ptr(),
+                &mut plan,
+            );
             let [f0, f1, f2] = out.compensation_force;
             let [t0, t1, t2] = out.compensation_torque;
             write_volatile(addr_of_mut!(COMPENSATION), [f0, f1, f2, t0, t1, t2]);
@@ -94,6 +126,11 @@ pub extern "C" fn _start() -> ! {
             if mask != 0 {
                 status[5] = tvmd_set_failures(handle, mask, &mut hover);
                 status[5] += tvmd_reset(handle);
+                status[5] += tvmd_reconfigure(handle, &config);
+                status[5] += tvmd_set_relaxation(handle, reference.position[0]);
+                status[5] += tvmd_set_rate_limits(handle, mask & 1, reference.velocity.as_ptr());
+                status[5] += tvmd_set_gains(handle, &config.gains);
+                status[5] += tvmd_seed_commands(handle, out.commands.as_ptr(), out.agent_count);
             }
             map.agents[0].motor[1] = read_volatile(addr_of!(MAP_SHIFT));
             status[6] = tvmd_actuator_map_validate(handle, &map);

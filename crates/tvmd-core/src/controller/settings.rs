@@ -13,6 +13,12 @@ use crate::natural_gains::NaturalGains;
 use crate::offset_free::OffsetFree;
 use crate::real::{lit, Real};
 
+/// Shortest control period (s) a controller accepts (1 MHz): below it the rates the rate
+/// limits, the observer and the planned-rate filter derive would be meaningless.
+pub const MIN_PERIOD: f64 = 1e-6;
+/// Longest control period (s) a controller accepts (1 Hz).
+pub const MAX_PERIOD: f64 = 1.0;
+
 /// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s position axes.
 pub const POSITION_FREQUENCY: f64 = 1.5;
 /// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s attitude axes.
@@ -37,8 +43,8 @@ pub struct ControllerSettings<T: Real> {
     pub relaxation: Relaxation<T>,
     /// `g` (m/s^2).
     pub gravity: T,
-    /// Control period `dt` (s), used by the rate limits, the offset-free state and the planned
-    /// rates.
+    /// Control period `dt` (s), in [[`MIN_PERIOD`], [`MAX_PERIOD`]]; used by the rate limits,
+    /// the offset-free state and the planned rates.
     pub period: T,
     /// Optional gimbal rate limits (the rate-constrained allocation).
     pub rate_limits: Option<RateLimits<T>>,
@@ -122,15 +128,20 @@ impl<T: Real> ControllerSettings<T> {
     }
 
     /// Gains, relaxation, rate limits, the offset-free action and the rate filter are valid by
-    /// construction (private fields); only the two plain numbers are checked here.
+    /// construction (private fields); only the two plain numbers are checked here: gravity
+    /// finite and positive, the period in [[`MIN_PERIOD`], [`MAX_PERIOD`]].
     pub(crate) fn validate(&self) -> Result<(), ConfigError> {
-        for (value, field) in [
-            (self.gravity, ConfigField::Gravity),
-            (self.period, ConfigField::Period),
-        ] {
-            if !value.is_finite() || value <= T::zero() {
-                return Err(ConfigError::Parameter { field });
-            }
+        if !self.gravity.is_finite() || self.gravity <= T::zero() {
+            return Err(ConfigError::Parameter {
+                field: ConfigField::Gravity,
+            });
+        }
+        let (min, max): (T, T) = (lit(MIN_PERIOD), lit(MAX_PERIOD));
+        // `!(a <= b)` also refuses NaN.
+        if !(self.period >= min && self.period <= max) {
+            return Err(ConfigError::Parameter {
+                field: ConfigField::Period,
+            });
         }
         Ok(())
     }

@@ -44,4 +44,7 @@ TvmdStatus step(TvmdController *c, const TvmdState *s, const TvmdReference *r, T
 /* law_test.c */
 void test_law(void);
 
+/* stages_test.c */
+void test_stages(void);
+
 #endif

@@ -492,6 +492,7 @@ int main(int argc, char **argv) {
   s = at_rest(0.0f, 0.0f, 1.5f);
   CHECK_STATUS(step(c, &s, &r, &o), TVMD_OK);
   test_law();
+  test_stages();
 
   fclose(record);
   printf("tvmd C test: %d checks, %d failed\n", checks, failed);

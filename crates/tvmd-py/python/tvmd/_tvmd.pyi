@@ -1047,6 +1047,39 @@ class Controller:
                 the exception's ``commands`` (n, 4) are the previous period's commands to hold.
             ValueError / TypeError: wrong shapes or argument types.
         """
+    def law_stage(self, state: _StateLike, reference: _ReferenceLike) -> "LawStage":
+        """The law stage of one period (``Controller::law`` in Rust, ``tvmd_law`` in C): ``u_fr``
+        (with the offset-free compensation), the projection, the planner and eq. 12, up to the
+        body wrench ``u_d``; ``allocate(out.wrench)`` then gives what ``step`` gives, bit for
+        bit. Run the two at their own rates (a flight stack's attitude and allocation loops);
+        with an offset-free law the next ``allocate`` records the delivered wrench.
+
+        Args:
+            state, reference: as ``step``.
+
+        Raises:
+            CycleError: as ``step``'s input checks (``commands``: the held ones).
+            ValueError / TypeError: wrong shapes or argument types.
+        """
+    def allocate(self, wrench: ArrayLike) -> "AllocationStage":
+        """The allocation stage: a (6,) body wrench ``[u_tau; u_f]`` (N m, N; body frame) to
+        per-agent commands inside ``E_f``, which become the held commands (the drop-in for a
+        flight stack's control allocation).
+
+        Raises:
+            ValueError: a wrench that is not (6,) or not finite.
+            CycleError: zero thrust on every agent for a non-zero force, or a non-finite result
+                (``commands``: the held ones).
+        """
+    def plan(self, reference_attitude: ArrayLike, force: ArrayLike) -> "PlannerResult":
+        """The planner alone: the attitude ``R_d`` closest to ``reference_attitude`` (3, 3) whose
+        AFS holds ``force`` (3,) (N, inertial frame), at the controller's relaxation and
+        failure mask. Changes nothing.
+
+        Raises:
+            ValueError: wrong shapes, non-finite values, or a ``reference_attitude`` that is not a
+                rotation.
+        """
     @property
     def team(self) -> Team:
         """The team."""
@@ -1126,6 +1159,62 @@ class HoverCapability:
         """``m_C g`` (N)."""
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict."""
+
+@final
+class LawStage:
+    """The law stage of one period (``Controller.law_stage``; read-only).
+
+    Attributes:
+        planner: PlannerResult. projection: ForceProjection. f_r: (3,) inertial.
+        law: LawOutput. wrench: (6,) ``u_d = [u_tau; u_f]`` (N m, N; body frame).
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+    @property
+    def planner(self) -> PlannerResult:
+        """The planner's result (eqs. 9-11)."""
+    @property
+    def projection(self) -> ForceProjection:
+        """The force projection ``K_f`` (eqs. 12-13)."""
+    @property
+    def f_r(self) -> _F64:
+        """(3,) ``t_Tf R u_fr`` (inertial)."""
+    @property
+    def law(self) -> LawOutput:
+        """The control law's output (eq. 12)."""
+    @property
+    def wrench(self) -> _F64:
+        """(6,) ``u_d = [u_tau; u_f]`` (N m, N; body frame): the wrench for ``allocate``."""
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict (nested records as dicts)."""
+
+@final
+class AllocationStage:
+    """The allocation stage of one period (``Controller.allocate``; read-only).
+
+    Attributes:
+        allocation: Allocation (``e_f`` is the force error). torque_error: N m.
+        commands: (n, 4). command_clamp: normalized. null_space: NullSpaceReport.
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+    @property
+    def allocation(self) -> Allocation:
+        """The allocation (eqs. 4 and 6)."""
+    @property
+    def torque_error(self) -> float:
+        """``||u_tau_d - u_tau||`` (N m), the torque the team could not deliver."""
+    @property
+    def commands(self) -> _F64:
+        """(n, 4) commands, columns ``eta_x, eta_y, thrust, omega``."""
+    @property
+    def command_clamp(self) -> float:
+        """Largest clamp of the command inversion (normalized)."""
+    @property
+    def null_space(self) -> "NullSpaceReport":
+        """What the null-space stage changed."""
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict (nested records as dicts)."""
 
 @final
 class StepOutput:

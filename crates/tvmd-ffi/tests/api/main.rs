@@ -1,6 +1,10 @@
 //! The C entry points called from Rust: creation into caller storage, a cycle, held commands,
 //! failure masks, the actuator map, the default (offset-free) law against the paper's, the
-//! landed hold (the C program in `tests/c` covers the same from C).
+//! landed hold, and the stages (module `stages`; the C program in `tests/c` covers the same
+//! from C).
+
+mod reconfigure;
+mod stages;
 
 use std::mem::size_of;
 
@@ -19,7 +23,7 @@ fn created() -> Box<TvmdController> {
 }
 
 /// The paper's controller with one of the `TVMD_ALLOCATOR_*`.
-fn created_with(allocator: u32) -> Box<TvmdController> {
+pub(crate) fn created_with(allocator: u32) -> Box<TvmdController> {
     let mut storage = Box::new(TvmdController {
         opaque: [0; TVMD_CONTROLLER_WORDS],
     });
@@ -43,11 +47,11 @@ fn created_with(allocator: u32) -> Box<TvmdController> {
     storage
 }
 
-fn identity() -> [f32; 9] {
+pub(crate) fn identity() -> [f32; 9] {
     [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
 }
 
-fn step(handle: &mut TvmdController, x: f32) -> (TvmdStatus, TvmdOutput) {
+pub(crate) fn step(handle: &mut TvmdController, x: f32) -> (TvmdStatus, TvmdOutput) {
     let state = TvmdState {
         size: size_of::<TvmdState>() as u32,
         position: [x, 0.0, 1.5],
