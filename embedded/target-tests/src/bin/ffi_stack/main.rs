@@ -21,6 +21,8 @@ use tvmd_ffi::stages::*;
 use tvmd_ffi::status::*;
 use tvmd_ffi::types::*;
 
+// The stack painter of the `cost` firmware, shared.
+#[path = "../cost/stack.rs"]
 mod stack;
 
 static mut STORAGE: TvmdController = TvmdController {
