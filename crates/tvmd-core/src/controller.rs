@@ -27,7 +27,7 @@ use crate::command::AgentCommand;
 use crate::effectiveness::Effectiveness;
 use crate::error::{ConfigError, InputError};
 use crate::hover::{hover_capability, HoverCapability};
-use crate::law::{Gains, LawOutput, Plant};
+use crate::law::{Gains, LawOutput, Plant, RigidState};
 use crate::offset_free::{Compensation, OffsetFreeState};
 use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::ForceProjection;
@@ -95,7 +95,7 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     /// The planned-rate filter (`None` when `settings.attitude_rate` is).
     attitude_rate: Option<AttitudeRateState<T>>,
     /// What the offset-free state records once the law stage's wrench is allocated.
-    pending: Option<cycle::PendingRecord<T>>,
+    pending: Option<(RigidState<T>, cycle::PendingRecord<T>)>,
     plant: Plant<T>,
     planner: AttitudePlanner<T>,
     allocator: A,

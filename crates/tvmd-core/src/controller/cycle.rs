@@ -53,11 +53,10 @@ pub struct AllocationStage<T: Real, const N: usize> {
     pub command_clamp: T,
 }
 
-/// What the offset-free state records at the end of a period, kept from the law stage until
-/// the allocation that delivers its wrench.
+/// What the offset-free state records at the end of a period besides the state, from the law
+/// stage for the allocation that delivers its wrench.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct PendingRecord<T: Real> {
-    state: RigidState<T>,
     e_x: Vector3<T>,
     e_r: Vector3<T>,
     t_tf: T,
@@ -93,7 +92,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         state: &RigidState<T>,
         reference: &Reference<T>,
     ) -> Result<LawStage<T>, CycleError<T, N>> {
-        self.law_stage(state, reference).map(|(stage, _)| stage)
+        let (stage, _, pending) = self.law_stage(state, reference)?;
+        // Kept for the allocation that delivers this wrench (`allocate`).
+        self.pending = pending.map(|p| (*state, p));
+        Ok(stage)
     }
 
     /// The attitude stage alone (a flight stack's attitude loop, run faster than the law stage
@@ -158,7 +160,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             }));
         }
         self.previous = stage.commands;
-        self.finish_offset_free(&stage.allocation);
+        if let Some((state, pending)) = self.pending.take() {
+            self.finish_offset_free(&state, pending, &stage.allocation);
+        }
         Ok(stage)
     }
 
@@ -198,7 +202,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         state: &RigidState<T>,
         reference: &Reference<T>,
     ) -> Result<ControlOutput<T, N>, CycleError<T, N>> {
-        let (law, u_fr) = self.law_stage(state, reference)?;
+        let (law, u_fr, pending) = self.law_stage(state, reference)?;
+        // A law stage run on its own before this step is superseded.
+        self.pending = None;
         let stage = self.allocation_stage(&law.law.u_d);
         let output = ControlOutput {
             planner: law.planner,
@@ -219,20 +225,23 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             first_non_finite(&output).map(|field| InputError::Overflow { field })
         };
         if let Some(error) = error {
-            self.pending = None;
             return Err(self.reject(error));
         }
         self.previous = output.commands;
-        self.finish_offset_free(&output.allocation);
+        if let Some(pending) = pending {
+            self.finish_offset_free(state, pending, &output.allocation);
+        }
         Ok(output)
     }
 
-    /// The law stage and `u_fr` (for `step`'s zero-thrust check).
+    /// The law stage, `u_fr` (for `step`'s zero-thrust check) and, with an offset-free action,
+    /// what its record needs once the wrench is allocated.
+    #[allow(clippy::type_complexity)]
     fn law_stage(
         &mut self,
         state: &RigidState<T>,
         reference: &Reference<T>,
-    ) -> Result<(LawStage<T>, Vector3<T>), CycleError<T, N>> {
+    ) -> Result<(LawStage<T>, Vector3<T>, Option<PendingRecord<T>>), CycleError<T, N>> {
         let checked = state
             .validate()
             .and_then(|()| reference.validate())
@@ -286,11 +295,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             }),
             None => law_of(reference),
         };
-        self.pending = match compensation {
+        let pending = match compensation {
             Some(c) => {
                 add_torque(&mut law, &c.torque);
                 Some(PendingRecord {
-                    state: *state,
                     e_x: law.e_x,
                     e_r: law.e_r,
                     t_tf: projection.t_tf,
@@ -307,7 +315,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             f_r,
             law,
         };
-        Ok((stage, u_fr))
+        Ok((stage, u_fr, pending))
     }
 
     /// The allocation of `wrench`, the null-space stage and the inversion, without the checks
@@ -349,25 +357,28 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         }
     }
 
-    /// End of a period whose commands were sent: the offset-free state records the wrench the
-    /// law stage asked for was delivered as `allocation.wrench`, and what was short.
-    fn finish_offset_free(&mut self, allocation: &Allocation<T, N>) {
-        if let Some(p) = self.pending.take() {
-            let saturation = Saturation::from_cycle(
-                p.t_tf,
-                p.t_eta,
-                p.unreachable,
-                allocation.wrench_error,
-                p.u_d_norm,
-            );
-            let record = CycleRecord {
-                e_x: p.e_x,
-                e_r: p.e_r,
-                wrench: allocation.wrench,
-                saturation,
-            };
-            self.offset_free.end(&self.plant, &p.state, &record);
-        }
+    /// End of a period whose commands were sent: the offset-free state records, for the
+    /// period's `state`, the wrench delivered (`allocation.wrench`) and what was short.
+    fn finish_offset_free(
+        &mut self,
+        state: &RigidState<T>,
+        p: PendingRecord<T>,
+        allocation: &Allocation<T, N>,
+    ) {
+        let saturation = Saturation::from_cycle(
+            p.t_tf,
+            p.t_eta,
+            p.unreachable,
+            allocation.wrench_error,
+            p.u_d_norm,
+        );
+        let record = CycleRecord {
+            e_x: p.e_x,
+            e_r: p.e_r,
+            wrench: allocation.wrench,
+            saturation,
+        };
+        self.offset_free.end(&self.plant, state, &record);
     }
 
     /// A refused period: why, and the previous commands to hold.
