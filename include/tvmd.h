@@ -1,4 +1,21 @@
-/* tvmd: C interface of the f32 full-pose controller for thrust-vectoring modular team UAVs. See README.md (C interface). */
+/*
+ * tvmd: C interface of the f32 full-pose controller for thrust-vectoring modular team UAVs
+ * (docs/c-interface.md). C99 and C++ (include/tvmd_px4.hpp: a C++17 layer for PX4).
+ *
+ * Units SI; world and body frames z up (PX4's NED/FRD: see tvmd_px4.hpp); matrices 9 floats
+ * row-major; the state's velocity in the body frame, the reference's in the world frame.
+ * Every struct passed by pointer starts with `size` (set it to sizeof); every entry point
+ * returns a TvmdStatus and never panics, allocates or blocks.
+ *
+ * Threads and interrupts: a TvmdController handle is not thread-safe and not reentrant: call
+ * its entry points from one task (the control loop) or serialize them, and not from an
+ * interrupt that may preempt another call on the same handle. Different handles are
+ * independent; the functions without a handle are pure.
+ *
+ * The cycle by stages, each at its own rate: tvmd_law (state, reference -> body wrench),
+ * tvmd_attitude (the torque for a planned attitude), tvmd_allocate (body wrench -> commands),
+ * tvmd_plan (the planner alone); tvmd_step is tvmd_law then tvmd_allocate.
+ */
 
 #ifndef TVMD_H
 #define TVMD_H
@@ -8,836 +25,1312 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// The capacity of the handle: the largest team it controls (and the channel count of
-// [`actuator::TvmdActuatorOutputs`]).
+/*
+ The capacity of the handle: the largest team it controls (and the channel count of
+ [`actuator::TvmdActuatorOutputs`]).
+ */
 #define TVMD_MAX_AGENTS 16
 
-// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
-// of `TvmdConfig` and the compensation of `TvmdOutput`).
+/*
+ The ABI version; raised on every incompatible change of a struct or function (2: the `law`
+ of `TvmdConfig` and the compensation of `TvmdOutput`).
+ */
 #define TVMD_ABI_VERSION 3
 
-// `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
+/*
+ `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
+ */
 #define TVMD_MOTOR_CURVE_ROTOR_SPEED 0
 
-// `map.motor_curve`: `T / sigma_Tf`, normalized thrust.
+/*
+ `map.motor_curve`: `T / sigma_Tf`, normalized thrust.
+ */
 #define TVMD_MOTOR_CURVE_THRUST 1
 
-// Bytes of a [`TvmdController`]: at least the controller's size on every supported target
-// (checked at compile time), with room for the core to grow within one ABI version.
+/*
+ Bytes of a [`TvmdController`]: at least the controller's size on every supported target
+ (checked at compile time), with room for the core to grow within one ABI version.
+ */
 #define TVMD_CONTROLLER_SIZE 4096
 
-// `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C
-// without compiler extensions).
+/*
+ `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C
+ without compiler extensions).
+ */
 #define TVMD_CONTROLLER_WORDS (TVMD_CONTROLLER_SIZE / 8)
 
-// `law.gain_schedule`: the gains `config.gains` as given (the paper's reading of eq. 12).
+/*
+ `law.gain_schedule`: the gains `config.gains` as given (the paper's reading of eq. 12).
+ */
 #define TVMD_GAINS_AS_GIVEN 0
 
-// `law.gain_schedule`: `config.gains` scaled by the team's mass (`K_x`, `K_v`) and inertia
-// (`K_R`, `K_Omega`), the authors' MATLAB reading.
+/*
+ `law.gain_schedule`: `config.gains` scaled by the team's mass (`K_x`, `K_v`) and inertia
+ (`K_R`, `K_Omega`), the authors' MATLAB reading.
+ */
 #define TVMD_GAINS_TEAM_SCALED 1
 
-// `law.gain_schedule`: gains from the closed-loop natural frequencies and damping ratios of
-// `law.position_*` and `law.attitude_*`, scaled by the team's mass and inertia (`config.gains`
-// is not used).
+/*
+ `law.gain_schedule`: gains from the closed-loop natural frequencies and damping ratios of
+ `law.position_*` and `law.attitude_*`, scaled by the team's mass and inertia (`config.gains`
+ is not used).
+ */
 #define TVMD_GAINS_NATURAL 2
 
-// `law.offset_free`: none (the paper's law, no steady-state correction).
+/*
+ `law.offset_free`: none (the paper's law, no steady-state correction).
+ */
 #define TVMD_OFFSET_FREE_OFF 0
 
-// `law.offset_free`: the disturbance observer (`force_bandwidth`, `torque_bandwidth`,
-// `max_torque`), the one of the library's default law.
+/*
+ `law.offset_free`: the disturbance observer (`force_bandwidth`, `torque_bandwidth`,
+ `max_torque`), the one of the library's default law.
+ */
 #define TVMD_OFFSET_FREE_OBSERVER 1
 
-// `law.offset_free`: integral action on the position and attitude errors (`integral_k_x`,
-// `integral_k_r`, `max_torque`).
+/*
+ `law.offset_free`: integral action on the position and attitude errors (`integral_k_x`,
+ `integral_k_r`, `max_torque`).
+ */
 #define TVMD_OFFSET_FREE_INTEGRAL 2
 
-// `limits.rotor_model`: `omega` normalized to 1 at `max_thrust` (`rho d^4 c_l = max_thrust`).
+/*
+ `limits.rotor_model`: `omega` normalized to 1 at `max_thrust` (`rho d^4 c_l = max_thrust`).
+ */
 #define TVMD_ROTOR_NORMALIZED 0
 
-// `limits.rotor_model`: the rotor constants of eq. (5), `T = rho d^4 c_l omega^2`, give
-// `max_thrust = rho d^4 c_l sigma_omega^2` and `omega` in rad/s (`max_thrust` is ignored).
+/*
+ `limits.rotor_model`: the rotor constants of eq. (5), `T = rho d^4 c_l omega^2`, give
+ `max_thrust = rho d^4 c_l sigma_omega^2` and `omega` in rad/s (`max_thrust` is ignored).
+ */
 #define TVMD_ROTOR_CONSTANTS 1
 
-// `allocator`: the redistributed pseudo-inverse (the paper's).
+/*
+ `allocator`: the redistributed pseudo-inverse (the paper's).
+ */
 #define TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE 0
 
-// `allocator`: the plain pseudo-inverse.
+/*
+ `allocator`: the plain pseudo-inverse.
+ */
 #define TVMD_ALLOCATOR_PSEUDO_INVERSE 1
 
-// `allocator`: the weighted pseudo-inverse with `agent_weights`.
+/*
+ `allocator`: the weighted pseudo-inverse with `agent_weights`.
+ */
 #define TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE 2
 
-// `allocator`: the exact-boundary incremental redistribution, the default of
-// `tvmd_config_paper` (starts from the previous period's forces; `tvmd_reset` and
-// `tvmd_set_failures` forget them).
+/*
+ `allocator`: the exact-boundary incremental redistribution, the default of
+ `tvmd_config_paper` (starts from the previous period's forces; `tvmd_reset` and
+ `tvmd_set_failures` forget them).
+ */
 #define TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION 3
 
-// `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
+/*
+ `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
+ */
 #define TVMD_PLANNER_ALREADY_FEASIBLE 0
 
-// `planner_status`: the search found the smallest feasible tilt (the planner saturating).
+/*
+ `planner_status`: the search found the smallest feasible tilt (the planner saturating).
+ */
 #define TVMD_PLANNER_PLANNED 1
 
-// `planner_status`: `f_r = 0`, `R_d = R_r`.
+/*
+ `planner_status`: `f_r = 0`, `R_d = R_r`.
+ */
 #define TVMD_PLANNER_ZERO_FORCE 2
 
-// `planner_status`: `||f_r|| > n sigma_Tf`, `b_zd` as close to `f_r` as the rotation allows.
+/*
+ `planner_status`: `||f_r|| > n sigma_Tf`, `b_zd` as close to `f_r` as the rotation allows.
+ */
 #define TVMD_PLANNER_UNREACHABLE 3
 
-// `hover.limit`: the maximum thrust `sigma_Tf`.
+/*
+ `hover.limit`: the maximum thrust `sigma_Tf`.
+ */
 #define TVMD_HOVER_LIMIT_MAX_THRUST 0
 
-// `hover.limit`: the idle thrust.
+/*
+ `hover.limit`: the idle thrust.
+ */
 #define TVMD_HOVER_LIMIT_MIN_THRUST 1
 
-// `hover.limit`: the inner gimbal limit `sigma_x`.
+/*
+ `hover.limit`: the inner gimbal limit `sigma_x`.
+ */
 #define TVMD_HOVER_LIMIT_GIMBAL_X 2
 
-// `hover.limit`: the outer gimbal limit `sigma_y`.
+/*
+ `hover.limit`: the outer gimbal limit `sigma_y`.
+ */
 #define TVMD_HOVER_LIMIT_GIMBAL_Y 3
 
-// A status code returned by every fallible entry point (`TVMD_OK` or one of `TVMD_ERR_*`).
+/*
+ A status code returned by every fallible entry point (`TVMD_OK` or one of `TVMD_ERR_*`).
+ */
 typedef int32_t TvmdStatus;
 
-// Caller-owned storage of one controller. Zero-initialize it (or call `tvmd_create` first):
-// a handle that was never created is refused with `TVMD_ERR_NOT_INITIALIZED`.
-typedef struct {
-  // Opaque; only the library reads or writes it.
+/*
+ Caller-owned storage of one controller. Zero-initialize it (or call `tvmd_create` first):
+ a handle that was never created is refused with `TVMD_ERR_NOT_INITIALIZED`.
+ */
+typedef struct TvmdController {
+  /*
+   Opaque; only the library reads or writes it.
+   */
   uint64_t opaque[TVMD_CONTROLLER_WORDS];
 } TvmdController;
 
-// One agent's channels.
-typedef struct {
-  // The two `actuator_motors` channels of the coaxial pair (`0..16`).
+/*
+ One agent's channels.
+ */
+typedef struct TvmdAgentChannels {
+  /*
+   The two `actuator_motors` channels of the coaxial pair (`0..16`).
+   */
   uint32_t motor[2];
-  // The `actuator_servos` channels of `[eta_x, eta_y]` (`0..16`).
+  /*
+   The `actuator_servos` channels of `[eta_x, eta_y]` (`0..16`).
+   */
   uint32_t servo[2];
-  // Each servo's output at `eta = 0`, in `(-1, 1)`.
+  /*
+   Each servo's output at `eta = 0`, in `(-1, 1)`.
+   */
   float servo_trim[2];
-  // `+1` or `-1`: the sign of the servo output for a positive angle.
+  /*
+   `+1` or `-1`: the sign of the servo output for a positive angle.
+   */
   float servo_direction[2];
-  // The gimbal angle (rad) of a unit deflection from trim, `> 0`.
+  /*
+   The gimbal angle (rad) of a unit deflection from trim, `> 0`.
+   */
   float servo_range[2];
 } TvmdAgentChannels;
 
-// The channel map of a team.
-typedef struct {
-  // `sizeof(TvmdActuatorMap)`.
+/*
+ The channel map of a team.
+ */
+typedef struct TvmdActuatorMap {
+  /*
+   `sizeof(TvmdActuatorMap)`.
+   */
   uint32_t size;
-  // Must equal the controller's agent count.
+  /*
+   Must equal the controller's agent count.
+   */
   uint32_t agent_count;
-  // Per agent (the first `agent_count` are used).
-  TvmdAgentChannels agents[TVMD_MAX_AGENTS];
-  // One of `TVMD_MOTOR_CURVE_*`.
+  /*
+   Per agent (the first `agent_count` are used).
+   */
+  struct TvmdAgentChannels agents[TVMD_MAX_AGENTS];
+  /*
+   One of `TVMD_MOTOR_CURVE_*`.
+   */
   uint32_t motor_curve;
 } TvmdActuatorMap;
 
-// One agent's command (eq. 6): gimbal angles, thrust and rotor speed.
-typedef struct {
-  // Inner gimbal angle `eta_x` (rad), `|eta_x| <= sigma_x`.
+/*
+ One agent's command (eq. 6): gimbal angles, thrust and rotor speed.
+ */
+typedef struct TvmdAgentCommand {
+  /*
+   Inner gimbal angle `eta_x` (rad), `|eta_x| <= sigma_x`.
+   */
   float eta_x;
-  // Outer gimbal angle `eta_y` (rad), `|eta_y| <= sigma_y`.
+  /*
+   Outer gimbal angle `eta_y` (rad), `|eta_y| <= sigma_y`.
+   */
   float eta_y;
-  // Thrust `T` (N), in `[min_thrust, max_thrust]` (0 for a failed agent).
+  /*
+   Thrust `T` (N), in `[min_thrust, max_thrust]` (0 for a failed agent).
+   */
   float thrust;
-  // Rotor speed `omega` of both coaxial rotors (eq. 5: `omega_P1 = omega_P2`).
+  /*
+   Rotor speed `omega` of both coaxial rotors (eq. 5: `omega_P1 = omega_P2`).
+   */
   float omega;
 } TvmdAgentCommand;
 
-// Normalized actuator outputs, 16 channels each (PX4's `actuator_motors` has 12 and
-// `actuator_servos` 8: copy the channels the vehicle uses).
-typedef struct {
-  // `sizeof(TvmdActuatorOutputs)`, set by the caller.
+/*
+ Normalized actuator outputs, 16 channels each (PX4's `actuator_motors` has 12 and
+ `actuator_servos` 8: copy the channels the vehicle uses).
+ */
+typedef struct TvmdActuatorOutputs {
+  /*
+   `sizeof(TvmdActuatorOutputs)`, set by the caller.
+   */
   uint32_t size;
-  // Motor channels in `[0, 1]`, NaN when unused.
+  /*
+   Motor channels in `[0, 1]`, NaN when unused.
+   */
   float motors[TVMD_MAX_AGENTS];
-  // Servo channels in `[-1, 1]`, NaN when unused.
+  /*
+   Servo channels in `[-1, 1]`, NaN when unused.
+   */
   float servos[TVMD_MAX_AGENTS];
 } TvmdActuatorOutputs;
 
-// One agent of the team (paper, "Modeling"): its gimbal centre, yaw and mass.
-typedef struct {
-  // `p_i`, the gimbal centre in the team CoM frame `{C}` (m).
+/*
+ One agent of the team (paper, "Modeling"): its gimbal centre, yaw and mass.
+ */
+typedef struct TvmdAgent {
+  /*
+   `p_i`, the gimbal centre in the team CoM frame `{C}` (m).
+   */
   float position[3];
-  // The yaw `psi_i = quarter_turns * pi/2`.
+  /*
+   The yaw `psi_i = quarter_turns * pi/2`.
+   */
   int32_t quarter_turns;
-  // `m_i` (kg), a point mass at `p_i`.
+  /*
+   `m_i` (kg), a point mass at `p_i`.
+   */
   float mass;
-  // The agent's own inertia about its centre in `{C}` axes (kg m^2), row-major; zeros for
-  // the paper's point-mass model.
+  /*
+   The agent's own inertia about its centre in `{C}` axes (kg m^2), row-major; zeros for
+   the paper's point-mass model.
+   */
   float inertia[9];
 } TvmdAgent;
 
-// Limits shared by every agent: gimbal limits and thrust range (eq. 6), rotor model (eq. 5).
-typedef struct {
-  // `sigma_x`, limit of `|eta_x|` (rad), in `(0, pi/2]`.
+/*
+ Limits shared by every agent: gimbal limits and thrust range (eq. 6), rotor model (eq. 5).
+ */
+typedef struct TvmdLimits {
+  /*
+   `sigma_x`, limit of `|eta_x|` (rad), in `(0, pi/2]`.
+   */
   float sigma_x;
-  // `sigma_y`, limit of `|eta_y|` (rad), in `(0, pi/2]`.
+  /*
+   `sigma_y`, limit of `|eta_y|` (rad), in `(0, pi/2]`.
+   */
   float sigma_y;
-  // `sigma_Tf`, the maximum thrust of one agent (N) (with `TVMD_ROTOR_NORMALIZED`).
+  /*
+   `sigma_Tf`, the maximum thrust of one agent (N) (with `TVMD_ROTOR_NORMALIZED`).
+   */
   float max_thrust;
-  // The idle thrust (N), in `[0, sigma_Tf)`.
+  /*
+   The idle thrust (N), in `[0, sigma_Tf)`.
+   */
   float min_thrust;
-  // `TVMD_ROTOR_NORMALIZED` or `TVMD_ROTOR_CONSTANTS`.
+  /*
+   `TVMD_ROTOR_NORMALIZED` or `TVMD_ROTOR_CONSTANTS`.
+   */
   uint32_t rotor_model;
-  // Air density `rho` (kg/m^3) (with `TVMD_ROTOR_CONSTANTS`).
+  /*
+   Air density `rho` (kg/m^3) (with `TVMD_ROTOR_CONSTANTS`).
+   */
   float rho;
-  // Rotor diameter `d` (m) (with `TVMD_ROTOR_CONSTANTS`).
+  /*
+   Rotor diameter `d` (m) (with `TVMD_ROTOR_CONSTANTS`).
+   */
   float rotor_diameter;
-  // Lift coefficient `c_l` (with `TVMD_ROTOR_CONSTANTS`).
+  /*
+   Lift coefficient `c_l` (with `TVMD_ROTOR_CONSTANTS`).
+   */
   float lift_coefficient;
-  // `sigma_omega`, the maximum rotor speed (rad/s) (with `TVMD_ROTOR_CONSTANTS`).
+  /*
+   `sigma_omega`, the maximum rotor speed (rad/s) (with `TVMD_ROTOR_CONSTANTS`).
+   */
   float max_rotor_speed;
 } TvmdLimits;
 
-// The gains of eq. (12), each a symmetric positive definite 3x3 matrix, row-major.
-typedef struct {
-  // `K_x`, position gain.
+/*
+ The gains of eq. (12), each a symmetric positive definite 3x3 matrix, row-major.
+ */
+typedef struct TvmdGains {
+  /*
+   `K_x`, position gain.
+   */
   float k_x[9];
-  // `K_R`, attitude gain.
+  /*
+   `K_R`, attitude gain.
+   */
   float k_r[9];
-  // `K_Omega`, angular-velocity block of `K_xi`.
+  /*
+   `K_Omega`, angular-velocity block of `K_xi`.
+   */
   float k_omega[9];
-  // `K_v`, velocity block of `K_xi`.
+  /*
+   `K_v`, velocity block of `K_xi`.
+   */
   float k_v[9];
 } TvmdGains;
 
-// The law beyond the paper: how the gains are formed, the offset-free action and the filter of
-// the planned attitude's rates. All numbers SI. A mode reads only its own fields; the fields
-// a mode does not use are ignored (any value, even NaN). Every number a mode uses must be
-// finite (`TVMD_ERR_CONFIG_NON_FINITE`) and positive (`TVMD_ERR_CONFIG_PARAMETER`); an unknown
-// mode is `TVMD_ERR_ENUM_VALUE`. All zeros is the paper's law.
-typedef struct {
-  // One of `TVMD_GAINS_*`.
+/*
+ The law beyond the paper: how the gains are formed, the offset-free action and the filter of
+ the planned attitude's rates. All numbers SI. A mode reads only its own fields; the fields
+ a mode does not use are ignored (any value, even NaN). Every number a mode uses must be
+ finite (`TVMD_ERR_CONFIG_NON_FINITE`) and positive (`TVMD_ERR_CONFIG_PARAMETER`); an unknown
+ mode is `TVMD_ERR_ENUM_VALUE`. All zeros is the paper's law.
+ */
+typedef struct TvmdLaw {
+  /*
+   One of `TVMD_GAINS_*`.
+   */
   uint32_t gain_schedule;
-  // Closed-loop natural frequency `w_x` (rad/s) of the position axes x, y, z (inertial), with
-  // `TVMD_GAINS_NATURAL`: `K_x = m_C diag(w_x^2)`.
+  /*
+   Closed-loop natural frequency `w_x` (rad/s) of the position axes x, y, z (inertial), with
+   `TVMD_GAINS_NATURAL`: `K_x = m_C diag(w_x^2)`.
+   */
   float position_frequency[3];
-  // Damping ratio `zeta_x` (dimensionless) of the position axes, with `TVMD_GAINS_NATURAL`:
-  // `K_v = m_C diag(2 zeta_x w_x)`.
+  /*
+   Damping ratio `zeta_x` (dimensionless) of the position axes, with `TVMD_GAINS_NATURAL`:
+   `K_v = m_C diag(2 zeta_x w_x)`.
+   */
   float position_damping[3];
-  // Closed-loop natural frequency `w_R` (rad/s) of roll, pitch, yaw (body), with
-  // `TVMD_GAINS_NATURAL`: `K_R = W J_C W`, `W = diag(w_R)`.
+  /*
+   Closed-loop natural frequency `w_R` (rad/s) of roll, pitch, yaw (body), with
+   `TVMD_GAINS_NATURAL`: `K_R = W J_C W`, `W = diag(w_R)`.
+   */
   float attitude_frequency[3];
-  // Damping ratio `zeta_R` (dimensionless) of roll, pitch, yaw, with `TVMD_GAINS_NATURAL`.
+  /*
+   Damping ratio `zeta_R` (dimensionless) of roll, pitch, yaw, with `TVMD_GAINS_NATURAL`.
+   */
   float attitude_damping[3];
-  // One of `TVMD_OFFSET_FREE_*`.
+  /*
+   One of `TVMD_OFFSET_FREE_*`.
+   */
   uint32_t offset_free;
-  // Observer bandwidth `L_f` (rad/s) of the force estimate, with
-  // `TVMD_OFFSET_FREE_OBSERVER`.
+  /*
+   Observer bandwidth `L_f` (rad/s) of the force estimate, with
+   `TVMD_OFFSET_FREE_OBSERVER`.
+   */
   float force_bandwidth;
-  // Observer bandwidth `L_tau` (rad/s) of the torque estimate, with
-  // `TVMD_OFFSET_FREE_OBSERVER`.
+  /*
+   Observer bandwidth `L_tau` (rad/s) of the torque estimate, with
+   `TVMD_OFFSET_FREE_OBSERVER`.
+   */
   float torque_bandwidth;
-  // Integral gain `K_Ix` (N/(m s)) per inertial axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+  /*
+   Integral gain `K_Ix` (N/(m s)) per inertial axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+   */
   float integral_k_x[3];
-  // Integral gain `K_IR` (N m/(rad s)) per body axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+  /*
+   Integral gain `K_IR` (N m/(rad s)) per body axis, with `TVMD_OFFSET_FREE_INTEGRAL`.
+   */
   float integral_k_r[3];
-  // Bound (N m) on the offset-free torque, with either offset-free action (the force is
-  // bounded by the working agents' capacity `n sigma_Tf`).
+  /*
+   Bound (N m) on the offset-free torque, with either offset-free action (the force is
+   bounded by the working agents' capacity `n sigma_Tf`).
+   */
   float max_torque;
-  // Non-zero: the law's `Omega_d`, `Omega_d_dot` are the filtered rates of the planned
-  // attitude `R_d` in place of the reference's (needed whenever the planner tilts away from
-  // the reference); zero: the reference's (the paper).
+  /*
+   Non-zero: the law's `Omega_d`, `Omega_d_dot` are the filtered rates of the planned
+   attitude `R_d` in place of the reference's (needed whenever the planner tilts away from
+   the reference); zero: the reference's (the paper).
+   */
   uint32_t attitude_rate;
-  // Bandwidth (rad/s) of the planned-rate filter, with `attitude_rate`.
+  /*
+   Bandwidth (rad/s) of the planned-rate filter, with `attitude_rate`.
+   */
   float attitude_rate_bandwidth;
-  // Bound (rad/s) on the planned rate, with `attitude_rate`.
+  /*
+   Bound (rad/s) on the planned rate, with `attitude_rate`.
+   */
   float attitude_rate_max;
 } TvmdLaw;
 
-// Everything `tvmd_create` needs. `tvmd_config_default` fills the paper's team and settings
-// with the offset-free law (the library's default); `tvmd_config_paper` the same team with the
-// paper's law.
-typedef struct {
-  // `sizeof(TvmdConfig)`.
+/*
+ Everything `tvmd_create` needs. `tvmd_config_default` fills the paper's team and settings
+ with the offset-free law (the library's default); `tvmd_config_paper` the same team with the
+ paper's law.
+ */
+typedef struct TvmdConfig {
+  /*
+   `sizeof(TvmdConfig)`.
+   */
   uint32_t size;
-  // `n`, the number of agents, `1..=TVMD_MAX_AGENTS`.
+  /*
+   `n`, the number of agents, `1..=TVMD_MAX_AGENTS`.
+   */
   uint32_t agent_count;
-  // The agents (the first `agent_count` are used).
-  TvmdAgent agents[TVMD_MAX_AGENTS];
-  // `m_0`, the navigator's mass at the team CoM (kg), `>= 0`.
+  /*
+   The agents (the first `agent_count` are used).
+   */
+  struct TvmdAgent agents[TVMD_MAX_AGENTS];
+  /*
+   `m_0`, the navigator's mass at the team CoM (kg), `>= 0`.
+   */
   float navigator_mass;
-  // `J_0`, the navigator's inertia about the team CoM (kg m^2), row-major.
+  /*
+   `J_0`, the navigator's inertia about the team CoM (kg m^2), row-major.
+   */
   float navigator_inertia[9];
-  // The agent limits.
-  TvmdLimits limits;
-  // The gains of eq. (12) (used as `law.gain_schedule` says; ignored with
-  // `TVMD_GAINS_NATURAL`).
-  TvmdGains gains;
-  // The AFS relaxation `s` of the planner, in `(0, 1]` (eq. 8).
+  /*
+   The agent limits.
+   */
+  struct TvmdLimits limits;
+  /*
+   The gains of eq. (12) (used as `law.gain_schedule` says; ignored with
+   `TVMD_GAINS_NATURAL`).
+   */
+  struct TvmdGains gains;
+  /*
+   The AFS relaxation `s` of the planner, in `(0, 1]` (eq. 8).
+   */
   float relaxation;
-  // `g` (m/s^2).
+  /*
+   `g` (m/s^2).
+   */
   float gravity;
-  // The control period `dt` (s).
+  /*
+   The control period `dt` (s).
+   */
   float period;
-  // Non-zero: limit the gimbal rates to `rate_limits` (rad/s, `[eta_x, eta_y]`).
+  /*
+   Non-zero: limit the gimbal rates to `rate_limits` (rad/s, `[eta_x, eta_y]`).
+   */
   uint32_t rate_limited;
-  // Gimbal rate limits (rad/s) when `rate_limited`.
+  /*
+   Gimbal rate limits (rad/s) when `rate_limited`.
+   */
   float rate_limits[2];
-  // One of `TVMD_ALLOCATOR_*`.
+  /*
+   One of `TVMD_ALLOCATOR_*`.
+   */
   uint32_t allocator;
-  // Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
-  // are used; ignored by the other allocators).
+  /*
+   Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
+   are used; ignored by the other allocators).
+   */
   float agent_weights[TVMD_MAX_AGENTS];
-  // The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
-  // zeros: the paper's law).
-  TvmdLaw law;
+  /*
+   The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
+   zeros: the paper's law).
+   */
+  struct TvmdLaw law;
 } TvmdConfig;
 
-// The measured state: pose and body-frame twist.
-typedef struct {
-  // `sizeof(TvmdState)`.
+/*
+ The measured state: pose and body-frame twist.
+ */
+typedef struct TvmdState {
+  /*
+   `sizeof(TvmdState)`.
+   */
   uint32_t size;
-  // `x`, CoM position, inertial frame (m), z up.
+  /*
+   `x`, CoM position, inertial frame (m), z up.
+   */
   float position[3];
-  // `R`, body-to-inertial rotation, row-major.
+  /*
+   `R`, body-to-inertial rotation, row-major.
+   */
   float attitude[9];
-  // `Omega`, body-frame angular velocity (rad/s).
+  /*
+   `Omega`, body-frame angular velocity (rad/s).
+   */
   float angular_velocity[3];
-  // `v`, body-frame linear velocity (m/s), `x_dot = R v`.
+  /*
+   `v`, body-frame linear velocity (m/s), `x_dot = R v`.
+   */
   float velocity[3];
 } TvmdState;
 
-// The full-pose reference.
-typedef struct {
-  // `sizeof(TvmdReference)`.
+/*
+ The full-pose reference.
+ */
+typedef struct TvmdReference {
+  /*
+   `sizeof(TvmdReference)`.
+   */
   uint32_t size;
-  // `x_r` (m).
+  /*
+   `x_r` (m).
+   */
   float position[3];
-  // `x_r_dot` (m/s), inertial.
+  /*
+   `x_r_dot` (m/s), inertial.
+   */
   float velocity[3];
-  // `x_r_ddot` (m/s^2), inertial.
+  /*
+   `x_r_ddot` (m/s^2), inertial.
+   */
   float acceleration[3];
-  // `R_r`, the reference attitude, row-major.
+  /*
+   `R_r`, the reference attitude, row-major.
+   */
   float attitude[9];
-  // `Omega_d` (rad/s), body frame of the reference.
+  /*
+   `Omega_d` (rad/s), body frame of the reference.
+   */
   float angular_velocity[3];
-  // `Omega_d_dot` (rad/s^2).
+  /*
+   `Omega_d_dot` (rad/s^2).
+   */
   float angular_acceleration[3];
 } TvmdReference;
 
-// What one `tvmd_step` produced.
-//
-// On an error status ("hold"), `commands` are the last good period's commands (idle before
-// the first good period, or when the handle is not initialized): inside `E_f`, never NaN, to
-// be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`,
-// `compensation_force`, `compensation_torque`) are NaN and `planner_status`/
-// `planner_iterations` 0 then: they were not computed this period.
-typedef struct {
-  // `sizeof(TvmdOutput)`, set by the caller.
+/*
+ What one `tvmd_step` produced.
+
+ On an error status ("hold"), `commands` are the last good period's commands (idle before
+ the first good period, or when the handle is not initialized): inside `E_f`, never NaN, to
+ be sent again. The diagnostics (`e_f`, `planned_attitude`, `planner_theta`,
+ `compensation_force`, `compensation_torque`) are NaN and `planner_status`/
+ `planner_iterations` 0 then: they were not computed this period.
+ */
+typedef struct TvmdOutput {
+  /*
+   `sizeof(TvmdOutput)`, set by the caller.
+   */
   uint32_t size;
-  // The status `tvmd_step` returned.
+  /*
+   The status `tvmd_step` returned.
+   */
   int32_t status;
-  // `n`; commands beyond it are idle.
+  /*
+   `n`; commands beyond it are idle.
+   */
   uint32_t agent_count;
-  // Per-agent commands inside `E_f` (idle for failed agents).
-  TvmdAgentCommand commands[TVMD_MAX_AGENTS];
-  // `e_f = ||u_fd - u_f||` (N), the allocation error of the force part.
+  /*
+   Per-agent commands inside `E_f` (idle for failed agents).
+   */
+  struct TvmdAgentCommand commands[TVMD_MAX_AGENTS];
+  /*
+   `e_f = ||u_fd - u_f||` (N), the allocation error of the force part.
+   */
   float e_f;
-  // `R_d`, the planned attitude, row-major.
+  /*
+   `R_d`, the planned attitude, row-major.
+   */
   float planned_attitude[9];
-  // `theta*`, the planner's tilt from `b_zr` toward `f_r` (rad).
+  /*
+   `theta*`, the planner's tilt from `b_zr` toward `f_r` (rad).
+   */
   float planner_theta;
-  // One of `TVMD_PLANNER_*`.
+  /*
+   One of `TVMD_PLANNER_*`.
+   */
   uint32_t planner_status;
-  // The planner's search steps.
+  /*
+   The planner's search steps.
+   */
   uint32_t planner_iterations;
-  // The offset-free force (N, inertial frame) as it stands after this period: what the
-  // next period adds to its request before its own update (the observer's estimate of the
-  // unmodelled force is its negative). Zero without an offset-free action and while landed
-  // (`tvmd_set_landed`).
+  /*
+   The offset-free force (N, inertial frame) as it stands after this period: what the
+   next period adds to its request before its own update (the observer's estimate of the
+   unmodelled force is its negative). Zero without an offset-free action and while landed
+   (`tvmd_set_landed`).
+   */
   float compensation_force[3];
-  // The offset-free torque (N m, body frame), as `compensation_force`.
+  /*
+   The offset-free torque (N m, body frame), as `compensation_force`.
+   */
   float compensation_torque[3];
 } TvmdOutput;
 
-// Whether the working agents can hold hover with a margin (the core's `HoverCapability`),
-// classified when the failure mask is set.
-typedef struct {
-  // `sizeof(TvmdHover)`, set by the caller.
+/*
+ Whether the working agents can hold hover with a margin (the core's `HoverCapability`),
+ classified when the failure mask is set.
+ */
+typedef struct TvmdHover {
+  /*
+   `sizeof(TvmdHover)`, set by the caller.
+   */
   uint32_t size;
-  // Non-zero when the hover wrench is strictly inside the attainable set.
+  /*
+   Non-zero when the hover wrench is strictly inside the attainable set.
+   */
   uint32_t capable;
-  // The smallest normalized slack of any working agent (`<= 1`; `<= 0` at a bound).
+  /*
+   The smallest normalized slack of any working agent (`<= 1`; `<= 0` at a bound).
+   */
   float margin;
-  // The agent whose slack is `margin`, or -1.
+  /*
+   The agent whose slack is `margin`, or -1.
+   */
   int32_t limiting_agent;
-  // The bound that agent is closest to, one of `TVMD_HOVER_LIMIT_*`.
+  /*
+   The bound that agent is closest to, one of `TVMD_HOVER_LIMIT_*`.
+   */
   uint32_t limit;
-  // `m_C g` (N).
+  /*
+   `m_C g` (N).
+   */
   float weight;
 } TvmdHover;
 
-// What `tvmd_attitude` returns. On an error the numbers are NaN.
-typedef struct {
-  // `sizeof(TvmdAttitudeOutput)`, set by the caller.
+/*
+ What `tvmd_attitude` returns. On an error the numbers are NaN.
+ */
+typedef struct TvmdAttitudeOutput {
+  /*
+   `sizeof(TvmdAttitudeOutput)`, set by the caller.
+   */
   uint32_t size;
-  // The status `tvmd_attitude` returned.
+  /*
+   The status `tvmd_attitude` returned.
+   */
   int32_t status;
-  // `u_tau_d` (N m), body frame.
+  /*
+   `u_tau_d` (N m), body frame.
+   */
   float torque[3];
-  // `e_R` against the planned attitude (rad), body frame.
+  /*
+   `e_R` against the planned attitude (rad), body frame.
+   */
   float attitude_error[3];
 } TvmdAttitudeOutput;
 
-// What `tvmd_law` returns: the body wrench for `tvmd_allocate` and the law's diagnostics. On
-// an error every number is NaN and `planner_status`/`planner_iterations` are 0.
-typedef struct {
-  // `sizeof(TvmdLawOutput)`, set by the caller.
+/*
+ What `tvmd_law` returns: the body wrench for `tvmd_allocate` and the law's diagnostics. On
+ an error every number is NaN and `planner_status`/`planner_iterations` are 0.
+ */
+typedef struct TvmdLawOutput {
+  /*
+   `sizeof(TvmdLawOutput)`, set by the caller.
+   */
   uint32_t size;
-  // The status `tvmd_law` returned.
+  /*
+   The status `tvmd_law` returned.
+   */
   int32_t status;
-  // `u_tau_d` (N m), body frame: the torque to allocate.
+  /*
+   `u_tau_d` (N m), body frame: the torque to allocate.
+   */
   float torque[3];
-  // `u_fd = K_f u_fr` (N), body frame: the force to allocate.
+  /*
+   `u_fd = K_f u_fr` (N), body frame: the force to allocate.
+   */
   float force[3];
-  // `R_d`, the planned attitude, row-major.
+  /*
+   `R_d`, the planned attitude, row-major.
+   */
   float planned_attitude[9];
-  // `theta*` (rad).
+  /*
+   `theta*` (rad).
+   */
   float planner_theta;
-  // One of `TVMD_PLANNER_*`.
+  /*
+   One of `TVMD_PLANNER_*`.
+   */
   uint32_t planner_status;
-  // The planner's search steps.
+  /*
+   The planner's search steps.
+   */
   uint32_t planner_iterations;
-  // `e_x = x - x_r` (m), inertial frame.
+  /*
+   `e_x = x - x_r` (m), inertial frame.
+   */
   float position_error[3];
-  // `e_R` against `R_d` (rad), body frame.
+  /*
+   `e_R` against `R_d` (rad), body frame.
+   */
   float attitude_error[3];
 } TvmdLawOutput;
 
-// A body wrench `[u_tau; u_f]` in the team's body frame `{C}` (z up, as the state).
-typedef struct {
-  // `sizeof(TvmdWrench)`.
+/*
+ A body wrench `[u_tau; u_f]` in the team's body frame `{C}` (z up, as the state).
+ */
+typedef struct TvmdWrench {
+  /*
+   `sizeof(TvmdWrench)`.
+   */
   uint32_t size;
-  // `u_tau` (N m), body frame.
+  /*
+   `u_tau` (N m), body frame.
+   */
   float torque[3];
-  // `u_f` (N), body frame.
+  /*
+   `u_f` (N), body frame.
+   */
   float force[3];
 } TvmdWrench;
 
-// What `tvmd_allocate` returns. On an error `commands` are the held ones (as `tvmd_step`'s)
-// and every number is NaN, `saturated` 0.
-typedef struct {
-  // `sizeof(TvmdAllocationOutput)`, set by the caller.
+/*
+ What `tvmd_allocate` returns. On an error `commands` are the held ones (as `tvmd_step`'s)
+ and every number is NaN, `saturated` 0.
+ */
+typedef struct TvmdAllocationOutput {
+  /*
+   `sizeof(TvmdAllocationOutput)`, set by the caller.
+   */
   uint32_t size;
-  // The status `tvmd_allocate` returned.
+  /*
+   The status `tvmd_allocate` returned.
+   */
   int32_t status;
-  // `n`; commands beyond it are idle.
+  /*
+   `n`; commands beyond it are idle.
+   */
   uint32_t agent_count;
-  // Per-agent commands inside `E_f` (idle for failed agents).
-  TvmdAgentCommand commands[TVMD_MAX_AGENTS];
-  // The allocated torque `u_tau = (M f)_tau` (N m), body frame.
+  /*
+   Per-agent commands inside `E_f` (idle for failed agents).
+   */
+  struct TvmdAgentCommand commands[TVMD_MAX_AGENTS];
+  /*
+   The allocated torque `u_tau = (M f)_tau` (N m), body frame.
+   */
   float allocated_torque[3];
-  // The allocated force `u_f = (M f)_f` (N), body frame.
+  /*
+   The allocated force `u_f = (M f)_f` (N), body frame.
+   */
   float allocated_force[3];
-  // `||u_fd - u_f||` (N), the force the team could not deliver (`e_f`).
+  /*
+   `||u_fd - u_f||` (N), the force the team could not deliver (`e_f`).
+   */
   float force_error;
-  // `||u_tau_d - u_tau||` (N m), the torque the team could not deliver.
+  /*
+   `||u_tau_d - u_tau||` (N m), the torque the team could not deliver.
+   */
   float torque_error;
-  // Bit `i` set: agent `i`'s force lies on the boundary of its admissible set (a gimbal or
-  // thrust limit holds it).
+  /*
+   Bit `i` set: agent `i`'s force lies on the boundary of its admissible set (a gimbal or
+   thrust limit holds it).
+   */
   uint32_t saturated;
 } TvmdAllocationOutput;
 
-// What `tvmd_plan` returns. On an error the numbers are NaN and the counts 0.
-typedef struct {
-  // `sizeof(TvmdPlanOutput)`, set by the caller.
+/*
+ What `tvmd_plan` returns. On an error the numbers are NaN and the counts 0.
+ */
+typedef struct TvmdPlanOutput {
+  /*
+   `sizeof(TvmdPlanOutput)`, set by the caller.
+   */
   uint32_t size;
-  // The status `tvmd_plan` returned.
+  /*
+   The status `tvmd_plan` returned.
+   */
   int32_t status;
-  // `R_d`, the planned attitude, row-major.
+  /*
+   `R_d`, the planned attitude, row-major.
+   */
   float planned_attitude[9];
-  // `theta*` (rad).
+  /*
+   `theta*` (rad).
+   */
   float theta;
-  // One of `TVMD_PLANNER_*`.
+  /*
+   One of `TVMD_PLANNER_*`.
+   */
   uint32_t planner_status;
-  // The planner's search steps.
+  /*
+   The planner's search steps.
+   */
   uint32_t iterations;
 } TvmdPlanOutput;
 
-// Success.
+/*
+ Success.
+ */
 #define TVMD_OK 0
 
-// A required pointer argument is null.
+/*
+ A required pointer argument is null.
+ */
 #define TVMD_ERR_NULL_POINTER 1
 
-// A struct's `size` field (or the storage size argument) is not this library's
-// `sizeof` of it: the caller was built against another version of `tvmd.h`.
+/*
+ A struct's `size` field (or the storage size argument) is not this library's
+ `sizeof` of it: the caller was built against another version of `tvmd.h`.
+ */
 #define TVMD_ERR_SIZE 2
 
-// The controller storage is not aligned to `tvmd_controller_align()`.
+/*
+ The controller storage is not aligned to `tvmd_controller_align()`.
+ */
 #define TVMD_ERR_ALIGNMENT 3
 
-// The handle was never created, or its last `tvmd_create` failed.
+/*
+ The handle was never created, or its last `tvmd_create` failed.
+ */
 #define TVMD_ERR_NOT_INITIALIZED 4
 
-// An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
-// `map.motor_curve`) has a value this library does not know.
+/*
+ An enum field (`limits.rotor_model`, `law.gain_schedule`, `law.offset_free`,
+ `map.motor_curve`) has a value this library does not know.
+ */
 #define TVMD_ERR_ENUM_VALUE 5
 
-// The handle's storage was overwritten: its start says created, but the guard at its end
-// does not hold (a neighbouring buffer overran it). Create the controller again.
+/*
+ The handle's storage was overwritten: its start says created, but the guard at its end
+ does not hold (a neighbouring buffer overran it). Create the controller again.
+ */
 #define TVMD_ERR_CORRUPTED 6
 
-// [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
+/*
+ [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.
+ */
 #define TVMD_ERR_INPUT_NON_FINITE 10
 
-// [`InputError::NotRotation`]: an attitude input is not a rotation matrix.
+/*
+ [`InputError::NotRotation`]: an attitude input is not a rotation matrix.
+ */
 #define TVMD_ERR_INPUT_NOT_ROTATION 11
 
-// [`InputError::OutOfRange`]: a finite input beyond the controller's bound
-// (`Controller::input_limit`).
+/*
+ [`InputError::OutOfRange`]: a finite input beyond the controller's bound
+ (`Controller::input_limit`).
+ */
 #define TVMD_ERR_INPUT_OUT_OF_RANGE 12
 
-// [`InputError::Unattainable`]: the only admissible answer to a non-zero force request is
-// zero thrust everywhere (refused rather than a free fall).
+/*
+ [`InputError::Unattainable`]: the only admissible answer to a non-zero force request is
+ zero thrust everywhere (refused rather than a free fall).
+ */
 #define TVMD_ERR_INPUT_UNATTAINABLE 13
 
-// [`InputError::Overflow`]: a non-finite output although the inputs were in range (a bug).
+/*
+ [`InputError::Overflow`]: a non-finite output although the inputs were in range (a bug).
+ */
 #define TVMD_ERR_INPUT_OVERFLOW 14
 
-// [`ConfigError::NoAgents`]: no agent, or every agent marked failed.
+/*
+ [`ConfigError::NoAgents`]: no agent, or every agent marked failed.
+ */
 #define TVMD_ERR_CONFIG_NO_AGENTS 20
 
-// [`ConfigError::TooManyAgents`]: `agent_count` above `TVMD_MAX_AGENTS`.
+/*
+ [`ConfigError::TooManyAgents`]: `agent_count` above `TVMD_MAX_AGENTS`.
+ */
 #define TVMD_ERR_CONFIG_TOO_MANY_AGENTS 21
 
-// [`ConfigError::NonFinite`]: a NaN or infinite configuration number (also a gain that the
-// gain schedule makes overflow).
+/*
+ [`ConfigError::NonFinite`]: a NaN or infinite configuration number (also a gain that the
+ gain schedule makes overflow).
+ */
 #define TVMD_ERR_CONFIG_NON_FINITE 22
 
-// [`ConfigError::GimbalLimit`]: `sigma_x` or `sigma_y` outside `(0, pi/2]`.
+/*
+ [`ConfigError::GimbalLimit`]: `sigma_x` or `sigma_y` outside `(0, pi/2]`.
+ */
 #define TVMD_ERR_CONFIG_GIMBAL_LIMIT 23
 
-// [`ConfigError::NonPositiveMass`]: an agent mass `<= 0` or a navigator mass `< 0`.
+/*
+ [`ConfigError::NonPositiveMass`]: an agent mass `<= 0` or a navigator mass `< 0`.
+ */
 #define TVMD_ERR_CONFIG_MASS 24
 
-// [`ConfigError::NonPositiveThrust`]: `max_thrust` or a rotor constant `<= 0`.
+/*
+ [`ConfigError::NonPositiveThrust`]: `max_thrust` or a rotor constant `<= 0`.
+ */
 #define TVMD_ERR_CONFIG_THRUST 25
 
-// [`ConfigError::IdleThrust`]: `min_thrust` outside `[0, max_thrust)`.
+/*
+ [`ConfigError::IdleThrust`]: `min_thrust` outside `[0, max_thrust)`.
+ */
 #define TVMD_ERR_CONFIG_IDLE_THRUST 26
 
-// [`ConfigError::NavigatorInertia`]: not symmetric positive semi-definite.
+/*
+ [`ConfigError::NavigatorInertia`]: not symmetric positive semi-definite.
+ */
 #define TVMD_ERR_CONFIG_NAVIGATOR_INERTIA 27
 
-// [`ConfigError::AgentInertia`]: an agent inertia not symmetric positive semi-definite.
+/*
+ [`ConfigError::AgentInertia`]: an agent inertia not symmetric positive semi-definite.
+ */
 #define TVMD_ERR_CONFIG_AGENT_INERTIA 28
 
-// [`ConfigError::NotSymmetricPositiveDefinite`]: a gain or the team inertia.
+/*
+ [`ConfigError::NotSymmetricPositiveDefinite`]: a gain or the team inertia.
+ */
 #define TVMD_ERR_CONFIG_NOT_SPD 29
 
-// [`ConfigError::Overflow`]: finite values whose derived quantity overflows `f32`.
+/*
+ [`ConfigError::Overflow`]: finite values whose derived quantity overflows `f32`.
+ */
 #define TVMD_ERR_CONFIG_OVERFLOW 30
 
-// [`ConfigError::RankDeficient`]: the (working) team cannot produce every wrench.
+/*
+ [`ConfigError::RankDeficient`]: the (working) team cannot produce every wrench.
+ */
 #define TVMD_ERR_CONFIG_RANK_DEFICIENT 31
 
-// [`ConfigError::AgentCount`]: `n_x > n` (not reachable through this API; kept one-to-one).
+/*
+ [`ConfigError::AgentCount`]: `n_x > n` (not reachable through this API; kept one-to-one).
+ */
 #define TVMD_ERR_CONFIG_AGENT_COUNT 32
 
-// [`ConfigError::Relaxation`]: the relaxation `s` outside `(0, 1]`.
+/*
+ [`ConfigError::Relaxation`]: the relaxation `s` outside `(0, 1]`.
+ */
 #define TVMD_ERR_CONFIG_RELAXATION 33
 
-// [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
-// `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
-// planned-rate bandwidth or bound) not positive.
+/*
+ [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
+ `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
+ planned-rate bandwidth or bound) not positive.
+ */
 #define TVMD_ERR_CONFIG_PARAMETER 34
 
-// [`ConfigError::FailureIndex`]: a failure mask bit at or beyond the team's agent count.
+/*
+ [`ConfigError::FailureIndex`]: a failure mask bit at or beyond the team's agent count.
+ */
 #define TVMD_ERR_CONFIG_FAILURE_INDEX 35
 
-// [`ConfigError::UnknownAllocator`]: `allocator` is none of `TVMD_ALLOCATOR_*`.
+/*
+ [`ConfigError::UnknownAllocator`]: `allocator` is none of `TVMD_ALLOCATOR_*`.
+ */
 #define TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR 36
 
-// [`ConfigError::AllocatorUnavailable`]: the allocator needs a feature this build lacks.
+/*
+ [`ConfigError::AllocatorUnavailable`]: the allocator needs a feature this build lacks.
+ */
 #define TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE 37
 
-// [`ConfigError::UnusedOption`]: an option the chosen allocator does not take.
+/*
+ [`ConfigError::UnusedOption`]: an option the chosen allocator does not take.
+ */
 #define TVMD_ERR_CONFIG_UNUSED_OPTION 38
 
-// The actuator map's agent count is not the controller's.
+/*
+ The actuator map's agent count is not the controller's.
+ */
 #define TVMD_ERR_MAP_AGENT_COUNT 50
 
-// A channel index of the actuator map is at or beyond `TVMD_MAX_AGENTS` (16 channels).
+/*
+ A channel index of the actuator map is at or beyond `TVMD_MAX_AGENTS` (16 channels).
+ */
 #define TVMD_ERR_MAP_CHANNEL_RANGE 51
 
-// Two outputs of the actuator map share a channel (motors and servos are counted apart).
+/*
+ Two outputs of the actuator map share a channel (motors and servos are counted apart).
+ */
 #define TVMD_ERR_MAP_DUPLICATE_CHANNEL 52
 
-// A servo's trim, direction or range is unusable: not finite, direction not `+1`/`-1`,
-// range `<= 0`, or `|trim| + sigma / range > 1` (the gimbal's travel would leave `[-1, 1]`).
+/*
+ A servo's trim, direction or range is unusable: not finite, direction not `+1`/`-1`,
+ range `<= 0`, or `|trim| + sigma / range > 1` (the gimbal's travel would leave `[-1, 1]`).
+ */
 #define TVMD_ERR_MAP_SERVO 53
 
-// A command given to `tvmd_actuator_outputs` is not finite or outside `E_f`; or an actuator
-// output given to the inverse mapping is not finite, outside its range, or an agent's two
-// motor channels differ.
+/*
+ A command given to `tvmd_actuator_outputs` is not finite or outside `E_f`; or an actuator
+ output given to the inverse mapping is not finite, outside its range, or an agent's two
+ motor channels differ.
+ */
 #define TVMD_ERR_ACTUATOR_VALUE 54
 
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
 
-// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
+/*
+ The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
+ */
 uint32_t tvmd_abi_version(void);
 
-// The crate version as a NUL-terminated static string (never null, never freed).
+/*
+ The crate version as a NUL-terminated static string (never null, never freed).
+ */
 const char *tvmd_version(void);
 
-// Fills `map` with the default layout: agent `i` on motors `2i, 2i+1` and servos `2i`
-// (`eta_x`), `2i+1` (`eta_y`), trim 0, direction +1, range = the gimbal limit (so
-// `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 8 agents need a map of
-// their own (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
-//
-// # Safety
-// `handle` is null or a `TvmdController`; `map` is null or points to a `TvmdActuatorMap`.
-TvmdStatus tvmd_actuator_map_default(const TvmdController *handle, TvmdActuatorMap *map);
+/*
+ Fills `map` with the default layout: agent `i` on motors `2i, 2i+1` and servos `2i`
+ (`eta_x`), `2i+1` (`eta_y`), trim 0, direction +1, range = the gimbal limit (so
+ `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 8 agents need a map of
+ their own (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
 
-// Checks `map` against the controller's team: agent count, channels within 16 and distinct
-// (per kind), servo trim/direction/range usable, a known motor curve.
-//
-// # Safety
-// As [`tvmd_actuator_map_default`].
-TvmdStatus tvmd_actuator_map_validate(const TvmdController *handle, const TvmdActuatorMap *map);
+ # Safety
+ `handle` is null or a `TvmdController`; `map` is null or points to a `TvmdActuatorMap`.
+ */
+TvmdStatus tvmd_actuator_map_default(const struct TvmdController *handle,
+                                     struct TvmdActuatorMap *map);
 
-// Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
-// and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
-// mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
-// command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
-// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status
-// too: its commands are the held ones.
-//
-// # Safety
-// `commands` is null or points to `count` commands; the other pointers as
-// [`tvmd_actuator_map_default`], `outputs` writable.
-TvmdStatus tvmd_actuator_outputs(const TvmdController *handle,
-                                 const TvmdActuatorMap *map,
-                                 const TvmdAgentCommand *commands,
+/*
+ Checks `map` against the controller's team: agent count, channels within 16 and distinct
+ (per kind), servo trim/direction/range usable, a known motor curve.
+
+ # Safety
+ As [`tvmd_actuator_map_default`].
+ */
+TvmdStatus tvmd_actuator_map_validate(const struct TvmdController *handle,
+                                      const struct TvmdActuatorMap *map);
+
+/*
+ Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
+ and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
+ mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
+ command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
+ clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status
+ too: its commands are the held ones.
+
+ # Safety
+ `commands` is null or points to `count` commands; the other pointers as
+ [`tvmd_actuator_map_default`], `outputs` writable.
+ */
+TvmdStatus tvmd_actuator_outputs(const struct TvmdController *handle,
+                                 const struct TvmdActuatorMap *map,
+                                 const struct TvmdAgentCommand *commands,
                                  size_t count,
-                                 TvmdActuatorOutputs *outputs);
+                                 struct TvmdActuatorOutputs *outputs);
 
-// The inverse of [`tvmd_actuator_outputs`] (for tests and telemetry): the commands that
-// `outputs` encodes through `map`, into `commands` (`count >= agent_count` entries; the rest
-// are not written). Failed agents read as idle. `TVMD_ERR_ACTUATOR_VALUE` if a used channel
-// is not finite, outside its range, or an agent's two motor channels differ.
-//
-// # Safety
-// `commands` is null or points to `count` writable commands; the other pointers as
-// [`tvmd_actuator_map_default`].
-TvmdStatus tvmd_actuator_commands(const TvmdController *handle,
-                                  const TvmdActuatorMap *map,
-                                  const TvmdActuatorOutputs *outputs,
-                                  TvmdAgentCommand *commands,
+/*
+ The inverse of [`tvmd_actuator_outputs`] (for tests and telemetry): the commands that
+ `outputs` encodes through `map`, into `commands` (`count >= agent_count` entries; the rest
+ are not written). Failed agents read as idle. `TVMD_ERR_ACTUATOR_VALUE` if a used channel
+ is not finite, outside its range, or an agent's two motor channels differ.
+
+ # Safety
+ `commands` is null or points to `count` writable commands; the other pointers as
+ [`tvmd_actuator_map_default`].
+ */
+TvmdStatus tvmd_actuator_commands(const struct TvmdController *handle,
+                                  const struct TvmdActuatorMap *map,
+                                  const struct TvmdActuatorOutputs *outputs,
+                                  struct TvmdAgentCommand *commands,
                                   size_t count);
 
-// Fills `config` with the library's default: the paper's team "A4 inc, 1 navigator" and
-// settings (as `tvmd_config_paper`) flown with the offset-free law (the core's
-// `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
-// damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
-// (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
-// (20 rad/s, 5 rad/s bound). This law holds its setpoint under model error and unmodelled
-// forces, where the paper's law leaves a steady error. The caller sets `config->size` first.
-//
-// # Safety
-// `config` is null or points to a writable `TvmdConfig`.
-TvmdStatus tvmd_config_default(TvmdConfig *config);
+/*
+ Fills `config` with the library's default: the paper's team "A4 inc, 1 navigator" and
+ settings (as `tvmd_config_paper`) flown with the offset-free law (the core's
+ `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
+ damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
+ (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
+ (20 rad/s, 5 rad/s bound). This law holds its setpoint under model error and unmodelled
+ forces, where the paper's law leaves a steady error. The caller sets `config->size` first.
 
-// Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
-// square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
-// `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
-// no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
-// and Python interfaces) and the paper's law: gains as given, no offset-free action, the
-// reference's rates (every `law` mode off; its numbers are those of `tvmd_config_default`, so
-// switching one mode on starts from the library's values). The caller sets `config->size`
-// first.
-//
-// # Safety
-// `config` is null or points to a writable `TvmdConfig`.
-TvmdStatus tvmd_config_paper(TvmdConfig *config);
+ # Safety
+ `config` is null or points to a writable `TvmdConfig`.
+ */
+TvmdStatus tvmd_config_default(struct TvmdConfig *config);
 
-// The bytes of caller memory a controller needs (`sizeof(TvmdController)`).
+/*
+ Fills `config` with the paper's team "A4 inc, 1 navigator" (four 0.7 kg agents on a
+ square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
+ `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
+ no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
+ and Python interfaces) and the paper's law: gains as given, no offset-free action, the
+ reference's rates (every `law` mode off; its numbers are those of `tvmd_config_default`, so
+ switching one mode on starts from the library's values). The caller sets `config->size`
+ first.
+
+ # Safety
+ `config` is null or points to a writable `TvmdConfig`.
+ */
+TvmdStatus tvmd_config_paper(struct TvmdConfig *config);
+
+/*
+ The bytes of caller memory a controller needs (`sizeof(TvmdController)`).
+ */
 size_t tvmd_controller_size(void);
 
-// The alignment, in bytes, caller memory for a controller needs.
+/*
+ The alignment, in bytes, caller memory for a controller needs.
+ */
 size_t tvmd_controller_align(void);
 
-// Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
-// On an error the storage is marked not initialized, and every other entry point refuses it.
-// Calling it again on a created handle replaces the controller.
-//
-// # Safety
-// `storage` is null or points to writable memory of `storage_size` bytes not used otherwise;
-// `config` is null or points to a `TvmdConfig`.
-TvmdStatus tvmd_create(TvmdController *storage, size_t storage_size, const TvmdConfig *config);
+/*
+ Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
+ On an error the storage is marked not initialized, and every other entry point refuses it.
+ Calling it again on a created handle replaces the controller.
 
-// One control period. Fills `out` (whose `size` the caller sets) and returns its status.
-//
-// On any error after `out` was found usable, `out` holds the previous good commands (see
-// [`TvmdOutput`]): null `state`/`reference`, a wrong `size`, a non-finite, non-rotation or
-// out-of-range input, an unattainable request. A null or wrongly sized `out` is not written.
-//
-// # Safety
-// Each pointer is null or points to its struct; `handle` as for [`tvmd_create`].
-TvmdStatus tvmd_step(TvmdController *handle,
-                     const TvmdState *state,
-                     const TvmdReference *reference,
-                     TvmdOutput *out);
+ # Safety
+ `storage` is null or points to writable memory of `storage_size` bytes not used otherwise;
+ `config` is null or points to a `TvmdConfig`.
+ */
+TvmdStatus tvmd_create(struct TvmdController *storage,
+                       size_t storage_size,
+                       const struct TvmdConfig *config);
 
-// Marks the agents whose bit is set in `failed_mask` (bit `i` = agent `i`) as failed and
-// classifies whether the working agents can hold hover; fills `hover` unless it is null.
-// On an error (a bit at or beyond the team's size, no working agent, a rank-deficient
-// remaining team) the previous mask stays in force.
-//
-// # Safety
-// `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
-TvmdStatus tvmd_set_failures(TvmdController *handle, uint32_t failed_mask, TvmdHover *hover);
+/*
+ One control period. Fills `out` (whose `size` the caller sets) and returns its status.
 
-// The hover classification of the mask in force (the full team's after `tvmd_create`).
-//
-// # Safety
-// `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
-TvmdStatus tvmd_hover_capability(const TvmdController *handle, TvmdHover *hover);
+ On any error after `out` was found usable, `out` holds the previous good commands (see
+ [`TvmdOutput`]): null `state`/`reference`, a wrong `size`, a non-finite, non-rotation or
+ out-of-range input, an unattainable request. A null or wrongly sized `out` is not written.
 
-// Forgets the previous command: the next held command is idle, and rate limits restart from
-// a centred gimbal; the offset-free state restarts from zero and the planned-rate filter at
-// rest. Configuration, failure mask and the landed flag (`tvmd_set_landed`) are kept.
-//
-// # Safety
-// `handle` as for [`tvmd_step`].
-TvmdStatus tvmd_reset(TvmdController *handle);
+ # Safety
+ Each pointer is null or points to its struct; `handle` as for [`tvmd_create`].
+ */
+TvmdStatus tvmd_step(struct TvmdController *handle,
+                     const struct TvmdState *state,
+                     const struct TvmdReference *reference,
+                     struct TvmdOutput *out);
 
-// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
-// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
-// otherwise (every other entry point makes the same check first).
-//
-// # Safety
-// `handle` as for [`tvmd_step`].
-TvmdStatus tvmd_check(const TvmdController *handle);
+/*
+ Marks the agents whose bit is set in `failed_mask` (bit `i` = agent `i`) as failed and
+ classifies whether the working agents can hold hover; fills `hover` unless it is null.
+ On an error (a bit at or beyond the team's size, no working agent, a rank-deficient
+ remaining team) the previous mask stays in force.
 
-// Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
-// (zero), from the caller's contact or landing detector. While landed the offset-free state
-// is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
-// not a disturbance to compensate, and nothing winds up against it. Call it with 1 on the
-// ground before take-off and again after touch-down, and with 0 at take-off, from which the
-// offset-free state starts again from zero. Nothing else changes, and it has no effect
-// without an offset-free action (`law.offset_free`). A created handle starts not landed.
-//
-// # Safety
-// `handle` as for [`tvmd_step`].
-TvmdStatus tvmd_set_landed(TvmdController *handle, uint32_t landed);
+ # Safety
+ `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
+ */
+TvmdStatus tvmd_set_failures(struct TvmdController *handle,
+                             uint32_t failed_mask,
+                             struct TvmdHover *hover);
 
-// Checks `config` as `tvmd_create` would (every field, the team's rank, the law), without
-// creating anything: `TVMD_OK` or the status `tvmd_create` would return. Builds the
-// controller on the stack to check it, so it costs what `tvmd_create` costs: call it before
-// flight or from a task with that stack, not from the control loop.
-//
-// # Safety
-// `config` is null or points to a `TvmdConfig`.
-TvmdStatus tvmd_validate_config(const TvmdConfig *config);
+/*
+ The hover classification of the mask in force (the full team's after `tvmd_create`).
 
-// Replaces the running controller's configuration, all or nothing: the new controller is
-// built and given the running one's failure mask, landed flag, held commands (agent by agent,
-// where admissible for the new configuration; otherwise idle) and offset-free estimate (when
-// both run the same kind of action); only then does it replace the running one. On any error
-// the running controller is untouched and steps exactly as before. As `tvmd_validate_config`,
-// it costs what `tvmd_create` costs.
-//
-// # Safety
-// `handle` as for `tvmd_step`; `config` is null or points to a `TvmdConfig`.
-TvmdStatus tvmd_reconfigure(TvmdController *handle, const TvmdConfig *config);
+ # Safety
+ `handle` as for [`tvmd_step`]; `hover` is null or points to a `TvmdHover`.
+ */
+TvmdStatus tvmd_hover_capability(const struct TvmdController *handle, struct TvmdHover *hover);
 
-// New gains of eq. (12) for the running controller (resolved by its law's gain schedule).
-// A gain that is not symmetric positive definite is refused and nothing changes.
-//
-// # Safety
-// `handle` as for `tvmd_step`; `gains` is null or points to a `TvmdGains`.
-TvmdStatus tvmd_set_gains(TvmdController *handle, const TvmdGains *gains);
+/*
+ Forgets the previous command: the next held command is idle, and rate limits restart from
+ a centred gimbal; the offset-free state restarts from zero and the planned-rate filter at
+ rest. Configuration, failure mask and the landed flag (`tvmd_set_landed`) are kept.
 
-// A new AFS relaxation `s` in `(0, 1]` for the planner, from the next period on. Anything
-// else is refused (`TVMD_ERR_CONFIG_RELAXATION`) and nothing changes.
-//
-// # Safety
-// `handle` as for `tvmd_step`.
-TvmdStatus tvmd_set_relaxation(TvmdController *handle, float relaxation);
+ # Safety
+ `handle` as for [`tvmd_step`].
+ */
+TvmdStatus tvmd_reset(struct TvmdController *handle);
 
-// Gimbal rate limits `[eta_x, eta_y]` (rad/s, positive) from the next period on when
-// `enabled` is non-zero (`limits` then points to 2 floats), none when it is zero (`limits`
-// may be null). A bad limit is refused and nothing changes.
-//
-// # Safety
-// `handle` as for `tvmd_step`; `limits` is null or points to 2 floats.
-TvmdStatus tvmd_set_rate_limits(TvmdController *handle, uint32_t enabled, const float *limits);
+/*
+ The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+ around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+ otherwise (every other entry point makes the same check first).
 
-// The commands the vehicle flies now (at a switch from another controller) become the held
-// ones: what a refused period repeats and where the rate limits start. `commands` holds
-// `count` entries, `count` = the team's agent count; each working agent's command must lie in
-// its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
-// command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
-// `count`: `TVMD_ERR_SIZE`) and the held commands stay.
-//
-// # Safety
-// `handle` as for `tvmd_step`; `commands` is null or points to `count` `TvmdAgentCommand`s.
-TvmdStatus tvmd_seed_commands(TvmdController *handle,
-                              const TvmdAgentCommand *commands,
+ # Safety
+ `handle` as for [`tvmd_step`].
+ */
+TvmdStatus tvmd_check(const struct TvmdController *handle);
+
+/*
+ Tells the controller whether the team stands on the ground (`landed` non-zero) or flies
+ (zero), from the caller's contact or landing detector. While landed the offset-free state
+ is cleared and held at zero (`TvmdOutput.compensation_*` are zero): the ground's reaction is
+ not a disturbance to compensate, and nothing winds up against it. Call it with 1 on the
+ ground before take-off and again after touch-down, and with 0 at take-off, from which the
+ offset-free state starts again from zero. Nothing else changes, and it has no effect
+ without an offset-free action (`law.offset_free`). A created handle starts not landed.
+
+ # Safety
+ `handle` as for [`tvmd_step`].
+ */
+TvmdStatus tvmd_set_landed(struct TvmdController *handle, uint32_t landed);
+
+/*
+ Checks `config` as `tvmd_create` would (every field, the team's rank, the law), without
+ creating anything: `TVMD_OK` or the status `tvmd_create` would return. Builds the
+ controller on the stack to check it, so it costs what `tvmd_create` costs: call it before
+ flight or from a task with that stack, not from the control loop.
+
+ # Safety
+ `config` is null or points to a `TvmdConfig`.
+ */
+TvmdStatus tvmd_validate_config(const struct TvmdConfig *config);
+
+/*
+ Replaces the running controller's configuration, all or nothing: the new controller is
+ built and given the running one's failure mask, landed flag, held commands (agent by agent,
+ where admissible for the new configuration; otherwise idle) and offset-free estimate (when
+ both run the same kind of action); only then does it replace the running one. On any error
+ the running controller is untouched and steps exactly as before. As `tvmd_validate_config`,
+ it costs what `tvmd_create` costs.
+
+ # Safety
+ `handle` as for `tvmd_step`; `config` is null or points to a `TvmdConfig`.
+ */
+TvmdStatus tvmd_reconfigure(struct TvmdController *handle, const struct TvmdConfig *config);
+
+/*
+ New gains of eq. (12) for the running controller (resolved by its law's gain schedule).
+ A gain that is not symmetric positive definite is refused and nothing changes.
+
+ # Safety
+ `handle` as for `tvmd_step`; `gains` is null or points to a `TvmdGains`.
+ */
+TvmdStatus tvmd_set_gains(struct TvmdController *handle, const struct TvmdGains *gains);
+
+/*
+ A new AFS relaxation `s` in `(0, 1]` for the planner, from the next period on. Anything
+ else is refused (`TVMD_ERR_CONFIG_RELAXATION`) and nothing changes.
+
+ # Safety
+ `handle` as for `tvmd_step`.
+ */
+TvmdStatus tvmd_set_relaxation(struct TvmdController *handle, float relaxation);
+
+/*
+ Gimbal rate limits `[eta_x, eta_y]` (rad/s, positive) from the next period on when
+ `enabled` is non-zero (`limits` then points to 2 floats), none when it is zero (`limits`
+ may be null). A bad limit is refused and nothing changes.
+
+ # Safety
+ `handle` as for `tvmd_step`; `limits` is null or points to 2 floats.
+ */
+TvmdStatus tvmd_set_rate_limits(struct TvmdController *handle,
+                                uint32_t enabled,
+                                const float *limits);
+
+/*
+ The commands the vehicle flies now (at a switch from another controller) become the held
+ ones: what a refused period repeats and where the rate limits start. `commands` holds
+ `count` entries, `count` = the team's agent count; each working agent's command must lie in
+ its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+ command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
+ `count`: `TVMD_ERR_SIZE`) and the held commands stay.
+
+ # Safety
+ `handle` as for `tvmd_step`; `commands` is null or points to `count` `TvmdAgentCommand`s.
+ */
+TvmdStatus tvmd_seed_commands(struct TvmdController *handle,
+                              const struct TvmdAgentCommand *commands,
                               uint32_t count);
 
-// The attitude stage alone: eq. (12)'s torque for `planned_attitude` (9 floats, row-major:
-// the last `tvmd_law`'s `planned_attitude`) from this `state`, with `reference`'s angular
-// velocity and acceleration (the planned ones with the law's rate filter) and the offset-free
-// torque. Pair it with the last law period's force rotated into this state's body frame
-// (`R^T R_law u_fd`) and call `tvmd_allocate`: an attitude and allocation loop faster than the
-// law's. Changes nothing.
-//
-// # Safety
-// Each pointer is null or points to its struct (`planned_attitude` to 9 floats); `handle` as
-// for `tvmd_create`.
-TvmdStatus tvmd_attitude(const TvmdController *handle,
-                         const TvmdState *state,
+/*
+ The attitude stage alone: eq. (12)'s torque for `planned_attitude` (9 floats, row-major:
+ the last `tvmd_law`'s `planned_attitude`) from this `state`, with `reference`'s angular
+ velocity and acceleration (the planned ones with the law's rate filter) and the offset-free
+ torque. Pair it with the last law period's force rotated into this state's body frame
+ (`R^T R_law u_fd`) and call `tvmd_allocate`: an attitude and allocation loop faster than the
+ law's. Changes nothing.
+
+ # Safety
+ Each pointer is null or points to its struct (`planned_attitude` to 9 floats); `handle` as
+ for `tvmd_create`.
+ */
+TvmdStatus tvmd_attitude(const struct TvmdController *handle,
+                         const struct TvmdState *state,
                          const float *planned_attitude,
-                         const TvmdReference *reference,
-                         TvmdAttitudeOutput *out);
+                         const struct TvmdReference *reference,
+                         struct TvmdAttitudeOutput *out);
 
-// The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
-// the caller). With an offset-free action the next `tvmd_allocate` records the delivered
-// wrench for the observer (run the allocation after each law period). Errors: as
-// `tvmd_step`'s input checks; nothing is held (the law sends no commands).
-//
-// # Safety
-// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
-TvmdStatus tvmd_law(TvmdController *handle,
-                    const TvmdState *state,
-                    const TvmdReference *reference,
-                    TvmdLawOutput *out);
+/*
+ The law stage of a period: fills `out` with the body wrench to allocate (its `size` set by
+ the caller). With an offset-free action the next `tvmd_allocate` records the delivered
+ wrench for the observer (run the allocation after each law period). Errors: as
+ `tvmd_step`'s input checks; nothing is held (the law sends no commands).
 
-// The allocation stage: the body wrench `wrench` to per-agent commands inside `E_f`, which
-// become the held commands (the drop-in for a flight stack's control allocation, e.g. at the
-// rate loop's rate). Fills `out` (its `size` set by the caller). On an error after `out` was
-// found usable, `out.commands` are the held ones: a null or wrongly sized `wrench`, a
-// non-finite wrench (`TVMD_ERR_INPUT_NON_FINITE`), zero thrust on every agent for a non-zero force.
-//
-// # Safety
-// Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
-TvmdStatus tvmd_allocate(TvmdController *handle,
-                         const TvmdWrench *wrench,
-                         TvmdAllocationOutput *out);
+ # Safety
+ Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+ */
+TvmdStatus tvmd_law(struct TvmdController *handle,
+                    const struct TvmdState *state,
+                    const struct TvmdReference *reference,
+                    struct TvmdLawOutput *out);
 
-// The planner alone: the attitude `R_d` closest to `reference_attitude` (9 floats, row-major,
-// a rotation) whose attainable force space holds `force` (3 floats, N, inertial frame), at
-// the controller's relaxation and failure mask. Reads the controller, changes nothing.
-//
-// # Safety
-// `reference_attitude` is null or points to 9 floats, `force` to 3; `handle` as for
-// `tvmd_create`; `out` is null or points to a `TvmdPlanOutput`.
-TvmdStatus tvmd_plan(const TvmdController *handle,
+/*
+ The allocation stage: the body wrench `wrench` to per-agent commands inside `E_f`, which
+ become the held commands (the drop-in for a flight stack's control allocation, e.g. at the
+ rate loop's rate). Fills `out` (its `size` set by the caller). On an error after `out` was
+ found usable, `out.commands` are the held ones: a null or wrongly sized `wrench`, a
+ non-finite wrench (`TVMD_ERR_INPUT_NON_FINITE`), zero thrust on every agent for a non-zero force.
+
+ # Safety
+ Each pointer is null or points to its struct; `handle` as for `tvmd_create`.
+ */
+TvmdStatus tvmd_allocate(struct TvmdController *handle,
+                         const struct TvmdWrench *wrench,
+                         struct TvmdAllocationOutput *out);
+
+/*
+ The planner alone: the attitude `R_d` closest to `reference_attitude` (9 floats, row-major,
+ a rotation) whose attainable force space holds `force` (3 floats, N, inertial frame), at
+ the controller's relaxation and failure mask. Reads the controller, changes nothing.
+
+ # Safety
+ `reference_attitude` is null or points to 9 floats, `force` to 3; `handle` as for
+ `tvmd_create`; `out` is null or points to a `TvmdPlanOutput`.
+ */
+TvmdStatus tvmd_plan(const struct TvmdController *handle,
                      const float *reference_attitude,
                      const float *force,
-                     TvmdPlanOutput *out);
+                     struct TvmdPlanOutput *out);
 
-// A short static name of a status code (`"TVMD_OK"`, `"TVMD_ERR_SIZE"`, ...), NUL-terminated,
-// never null; `"TVMD_UNKNOWN_STATUS"` for a value no entry point returns.
+/*
+ A short static name of a status code (`"TVMD_OK"`, `"TVMD_ERR_SIZE"`, ...), NUL-terminated,
+ never null; `"TVMD_UNKNOWN_STATUS"` for a value no entry point returns.
+ */
 const char *tvmd_status_name(TvmdStatus status);
 
 #ifdef __cplusplus
