@@ -48,6 +48,17 @@
 #define TVMD_MOTOR_CURVE_THRUST 1
 
 /*
+ Motor channels a map may use: PX4's `actuator_motors` has 12.
+ */
+#define TVMD_MOTOR_CHANNELS 12
+
+/*
+ Servo channels a map may use: PX4's `actuator_servos` has 8, so one stock output path
+ drives at most four two-axis agents.
+ */
+#define TVMD_SERVO_CHANNELS 8
+
+/*
  Bytes of a [`TvmdController`]: at least the controller's size on every supported target
  (checked at compile time), with room for the core to grow within one ABI version.
  */
@@ -188,11 +199,11 @@ typedef struct TvmdController {
  */
 typedef struct TvmdAgentChannels {
   /*
-   The two `actuator_motors` channels of the coaxial pair (`0..16`).
+   The two `actuator_motors` channels of the coaxial pair (`0..TVMD_MOTOR_CHANNELS`).
    */
   uint32_t motor[2];
   /*
-   The `actuator_servos` channels of `[eta_x, eta_y]` (`0..16`).
+   The `actuator_servos` channels of `[eta_x, eta_y]` (`0..TVMD_SERVO_CHANNELS`).
    */
   uint32_t servo[2];
   /*
@@ -1023,8 +1034,8 @@ const char *tvmd_version(void);
 /*
  Fills `map` with the default layout: agent `i` on motors `2i, 2i+1` and servos `2i`
  (`eta_x`), `2i+1` (`eta_y`), trim 0, direction +1, range = the gimbal limit (so
- `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 8 agents need a map of
- their own (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
+ `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 4 agents need more
+ servo channels than PX4's `actuator_servos` has (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
 
  # Safety
  `handle` is null or a `TvmdController`; `map` is null or points to a `TvmdActuatorMap`.
@@ -1033,8 +1044,9 @@ TvmdStatus tvmd_actuator_map_default(const struct TvmdController *handle,
                                      struct TvmdActuatorMap *map);
 
 /*
- Checks `map` against the controller's team: agent count, channels within 16 and distinct
- (per kind), servo trim/direction/range usable, a known motor curve.
+ Checks `map` against the controller's team: agent count, motor channels below
+ `TVMD_MOTOR_CHANNELS` (12) and servo channels below `TVMD_SERVO_CHANNELS` (8), distinct per
+ kind, servo trim/direction/range usable, a known motor curve.
 
  # Safety
  As [`tvmd_actuator_map_default`].

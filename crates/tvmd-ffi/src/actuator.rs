@@ -30,13 +30,19 @@ pub const TVMD_MOTOR_CURVE_ROTOR_SPEED: u32 = 0;
 /// `map.motor_curve`: `T / sigma_Tf`, normalized thrust.
 pub const TVMD_MOTOR_CURVE_THRUST: u32 = 1;
 
+/// Motor channels a map may use: PX4's `actuator_motors` has 12.
+pub const TVMD_MOTOR_CHANNELS: u32 = 12;
+/// Servo channels a map may use: PX4's `actuator_servos` has 8, so one stock output path
+/// drives at most four two-axis agents.
+pub const TVMD_SERVO_CHANNELS: u32 = 8;
+
 /// One agent's channels.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TvmdAgentChannels {
-    /// The two `actuator_motors` channels of the coaxial pair (`0..16`).
+    /// The two `actuator_motors` channels of the coaxial pair (`0..TVMD_MOTOR_CHANNELS`).
     pub motor: [u32; 2],
-    /// The `actuator_servos` channels of `[eta_x, eta_y]` (`0..16`).
+    /// The `actuator_servos` channels of `[eta_x, eta_y]` (`0..TVMD_SERVO_CHANNELS`).
     pub servo: [u32; 2],
     /// Each servo's output at `eta = 0`, in `(-1, 1)`.
     pub servo_trim: [f32; 2],
@@ -77,10 +83,12 @@ fn size_ok<T>(size: u32) -> bool {
     usize::try_from(size).ok() == Some(core::mem::size_of::<T>())
 }
 
-/// The used channels of one kind; `TVMD_ERR_MAP_*` for an index beyond 16 or a repeat.
-fn mark(used: &mut [bool; TVMD_MAX_AGENTS], channel: u32) -> Result<(), TvmdStatus> {
+/// The used channels of one kind; `TVMD_ERR_MAP_*` for an index at or beyond `limit` or a
+/// repeat.
+fn mark(used: &mut [bool; TVMD_MAX_AGENTS], channel: u32, limit: u32) -> Result<(), TvmdStatus> {
     let slot = usize::try_from(channel)
         .ok()
+        .filter(|_| channel < limit)
         .and_then(|c| used.get_mut(c))
         .ok_or(TVMD_ERR_MAP_CHANNEL_RANGE)?;
     if *slot {
@@ -109,10 +117,10 @@ fn validate<'a>(
     let (mut motors, mut servos) = ([false; TVMD_MAX_AGENTS], [false; TVMD_MAX_AGENTS]);
     for agent in agents {
         for m in agent.motor {
-            mark(&mut motors, m)?;
+            mark(&mut motors, m, TVMD_MOTOR_CHANNELS)?;
         }
         for s in agent.servo {
-            mark(&mut servos, s)?;
+            mark(&mut servos, s, TVMD_SERVO_CHANNELS)?;
         }
         for (((trim, dir), range), sigma) in agent
             .servo_trim
@@ -175,8 +183,8 @@ fn motor_value(curve: u32, limits: &AgentLimits<f32>, c: &TvmdAgentCommand) -> f
 
 /// Fills `map` with the default layout: agent `i` on motors `2i, 2i+1` and servos `2i`
 /// (`eta_x`), `2i+1` (`eta_y`), trim 0, direction +1, range = the gimbal limit (so
-/// `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 8 agents need a map of
-/// their own (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
+/// `eta = +-sigma` is `+-1`), the rotor-speed curve. Teams of more than 4 agents need more
+/// servo channels than PX4's `actuator_servos` has (`TVMD_ERR_MAP_CHANNEL_RANGE`). The caller sets `map->size` first.
 ///
 /// # Safety
 /// `handle` is null or a `TvmdController`; `map` is null or points to a `TvmdActuatorMap`.
@@ -196,7 +204,7 @@ pub unsafe extern "C" fn tvmd_actuator_map_default(
         Err(status) => return status,
     };
     let n = controller.team().len();
-    if 2 * n > TVMD_MAX_AGENTS {
+    if 2 * n > TVMD_SERVO_CHANNELS as usize {
         return TVMD_ERR_MAP_CHANNEL_RANGE;
     }
     let limits = controller.team().limits();
@@ -215,8 +223,9 @@ pub unsafe extern "C" fn tvmd_actuator_map_default(
     TVMD_OK
 }
 
-/// Checks `map` against the controller's team: agent count, channels within 16 and distinct
-/// (per kind), servo trim/direction/range usable, a known motor curve.
+/// Checks `map` against the controller's team: agent count, motor channels below
+/// `TVMD_MOTOR_CHANNELS` (12) and servo channels below `TVMD_SERVO_CHANNELS` (8), distinct per
+/// kind, servo trim/direction/range usable, a known motor curve.
 ///
 /// # Safety
 /// As [`tvmd_actuator_map_default`].

@@ -111,9 +111,9 @@ fn actuator_channels_follow_the_map_and_round_trip() {
     // SAFETY: valid pointers to live values; 16 commands.
     unsafe {
         assert_eq!(tvmd_actuator_map_default(&*handle, &mut map), TVMD_OK);
-        // Agent i on motors [15 - i, 8 + i], servos [i, 4 + i], reversed eta_y.
+        // Agent i on motors [11 - i, 4 + i], servos [i, 4 + i], reversed eta_y.
         for (i, a) in map.agents.iter_mut().take(4).enumerate() {
-            a.motor = [15 - i as u32, 8 + i as u32];
+            a.motor = [11 - i as u32, 4 + i as u32];
             a.servo = [i as u32, 4 + i as u32];
             a.servo_direction = [1.0, -1.0];
         }
@@ -125,7 +125,7 @@ fn actuator_channels_follow_the_map_and_round_trip() {
     }
     let (sigma_x, sigma_y) = (std::f32::consts::PI / 6.0, std::f32::consts::FRAC_PI_4);
     for (i, (c, b)) in out.commands.iter().zip(&back).enumerate().take(4) {
-        let (m0, m1) = (act.motors[15 - i], act.motors[8 + i]);
+        let (m0, m1) = (act.motors[11 - i], act.motors[4 + i]);
         let (sx, sy) = (act.servos[i], act.servos[4 + i]);
         assert_eq!(m0, m1, "agent {i}: one speed for the coaxial pair");
         if i == 1 {
@@ -143,7 +143,7 @@ fn actuator_channels_follow_the_map_and_round_trip() {
         assert!((b.eta_y - c.eta_y).abs() <= 1e-6);
         assert!((b.thrust - c.thrust).abs() <= 1e-5 * c.thrust.max(1.0));
     }
-    for unused in [0, 1, 2, 3, 4, 5, 6, 7] {
+    for unused in [0, 1, 2, 3, 12, 13, 14, 15] {
         assert!(act.motors[unused].is_nan());
     }
     for unused in 8..16 {

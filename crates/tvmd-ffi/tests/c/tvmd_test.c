@@ -252,8 +252,8 @@ static void test_actuators(TvmdController *c, const TvmdOutput *o, uint32_t fail
   for (i = 0; i < 4; ++i) {
     map.agents[i].motor[0] = (uint32_t)(11 - 2 * i);
     map.agents[i].motor[1] = (uint32_t)(2 * i);
-    map.agents[i].servo[0] = (uint32_t)(15 - i);
-    map.agents[i].servo[1] = (uint32_t)(2 * i);
+    map.agents[i].servo[0] = (uint32_t)(7 - i);
+    map.agents[i].servo[1] = (uint32_t)i;
     map.agents[i].servo_trim[0] = 0.1f;
     map.agents[i].servo_trim[1] = -0.05f;
     map.agents[i].servo_direction[0] = -1.0f;
@@ -281,7 +281,7 @@ static void test_actuators(TvmdController *c, const TvmdOutput *o, uint32_t fail
       }
     }
     /* Channels no agent uses: motors 1, 3, 8, 10, 12..15; servos 1, 3, 5, 7..11. */
-    CHECK(isnan(act.motors[1]) && isnan(act.motors[8]) && isnan(act.motors[12]) && isnan(act.servos[1]) && isnan(act.servos[10]));
+    CHECK(isnan(act.motors[1]) && isnan(act.motors[8]) && isnan(act.motors[12]) && isnan(act.servos[8]) && isnan(act.servos[10]));
     /* The round trip: outputs -> commands -> outputs. */
     CHECK_STATUS(tvmd_actuator_commands(c, &map, &act, back, TVMD_MAX_AGENTS), TVMD_OK);
     for (i = 0; i < 4; ++i) {
@@ -303,6 +303,11 @@ static void test_actuators(TvmdController *c, const TvmdOutput *o, uint32_t fail
   /* Map and value errors; outputs are not written on an error. */
   round = act;
   bad = map; bad.agents[2].motor[1] = TVMD_MAX_AGENTS;
+  CHECK_STATUS(tvmd_actuator_map_validate(c, &bad), TVMD_ERR_MAP_CHANNEL_RANGE);
+  /* PX4's actuator_motors has 12 channels and actuator_servos 8. */
+  bad = map; bad.agents[1].motor[0] = TVMD_MOTOR_CHANNELS;
+  CHECK_STATUS(tvmd_actuator_map_validate(c, &bad), TVMD_ERR_MAP_CHANNEL_RANGE);
+  bad = map; bad.agents[0].servo[1] = TVMD_SERVO_CHANNELS;
   CHECK_STATUS(tvmd_actuator_map_validate(c, &bad), TVMD_ERR_MAP_CHANNEL_RANGE);
   CHECK_STATUS(tvmd_actuator_outputs(c, &bad, o->commands, TVMD_MAX_AGENTS, &round), TVMD_ERR_MAP_CHANNEL_RANGE);
   CHECK(memcmp(&round, &act, sizeof act) == 0);
