@@ -22,6 +22,35 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
     let mut worst_rounds = 0;
     let (mut exact, mut attainable, mut outside_e_f) = (0, 0, 0.0);
     let mut worst_cost = tvmd_core::WalkCost::default();
+    if let Ok(spec) = std::env::var("TVMD_TRACE") {
+        // `TEAM:K`: request K of TEAM with the walk capped at 0, 1, ... rounds.
+        let (id, k) = spec.split_once(':').unwrap_or((&spec, "0"));
+        if id == t.id() {
+            let k: usize = k.parse().unwrap_or(0);
+            let w = t.requests[k].1.cast::<T>();
+            let request = AllocationRequest {
+                effectiveness: &e,
+                sets: &sets,
+                wrench: w,
+            };
+            for cap in 0..40 {
+                let mut a = ExactBoundaryRedistribution::<T, N>::new().with_max_rounds(Some(cap));
+                let out = a.allocate(&request);
+                let r = w - e.wrench(&out.forces);
+                println!(
+                    "cap {cap:2}: rounds {:2}  e_f {:.6e}  e_tau {:.6e}  {:?}",
+                    a.last_cost().rounds,
+                    out.e_f.to_subset().unwrap_or(f64::NAN),
+                    r.fixed_rows::<3>(0).norm().to_subset().unwrap_or(f64::NAN),
+                    a.last_cost()
+                );
+                if a.last_cost().rounds < cap {
+                    break;
+                }
+            }
+        }
+        return;
+    }
     if let Ok(spec) = std::env::var("TVMD_PROFILE") {
         // `TEAM:K`: allocate request K of TEAM over and over (for `perf record`).
         let (id, k) = spec.split_once(':').unwrap_or((&spec, "0"));
@@ -65,7 +94,7 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
             if SetTeam::attainable(kind) {
                 reps_done(&mut attainable, &mut exact, rel);
             } else {
-                outside_e_f = rel;
+                outside_e_f += rel / reps as f64;
             }
         }
         worst_rounds = worst_rounds.max(rounds);
@@ -75,9 +104,10 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
     times.sort_by(|a, b| a.0.total_cmp(&b.0));
     let median = times[times.len() / 2].0;
     let (worst, k, kind, rounds) = times.last().cloned().unwrap();
-    let _ = outside_e_f;
+    let outside = t.requests.len() - attainable / reps.max(1);
+    let outside_e_f = outside_e_f / outside.max(1) as f64;
     println!(
-        "{:<12} worst {worst:7.2} us (request {k}, {kind}, {rounds} rounds)  median {median:6.2}  mean {mean:6.2}  max rounds {worst_rounds}  exact {}/{}  max cost {worst_cost:?}",
+        "{:<12} worst {worst:7.2} us (request {k}, {kind}, {rounds} rounds)  median {median:6.2}  mean {mean:6.2}  max rounds {worst_rounds}  exact {}/{}  outside mean rel e_f {outside_e_f:.4}  max cost {worst_cost:?}",
         t.id(), exact / reps, attainable / reps
     );
 }

@@ -125,3 +125,23 @@ fn the_bound_is_linear_in_the_agents() {
     assert_eq!(WalkCost::bound(16, 5).rounds, 5);
     assert_eq!(WalkCost::bound(16, u32::MAX).solves, 4 * 16 + 9);
 }
+
+#[test]
+fn the_cap_is_an_allocator_option_of_the_exact_boundary_redistribution_only() {
+    use tvmd_core::allocation::AllocatorOptions;
+    use tvmd_core::{AnyAllocator, ConfigError, ConfigField};
+    let capped = AllocatorOptions::<f64, 4> {
+        max_rounds: Some(3),
+        ..AllocatorOptions::default()
+    };
+    match AnyAllocator::from_name("exact-boundary-redistribution", &capped) {
+        Ok(AnyAllocator::ExactBoundaryRedistribution(a)) => assert_eq!(a.max_rounds(), Some(3)),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        AnyAllocator::from_name("redistributed-pseudo-inverse", &capped).unwrap_err(),
+        ConfigError::UnusedOption {
+            field: ConfigField::AllocatorMaxRounds
+        }
+    );
+}
