@@ -12,7 +12,7 @@ use tvmd_core::nalgebra::{Vector3, Vector6};
 use tvmd_core::team::presets;
 use tvmd_core::{
     AdmissibleSet, AllocationRequest, Allocator, ExactBoundaryRedistribution, FailureMask,
-    TeamConfig,
+    RedistributedPseudoInverse, TeamConfig,
 };
 
 use crate::{clock, stack};
@@ -52,6 +52,15 @@ fn allocate<const N: usize>(
     a.allocate(r).e_f
 }
 
+/// The paper's allocator on the same request, for comparison.
+#[inline(never)]
+fn allocate_rpi<const N: usize>(
+    _a: &mut ExactBoundaryRedistribution<f32, N>,
+    r: &AllocationRequest<'_, f32, N>,
+) -> f32 {
+    RedistributedPseudoInverse.allocate(r).e_f
+}
+
 /// The same call shape with no work.
 #[inline(never)]
 fn empty<const N: usize>(
@@ -71,18 +80,31 @@ fn team<const N: usize>(name: &str) -> Option<TeamConfig<f32, N>> {
 }
 
 /// The worst and median instructions of one allocation over `set`'s requests (`None` if the
-/// team was refused), printed with the stack peak and the comparison with the host.
-pub fn report<const N: usize>(set: &SetTeam<N>, per_tick: u32) -> Option<(u32, u32)> {
+/// team was refused), printed with the stack peak and the comparison with the host (uncapped
+/// only: the host's forces are the default's); `cap` is the walk's round cap
+/// (`ExactBoundaryRedistribution::with_max_rounds`).
+pub fn report<const N: usize>(
+    set: &SetTeam<N>,
+    cap: Option<u32>,
+    per_tick: u32,
+) -> Option<(u32, u32)> {
     let config = team::<N>(set.name)?;
     let mask = FailureMask::with_failed(set.failed).ok()?;
     let e = config.effectiveness(&mask);
     let sets = [AdmissibleSet::from_limits(config.limits()); N];
-    let mut a = ExactBoundaryRedistribution::<f32, N>::new();
+    let mut a = ExactBoundaryRedistribution::<f32, N>::new().with_max_rounds(cap);
     let mut counts = [0u32; 128];
+    let mut paper = [0u32; 128];
     let (mut stack_peak, mut identical, mut worst_diff, mut max_rounds) = (0, 0, 0.0f32, 0);
     let (mut rounds_differ, mut worst_at, mut worst_so_far) = (0, 0, 0);
     let thrust = config.limits().max_thrust();
-    for (k, (r, slot)) in set.requests.iter().zip(counts.iter_mut()).enumerate() {
+    for (k, ((r, slot), paper_slot)) in set
+        .requests
+        .iter()
+        .zip(counts.iter_mut())
+        .zip(paper.iter_mut())
+        .enumerate()
+    {
         let request = AllocationRequest {
             effectiveness: &e,
             sets: &sets,
@@ -94,8 +116,14 @@ pub fn report<const N: usize>(set: &SetTeam<N>, per_tick: u32) -> Option<(u32, u
         let overhead = clock::ticks(REPS, &mut || {
             black_box(empty(black_box(&mut a), black_box(&request)));
         });
-        let per = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-        *slot = ((per + u64::from(REPS) / 2) / u64::from(REPS)) as u32;
+        let per_call = |work: u32| {
+            let per = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
+            ((per + u64::from(REPS) / 2) / u64::from(REPS)) as u32
+        };
+        *slot = per_call(work);
+        *paper_slot = per_call(clock::ticks(REPS, &mut || {
+            black_box(allocate_rpi(black_box(&mut a), black_box(&request)));
+        }));
         if *slot >= worst_so_far {
             (worst_so_far, worst_at) = (*slot, k);
         }
@@ -120,8 +148,17 @@ pub fn report<const N: usize>(set: &SetTeam<N>, per_tick: u32) -> Option<(u32, u
     let n = set.requests.len().min(counts.len());
     let sorted = sort(&mut counts[..n]);
     let (worst, median) = (sorted.last().copied()?, *sorted.get(n / 2)?);
+    let sorted = sort(&mut paper[..n]);
+    let (paper_worst, paper_median) = (sorted.last().copied()?, *sorted.get(n / 2)?);
+    if cap.is_some() {
+        hprintln!(
+            "cost: allocation {:10} (n = {:2}, {} requests), walk capped at {:?} rounds: {:6} instructions worst (request {}), {:6} median, {:2} rounds at most",
+            set.name, N, n, cap, worst, worst_at, median, max_rounds
+        );
+        return Some((worst, median));
+    }
     hprintln!(
-        "cost: allocation {:10} (n = {:2}, {} requests): exact-boundary-redistribution {:6} instructions worst (request {}), {:6} median, {:2} rounds at most, peak stack {:5} B; host f32 forces: {}/{} bit-identical, worst difference {:.2e} of sigma_Tf, rounds differ on {}",
+        "cost: allocation {:10} (n = {:2}, {} requests): exact-boundary-redistribution {:6} instructions worst (request {}), {:6} median, {:2} rounds at most, peak stack {:5} B; host f32 forces: {}/{} bit-identical, worst difference {:.2e} of sigma_Tf, rounds differ on {}; redistributed-pseudo-inverse {} worst, {} median",
         set.name,
         N,
         n,
@@ -133,7 +170,9 @@ pub fn report<const N: usize>(set: &SetTeam<N>, per_tick: u32) -> Option<(u32, u
         identical,
         n,
         worst_diff,
-        rounds_differ
+        rounds_differ,
+        paper_worst,
+        paper_median
     );
     Some((worst, median))
 }
