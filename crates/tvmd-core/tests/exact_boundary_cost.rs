@@ -133,13 +133,15 @@ fn the_bound_is_linear_in_the_agents() {
         WalkCost {
             start_rounds: 4,
             rounds: 12,
-            solves: 25,
-            releases: 12,
+            solves: 27,
+            releases: 13,
             line_searches: 13,
         }
     );
     assert_eq!(WalkCost::bound(16, 5).rounds, 5);
-    assert_eq!(WalkCost::bound(16, u32::MAX).solves, 4 * 16 + 9);
+    assert_eq!(WalkCost::bound(16, u32::MAX).solves, 4 * 16 + 11);
+    // One agent: at most one release per constraint.
+    assert_eq!(WalkCost::bound(1, u32::MAX).releases, 6);
 }
 
 #[test]

@@ -26,14 +26,17 @@ impl WalkCost {
     /// The worst case with `n` working agents and the walk capped at `cap` rounds (no cap:
     /// `u32::MAX`), from the code's loop caps:
     /// - the start is the redistributed pseudo-inverse: at most `n` rounds;
-    /// - the walk: at most `min(2 n + 4, cap)` rounds (the `while` of `allocate`);
-    /// - a round's direction solves once, and once more when it releases a constraint; the
-    ///   second solve never releases (`direction(r, false)`), so at most two solves and one
-    ///   release a round; a release is also at most once per constraint (`ActiveSet::released`),
-    ///   so at most `6 n` in all;
+    /// - the walk: at most `R = min(2 n + 4, cap)` rounds (the `while` of `allocate`), so at
+    ///   most `R + 1` directions (the last may fail: nothing finite to step along);
+    /// - a direction solves once, and once more when it releases a constraint; the second solve
+    ///   never releases (`direction(r, false)`), so at most one release per direction, and at
+    ///   most once per constraint (`ActiveSet::released`): `min(R + 1, 6 n)` releases;
     /// - the shedding of internal forces before the walk (a previous-period start only): one
     ///   solve and one line search;
     /// - one line search per round.
+    ///
+    /// So at most `R + 1 + releases + 1` solves and `R + 1` line searches; without a cap,
+    /// `2 n + 4` rounds, `2 n + 5` releases, `4 n + 11` solves and `2 n + 5` line searches.
     pub const fn bound(n: usize, cap: u32) -> Self {
         // More agents than `u32::MAX / 8` cannot be held in memory; the cast is exact below it.
         let n = if n > (u32::MAX / 8) as usize {
@@ -43,11 +46,16 @@ impl WalkCost {
         };
         let limit = 2 * n + 4;
         let rounds = if cap < limit { cap } else { limit };
-        let releases = if rounds < 6 * n { rounds } else { 6 * n };
+        let directions = rounds + 1;
+        let releases = if directions < 6 * n {
+            directions
+        } else {
+            6 * n
+        };
         Self {
             start_rounds: n,
             rounds,
-            solves: rounds + releases + 1,
+            solves: directions + releases + 1,
             releases,
             line_searches: rounds + 1,
         }

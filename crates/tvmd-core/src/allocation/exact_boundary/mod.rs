@@ -52,8 +52,8 @@ use crate::real::{eps, lit, Real};
 /// [`Allocator::reset`].
 ///
 /// Worst case ([`WalkCost::bound`], counted per allocation by [`Self::last_cost`]): with `n`
-/// working agents, at most `n` start rounds, `2 n + 4` walk rounds, `4 n + 9` Gram solves,
-/// `2 n + 4` releases and `2 n + 5` line searches.
+/// working agents, at most `n` start rounds, `2 n + 4` walk rounds, `4 n + 11` Gram solves,
+/// `2 n + 5` releases and `2 n + 5` line searches.
 ///
 /// ```
 /// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
