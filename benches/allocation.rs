@@ -5,15 +5,23 @@
 //! order, from a reset allocator as in `tvmd-sim allocation-eval`): the median is the mean
 //! time of one allocation over the team's set. f64, capacity `N` = the team's size.
 //!
+//! Also `allocation-worst/<team>/exact-boundary-redistribution` (issue 46): the default
+//! allocator on the team's costliest request (found by a timing pre-pass: the minimum of 20
+//! allocations per request), each iteration from a reset allocator: the worst case per request
+//! on the set (`cargo run --release -p tvmd-core --example allocation_worst` lists every team's).
+//!
 //! Run: `cargo bench --bench allocation --features clarabel -- --warm-up-time 0.5
 //! --measurement-time 1`, then `python3 benches/allocation_table.py` for the table.
 
 use std::hint::black_box;
+use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use tvmd::core::allocation::AllocatorOptions;
 use tvmd::core::nalgebra::Vector6;
-use tvmd::core::{AdmissibleSet, AllocationRequest, Allocator, AnyAllocator};
+use tvmd::core::{
+    AdmissibleSet, AllocationRequest, Allocator, AnyAllocator, ExactBoundaryRedistribution,
+};
 use tvmd_studies::allocation_bench::{failure_mask, team, team_size, AllocationSet, TeamRequests};
 
 const SET: &str = include_str!("data/allocation_set.json");
@@ -52,6 +60,38 @@ fn bench_team<const N: usize>(c: &mut Criterion, t: &TeamRequests) {
             })
         });
     }
+    group.finish();
+    // The default allocator's costliest request of the team.
+    let costliest = wrenches
+        .iter()
+        .map(|w| {
+            let request = AllocationRequest {
+                effectiveness: &effectiveness,
+                sets: &sets,
+                wrench: *w,
+            };
+            let best = (0..20)
+                .map(|_| {
+                    let t0 = Instant::now();
+                    black_box(ExactBoundaryRedistribution::<f64, N>::new().allocate(&request));
+                    t0.elapsed()
+                })
+                .min()
+                .unwrap_or_default();
+            (best, *w)
+        })
+        .max_by_key(|(t, _)| *t)
+        .map(|(_, w)| w)
+        .unwrap_or_else(Vector6::zeros);
+    let mut group = c.benchmark_group(format!("allocation-worst/{}", team_id(t)));
+    group.bench_function("exact-boundary-redistribution", |b| {
+        let request = AllocationRequest {
+            effectiveness: &effectiveness,
+            sets: &sets,
+            wrench: costliest,
+        };
+        b.iter(|| ExactBoundaryRedistribution::<f64, N>::new().allocate(black_box(&request)))
+    });
     group.finish();
 }
 

@@ -86,6 +86,8 @@ cargo package -p tvmd-core --locked --allow-dirty
 step "panic-free link check: f32 control cycle on thumbv7em with an undefined panic handler"
 # Links only if no panic path survives in the cycle (see embedded/cycle-check/src/main.rs).
 cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf
+# The same with the default allocator (the exact-boundary redistribution, issue 46).
+cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml --target thumbv7em-none-eabihf --features default-allocator
 
 step "the C interface: header as C99/C++11, the C test program and its bit-exact replay, thumbv7em staticlib and panic-free link check"
 # See scripts/ffi.sh. Measured on the 2-core development machine: 6 s warm; the link check's

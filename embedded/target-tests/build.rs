@@ -13,6 +13,9 @@ mod cases;
 
 use cases::{Family, MAX_OUTPUTS};
 
+#[path = "build_allocation_set.rs"]
+mod allocation_set;
+
 fn nums(v: &Value) -> Vec<f64> {
     match v {
         Value::Number(n) => vec![n.as_f64().expect("number")],
@@ -170,6 +173,7 @@ fn main() {
     src.push_str("];\n");
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     std::fs::write(out_dir.join("vectors.rs"), src).unwrap();
+    allocation_set::write(&manifest, &out_dir);
     // cortex-m-rt's link.x includes memory.x from the linker search path.
     std::fs::copy(manifest.join("memory.x"), out_dir.join("memory.x")).unwrap();
     println!("cargo:rustc-link-search={}", out_dir.display());

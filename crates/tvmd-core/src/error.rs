@@ -85,6 +85,8 @@ pub enum ConfigField {
     PlannerMaxIterations,
     /// The per-agent weights of the weighted pseudo-inverse.
     AllocatorWeights,
+    /// The exact-boundary redistribution's round cap.
+    AllocatorMaxRounds,
     /// Clarabel's regularisation `lambda`.
     ClarabelLambda,
     /// Clarabel's wrench weights `W`.
@@ -143,6 +145,7 @@ impl ConfigField {
             Self::PlannerTolerance => "planner.tolerance",
             Self::PlannerMaxIterations => "planner.max_iterations",
             Self::AllocatorWeights => "allocation.weights",
+            Self::AllocatorMaxRounds => "allocation.max_rounds",
             Self::ClarabelLambda => "clarabel.lambda",
             Self::ClarabelWeights => "clarabel.weights",
             Self::ClarabelTolerance => "clarabel.tolerance",

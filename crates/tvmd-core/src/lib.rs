@@ -82,7 +82,7 @@ pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
     ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
-    PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
+    PseudoInverse, RedistributedPseudoInverse, WalkCost, WeightedPseudoInverse,
 };
 #[cfg(feature = "clarabel")]
 pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};

@@ -11,13 +11,24 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use tvmd_core::nalgebra::Vector3;
 use tvmd_core::team::presets;
-use tvmd_core::{
-    AgentCommand, Controller, ControllerSettings, RedistributedPseudoInverse, Reference, RigidState,
-};
+use tvmd_core::{AgentCommand, Controller, ControllerSettings, Reference, RigidState};
 
 extern "Rust" {
     /// Deliberately never defined.
     fn tvmd_core_cycle_can_panic() -> !;
+}
+
+/// The allocator of the checked cycle: the paper's, or with `--features default-allocator`
+/// the default one.
+#[cfg(not(feature = "default-allocator"))]
+fn allocator() -> tvmd_core::RedistributedPseudoInverse {
+    tvmd_core::RedistributedPseudoInverse
+}
+
+/// The allocator of the checked cycle: the default one.
+#[cfg(feature = "default-allocator")]
+fn allocator() -> tvmd_core::ExactBoundaryRedistribution<f32, 4> {
+    tvmd_core::ExactBoundaryRedistribution::new()
 }
 
 #[panic_handler]
@@ -61,13 +72,8 @@ fn write_outputs(commands: &[AgentCommand<f32>; 4], status: u32) {
 /// Entry point: configure once, then run the cycle forever.
 #[no_mangle]
 pub extern "C" fn _start() -> ! {
-    let controller = presets::a4_inc::<f32, 4>().and_then(|team| {
-        Controller::new(
-            team,
-            ControllerSettings::paper(),
-            RedistributedPseudoInverse,
-        )
-    });
+    let controller = presets::a4_inc::<f32, 4>()
+        .and_then(|team| Controller::new(team, ControllerSettings::paper(), allocator()));
     let Ok(mut controller) = controller else {
         write_outputs(&[AgentCommand::idle(); 4], 2);
         loop {}

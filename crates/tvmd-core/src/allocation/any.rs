@@ -42,6 +42,9 @@ pub struct AllocatorOptions<T: Real, const N: usize> {
     /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`) and
     /// `SequentialConvexAllocator` (default `0`).
     pub regularization: Option<T>,
+    /// Round cap of [`ExactBoundaryRedistribution::with_max_rounds`] (default: none, the walk's
+    /// own `2 n + 4`): bounds the allocator's work per period, see `docs/allocation-benchmark.md`.
+    pub max_rounds: Option<u32>,
 }
 
 impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
@@ -50,6 +53,7 @@ impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
             agent_weights: None,
             wrench_weights: None,
             regularization: None,
+            max_rounds: None,
         }
     }
 }
@@ -124,16 +128,26 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
                     ConfigField::AllocatorWeights,
                 )?;
                 no_clarabel_options()?;
+                refuse(
+                    options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
+                    ConfigField::AllocatorMaxRounds,
+                )?;
                 Ok(match name {
                     PSEUDO_INVERSE => Self::PseudoInverse(PseudoInverse),
                     REDISTRIBUTED_PSEUDO_INVERSE => {
                         Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
                     }
-                    _ => Self::ExactBoundaryRedistribution(ExactBoundaryRedistribution::new()),
+                    _ => Self::ExactBoundaryRedistribution(
+                        ExactBoundaryRedistribution::new().with_max_rounds(options.max_rounds),
+                    ),
                 })
             }
             WEIGHTED_PSEUDO_INVERSE => {
                 no_clarabel_options()?;
+                refuse(
+                    options.max_rounds.is_some(),
+                    ConfigField::AllocatorMaxRounds,
+                )?;
                 let weights = options.agent_weights.unwrap_or([T::one(); N]);
                 Ok(Self::WeightedPseudoInverse(WeightedPseudoInverse::new(
                     weights,
@@ -143,6 +157,10 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
                 refuse(
                     options.agent_weights.is_some(),
                     ConfigField::AllocatorWeights,
+                )?;
+                refuse(
+                    options.max_rounds.is_some(),
+                    ConfigField::AllocatorMaxRounds,
                 )?;
                 if name == CLARABEL {
                     Self::clarabel(options)

@@ -20,7 +20,7 @@ pub use clarabel::{
     ClarabelAllocator, ClarabelStatus, FallbackReason, SequentialConvexAllocator, SequentialReport,
     SolveReport, StopReason,
 };
-pub use exact_boundary::ExactBoundaryRedistribution;
+pub use exact_boundary::{ExactBoundaryRedistribution, WalkCost};
 pub use names::{
     CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,

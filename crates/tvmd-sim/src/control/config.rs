@@ -59,6 +59,7 @@ fn config_field(e: &ConfigError) -> &'static str {
         Some(ConfigField::Gravity) => "physics.gravity",
         Some(
             ConfigField::AllocatorWeights
+            | ConfigField::AllocatorMaxRounds
             | ConfigField::ClarabelLambda
             | ConfigField::ClarabelWeights
             | ConfigField::ClarabelTolerance

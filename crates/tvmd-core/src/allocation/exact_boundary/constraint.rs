@@ -138,6 +138,41 @@ impl<T: Real> Constraint<T> {
             })
     }
 
+    /// `f` moved onto this curved constraint's boundary without trigonometry: a sphere scales
+    /// `f` to its radius; a cone (`c = +-e_y`) sets `f_y` to its value on the cone at `||f||` and
+    /// scales `(f_x, f_z)` to keep `||f||`. `f` itself for a plane, at the origin, or when the
+    /// result would not be finite.
+    pub(super) fn retract(&self, f: &Vector3<T>) -> Vector3<T> {
+        let n = norm(f);
+        if !self.curved() || n <= T::zero() || !n.is_finite() {
+            return *f;
+        }
+        let zero = T::zero();
+        let out = if self.c == Vector3::zeros() {
+            // `s ||f|| + k = 0`.
+            f * (-self.k / self.s / n)
+        } else if self.c.x == zero && self.c.z == zero && self.c.y != zero {
+            // `c_y f_y + s ||f|| + k = 0`, `c_y = +-1`.
+            let fy = -(self.s * n + self.k) / self.c.y;
+            let side = Vector3::new(f.x, zero, f.z);
+            let side_len = norm(&side);
+            let rest = (n * n - fy * fy).max(zero).sqrt();
+            if side_len <= zero {
+                return *f;
+            }
+            let mut out = side * (rest / side_len);
+            out.y = fy;
+            out
+        } else {
+            return *f;
+        };
+        if out.iter().all(|x| x.is_finite()) {
+            out
+        } else {
+            *f
+        }
+    }
+
     /// `|k|`, the part of the ray's scale this constraint needs.
     pub(super) fn offset(&self) -> T {
         self.k.abs()

@@ -4,17 +4,21 @@
 
 pub(super) mod active;
 pub(super) mod constraint;
+mod cost;
+mod walk;
 
-use nalgebra::{Matrix6, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 
 use self::active::ActiveSet;
-use self::constraint::{constraints, regular, Constraint, Ray, CONSTRAINTS};
+use self::constraint::{constraints, regular};
+pub use self::cost::WalkCost;
+use self::walk::{on_boundary, Walk};
 use super::{
     outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
 };
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
-use crate::linalg::{max_abs, norm, solve_gram};
+use crate::linalg::{max_abs, norm};
 use crate::real::{eps, lit, Real};
 
 /// Incremental allocation on the exact admissible boundary.
@@ -35,7 +39,8 @@ use crate::real::{eps, lit, Real};
 /// 3. that agent is held on that boundary from now on (a cone or sphere is re-entered after a
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
-/// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds. A start that
+/// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds (or the cap of
+/// [`Self::with_max_rounds`], for a flight controller's period). A start that
 /// already meets the request is returned as it is. The result is the candidate (the
 /// redistributed pseudo-inverse's forces, the walk's start and each of its points) with the
 /// smallest torque-first error, so it is never worse than the redistributed pseudo-inverse by
@@ -45,6 +50,10 @@ use crate::real::{eps, lit, Real};
 /// `rounds` counts the start's rounds and the walk's; `saturated` marks agents that end on a boundary.
 /// The previous forces are forgotten by [`Allocator::configure`] (new team or failures) and
 /// [`Allocator::reset`].
+///
+/// Worst case ([`WalkCost::bound`], counted per allocation by [`Self::last_cost`]): with `n`
+/// working agents, at most `n` start rounds, `2 n + 4` walk rounds, `4 n + 11` Gram solves,
+/// `2 n + 5` releases and `2 n + 5` line searches.
 ///
 /// ```
 /// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
@@ -67,11 +76,17 @@ use crate::real::{eps, lit, Real};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExactBoundaryRedistribution<T: Real, const N: usize> {
     previous: Option<[Vector3<T>; N]>,
+    max_rounds: Option<u32>,
+    last: WalkCost,
 }
 
 impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
     fn default() -> Self {
-        Self { previous: None }
+        Self {
+            previous: None,
+            max_rounds: None,
+            last: WalkCost::default(),
+        }
     }
 }
 
@@ -92,209 +107,30 @@ impl<T: Real, const N: usize> ExactBoundaryRedistribution<T, N> {
         Self::default()
     }
 
+    /// The same allocator with its walk capped at `rounds` rounds per allocation (`None`: no cap
+    /// beyond the built-in `2 n + 4`, the default). A capped walk returns the best forces it
+    /// found so far (by the torque-first error, never worse than the redistributed
+    /// pseudo-inverse's), inside every agent's set, and their true wrench error; `Some(0)` is
+    /// the redistributed pseudo-inverse (or the previous forces, when they do better).
+    pub fn with_max_rounds(mut self, rounds: Option<u32>) -> Self {
+        self.max_rounds = rounds;
+        self
+    }
+
+    /// The cap of [`Self::with_max_rounds`].
+    pub fn max_rounds(&self) -> Option<u32> {
+        self.max_rounds
+    }
+
+    /// The work of the last allocation (zero before the first), within
+    /// [`WalkCost::bound`]`(n, cap)`.
+    pub fn last_cost(&self) -> WalkCost {
+        self.last
+    }
+
     /// The forces of the last allocation, the next one's candidate start.
     pub fn previous(&self) -> Option<&[Vector3<T>; N]> {
         self.previous.as_ref()
-    }
-}
-
-/// The walk's state over the agents.
-struct Walk<'a, T: Real, const N: usize> {
-    effectiveness: &'a Effectiveness<T, N>,
-    sets: &'a [AdmissibleSet<T>; N],
-    bounds: [[Constraint<T>; CONSTRAINTS]; N],
-    /// `sum_i M_i M_i^T` over the working agents, before any is held.
-    gram: Matrix6<T>,
-    working: [bool; N],
-    forces: [Vector3<T>; N],
-    active: [ActiveSet<T>; N],
-}
-
-impl<T: Real, const N: usize> Walk<'_, T, N> {
-    fn remaining(&self, wrench: &Vector6<T>) -> Vector6<T> {
-        wrench - self.effectiveness.wrench(&self.forces)
-    }
-
-    /// `delta` of step 1, or `None` when nothing can move or the solve is not finite.
-    fn direction(&mut self, r: &Vector6<T>, release: bool) -> Option<[Vector3<T>; N]> {
-        let mut gram = self.gram;
-        let mut movable = false;
-        for (((block, a), f), (w, b)) in self
-            .effectiveness
-            .blocks()
-            .iter()
-            .zip(self.active.iter_mut())
-            .zip(&self.forces)
-            .zip(self.working.iter().zip(&self.bounds))
-        {
-            if let (Some(block), true) = (block, *w) {
-                a.update(b, f);
-                a.downdate(block, &mut gram);
-                movable |= !a.fixed();
-            }
-        }
-        if !movable {
-            return None;
-        }
-        let lambda = solve_gram(&gram, r);
-        // `M_i^T lambda`, the free increments, once for the release test and the step.
-        let mut delta = [Vector3::zeros(); N];
-        for ((d, block), w) in delta
-            .iter_mut()
-            .zip(self.effectiveness.blocks())
-            .zip(&self.working)
-        {
-            if let (Some(block), true) = (block, *w) {
-                *d = block.tr_mul(&lambda);
-            }
-        }
-        if release && self.release_one(&delta) {
-            return self.direction(r, false);
-        }
-        for ((d, a), w) in delta.iter_mut().zip(&self.active).zip(&self.working) {
-            if *w {
-                *d = a.project(d);
-            }
-        }
-        delta
-            .iter()
-            .all(|d| d.iter().all(|x| x.is_finite()))
-            .then_some(delta)
-    }
-
-    /// Lets go of the held constraint the free increment `free_i = M_i^T lambda` leaves most steeply
-    /// inward (an active-set method's multiplier test), if any: holding it would keep the agent
-    /// on a boundary the request pulls it away from.
-    fn release_one(&mut self, free: &[Vector3<T>; N]) -> bool {
-        let mut worst: Option<(usize, usize, T)> = None;
-        for (i, (((free, a), f), (w, b))) in free
-            .iter()
-            .zip(&self.active)
-            .zip(&self.forces)
-            .zip(self.working.iter().zip(&self.bounds))
-            .enumerate()
-        {
-            if !*w || !a.any_releasable() {
-                continue;
-            }
-            let free_norm = norm(free);
-            for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
-                let g = c.gradient(f);
-                let scale = norm(&g) * free_norm;
-                if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
-                    continue;
-                }
-                let slope = g.dot(free) / scale;
-                if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
-                    worst = Some((i, k, slope));
-                }
-            }
-        }
-        match worst.and_then(|(i, k, _)| self.active.get_mut(i).map(|a| (a, k))) {
-            Some((a, k)) => {
-                a.release(k);
-                true
-            }
-            None => false,
-        }
-    }
-
-    /// Step 2: the largest `tau <= 1`, and for each agent the constraint it stops on: the one
-    /// agent that stops the step, or, when the step is zero, every agent already on a boundary
-    /// the increment leaves (held together, one round instead of one each).
-    fn step(&self, delta: &[Vector3<T>; N]) -> (T, [Option<usize>; N]) {
-        let mut tau = T::one();
-        let mut first = None;
-        let mut at_once = [None; N];
-        for (i, ((((f, d), b), a), (w, now))) in self
-            .forces
-            .iter()
-            .zip(delta)
-            .zip(&self.bounds)
-            .zip(&self.active)
-            .zip(self.working.iter().zip(at_once.iter_mut()))
-            .enumerate()
-        {
-            if !*w || a.fixed() {
-                continue;
-            }
-            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), T::max);
-            let Some(ray) = Ray::new(f, d, offset) else {
-                continue;
-            };
-            for (k, c) in b.iter().enumerate() {
-                if a.holds(k) {
-                    continue;
-                }
-                if let Some(t) = c.first_exit_along(&ray, tau) {
-                    if t == T::zero() && now.is_none() {
-                        *now = Some(k);
-                    }
-                    if t < tau {
-                        tau = t;
-                        first = Some((i, k));
-                    }
-                }
-            }
-        }
-        if tau > T::zero() {
-            at_once = [None; N];
-            if let Some((i, k)) = first {
-                if let Some(slot) = at_once.get_mut(i) {
-                    *slot = Some(k);
-                }
-            }
-        }
-        (tau, at_once)
-    }
-
-    /// Moves by `tau delta`; agents that left their set by moving along a curved boundary's
-    /// tangent (or by round-off) are put back on it.
-    fn advance(&mut self, tau: T, delta: &[Vector3<T>; N]) {
-        for ((((f, d), (set, w)), a), b) in self
-            .forces
-            .iter_mut()
-            .zip(delta)
-            .zip(self.sets.iter().zip(&self.working))
-            .zip(&self.active)
-            .zip(&self.bounds)
-        {
-            if *w {
-                *f += d * tau;
-                // Only a tangent step on a cone or sphere leaves the set by more than round-off
-                // (the final forces are checked with the gimbal inverse anyway). The set's own
-                // constraints decide without `asin`/`atan2`.
-                if a.curved() && violated(b, f) {
-                    *f = set.saturate(f);
-                }
-            }
-        }
-    }
-}
-
-impl<T: Real, const N: usize> Walk<'_, T, N> {
-    /// Moves the forces in `null(M)` toward the minimum-norm forces of their own wrench, as far
-    /// as every agent's exact set allows (`M f` unchanged to round-off). The previous period's
-    /// forces carry the internal forces of the last saturation; without this they persist
-    /// until the redistributed pseudo-inverse's start is exact again, and the commands jump
-    /// there (measured: 0.17 rad in one period on paper-tilt at `s = 1`).
-    fn shed_internal(&mut self) {
-        let lambda = solve_gram(&self.gram, &self.effectiveness.wrench(&self.forces));
-        let mut delta = [Vector3::zeros(); N];
-        for (((d, block), f), w) in delta
-            .iter_mut()
-            .zip(self.effectiveness.blocks())
-            .zip(&self.forces)
-            .zip(&self.working)
-        {
-            if let (Some(block), true) = (block, *w) {
-                *d = block.tr_mul(&lambda) - f;
-            }
-        }
-        if delta.iter().all(|d| d.iter().all(|x| x.is_finite())) {
-            let (tau, _) = self.step(&delta);
-            self.advance(tau, &delta);
-        }
     }
 }
 
@@ -313,27 +149,6 @@ pub(in crate::allocation) fn per_set<T: Real, U: Copy, const N: usize>(
             u
         }
     })
-}
-
-/// Whether `f` is outside the set its constraints describe (or not finite): the same test as
-/// [`outside`] up to round-off, with a dot product per constraint and one norm instead of the
-/// gimbal inverse.
-fn violated<T: Real>(bounds: &[Constraint<T>; CONSTRAINTS], f: &Vector3<T>) -> bool {
-    if !f.iter().all(|x| x.is_finite()) {
-        return true;
-    }
-    let n = norm(f);
-    bounds.iter().any(|c| c.value_with_norm(f, n) > T::zero())
-}
-
-/// Whether `f` is on a constraint of its set, within `sqrt(eps)` of the largest thrust.
-fn on_boundary<T: Real>(
-    bounds: &[Constraint<T>; CONSTRAINTS],
-    set: &AdmissibleSet<T>,
-    f: &Vector3<T>,
-) -> bool {
-    let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
-    bounds.iter().any(|c| c.value(f) > -tol)
 }
 
 /// `||[w r_tau; r_f]||`, `w` = [`ExactBoundaryRedistribution::TORQUE_PRIORITY`]
@@ -378,6 +193,10 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             }
         }
         // Met by the start (hover, and most requests inside the attainable set): nothing to walk.
+        self.last = WalkCost {
+            start_rounds: start.rounds,
+            ..WalkCost::default()
+        };
         if !moved && max_abs(&(request.wrench - start.wrench)) <= tol {
             self.previous = Some(start.forces);
             return start;
@@ -405,18 +224,19 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             working,
             forces,
             active: [ActiveSet::default(); N],
+            cost: WalkCost::default(),
         };
         // A kept start that already meets the request stays as it is (a repeated request keeps
         // its forces); any other sheds internal force before it walks.
         if forces != start.forces && max_abs(&walk.remaining(&request.wrench)) > tol {
             walk.shed_internal();
         }
-        let limit = 2 * e.working_count() + 4;
+        let limit = WalkCost::bound(e.working_count(), self.max_rounds.unwrap_or(u32::MAX)).rounds;
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
         // than its step gained, and the result is never worse than the start.
         let mut best = rpi;
-        while (rounds as usize) < limit {
+        while rounds < limit {
             let r = walk.remaining(&request.wrench);
             let error = torque_first(&r);
             if error < best.0 {
@@ -462,6 +282,11 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             *s = on_boundary(b, set, f);
         }
         self.previous = Some(forces);
+        self.last = WalkCost {
+            start_rounds: start.rounds,
+            rounds,
+            ..walk.cost
+        };
         Allocation::from_forces(request, forces, start.rounds + rounds, saturated)
     }
 
