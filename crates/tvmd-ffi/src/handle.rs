@@ -130,6 +130,15 @@ pub(crate) unsafe fn controller<'a>(
     inner(handle).map(|i| &i.controller)
 }
 
+/// The commands a refused period holds: the controller's previous ones.
+pub(crate) fn held_commands(controller: &FfiController) -> [TvmdAgentCommand; TVMD_MAX_AGENTS] {
+    let mut held = [TvmdAgentCommand::default(); TVMD_MAX_AGENTS];
+    for (slot, c) in held.iter_mut().zip(controller.previous_commands()) {
+        *slot = c.into();
+    }
+    held
+}
+
 /// The core controller a configuration describes.
 pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
     let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
@@ -265,11 +274,7 @@ pub unsafe extern "C" fn tvmd_step(
     let controller = &mut inner.controller;
     let n = controller.team().len();
     let hold = |out: &mut TvmdOutput, status, controller: &FfiController| {
-        let mut held = [TvmdAgentCommand::default(); TVMD_MAX_AGENTS];
-        for (slot, c) in held.iter_mut().zip(controller.previous_commands()) {
-            *slot = c.into();
-        }
-        out.held(status, n, &held);
+        out.held(status, n, &held_commands(controller));
         status
     };
     let (Some(state), Some(reference)) = (state.as_ref(), reference.as_ref()) else {

@@ -7,7 +7,7 @@
 
 use tvmd_core::nalgebra::Vector6;
 
-use crate::handle::{checked_size, inner as inner_ref, inner_mut};
+use crate::handle::{checked_size, held_commands, inner as inner_ref, inner_mut};
 use crate::status::*;
 use crate::types::*;
 use crate::TVMD_MAX_AGENTS;
@@ -288,10 +288,7 @@ pub unsafe extern "C" fn tvmd_allocate(
     };
     let controller = &mut inner.controller;
     let n = controller.team().len();
-    let mut held = [TvmdAgentCommand::default(); TVMD_MAX_AGENTS];
-    for (slot, c) in held.iter_mut().zip(controller.previous_commands()) {
-        *slot = c.into();
-    }
+    let held = held_commands(controller);
     let Some(wrench) = wrench.as_ref() else {
         out.held(TVMD_ERR_NULL_POINTER, n, &held);
         return TVMD_ERR_NULL_POINTER;

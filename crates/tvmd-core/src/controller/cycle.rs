@@ -7,7 +7,7 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use super::guard::{check_range, first_non_finite};
+use super::guard::{check_range, first_non_finite, first_non_finite_allocation};
 use super::{ControlOutput, Controller, CycleError};
 use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceReport};
 use crate::anti_windup::Saturation;
@@ -149,15 +149,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if force.iter().any(|x| *x != T::zero()) && all_idle(&stage.commands) {
             return Err(self.reject(InputError::Unattainable { field: "wrench" }));
         }
-        let probe =
-            stage.commands.iter().fold(T::zero(), |acc, c| {
-                acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * T::zero()
-            }) + (stage.allocation.e_f + stage.allocation.wrench_error + stage.torque_error)
-                * T::zero();
-        if probe != T::zero() {
-            return Err(self.reject(InputError::Overflow {
-                field: "output.allocation",
-            }));
+        let checked = first_non_finite_allocation(&stage.commands, &stage.allocation)
+            .or((!stage.torque_error.is_finite()).then_some("output.allocation"));
+        if let Some(field) = checked {
+            return Err(self.reject(InputError::Overflow { field }));
         }
         self.previous = stage.commands;
         if let Some((state, pending)) = self.pending.take() {

@@ -4,6 +4,8 @@
 use nalgebra::Vector3;
 
 use super::ControlOutput;
+use crate::allocation::Allocation;
+use crate::command::AgentCommand;
 use crate::error::InputError;
 use crate::law::{Gains, Reference, RigidState};
 use crate::real::{count, lit, to_f64, Real};
@@ -74,27 +76,10 @@ pub(super) fn input_limit<T: Real, const N: usize>(
 pub(super) fn first_non_finite<T: Real, const N: usize>(
     out: &ControlOutput<T, N>,
 ) -> Option<&'static str> {
-    let zero = T::zero();
-    let probe = |values: &[T]| values.iter().fold(zero, |acc, x| acc + *x * zero) == zero;
-    let commands = out.commands.iter().fold(zero, |acc, c| {
-        acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * zero
-    }) == zero;
-    let forces = out
-        .allocation
-        .forces
-        .iter()
-        .fold(zero, |acc, f| acc + (f.x + f.y + f.z) * zero)
-        == zero;
+    if let Some(field) = first_non_finite_allocation(&out.commands, &out.allocation) {
+        return Some(field);
+    }
     let law = &out.law;
-    if !commands {
-        return Some("output.commands");
-    }
-    if !forces
-        || !probe(out.allocation.wrench.as_slice())
-        || !probe(&[out.allocation.e_f, out.allocation.wrench_error])
-    {
-        return Some("output.allocation");
-    }
     if !probe(out.planner.r_d.as_slice()) || !probe(&[out.planner.theta]) {
         return Some("output.planner");
     }
@@ -111,4 +96,36 @@ pub(super) fn first_non_finite<T: Real, const N: usize>(
         return Some("output.law");
     }
     None
+}
+
+/// As [`first_non_finite`] for the allocation stage's part: the commands, then the allocation.
+pub(super) fn first_non_finite_allocation<T: Real, const N: usize>(
+    commands: &[AgentCommand<T>; N],
+    allocation: &Allocation<T, N>,
+) -> Option<&'static str> {
+    let zero = T::zero();
+    let commands = commands.iter().fold(zero, |acc, c| {
+        acc + (c.eta_x + c.eta_y + c.thrust + c.omega) * zero
+    }) == zero;
+    let forces = allocation
+        .forces
+        .iter()
+        .fold(zero, |acc, f| acc + (f.x + f.y + f.z) * zero)
+        == zero;
+    if !commands {
+        return Some("output.commands");
+    }
+    if !forces
+        || !probe(allocation.wrench.as_slice())
+        || !probe(&[allocation.e_f, allocation.wrench_error])
+    {
+        return Some("output.allocation");
+    }
+    None
+}
+
+/// Whether every value is finite (`sum x * 0 == 0`).
+fn probe<T: Real>(values: &[T]) -> bool {
+    let zero = T::zero();
+    values.iter().fold(zero, |acc, x| acc + *x * zero) == zero
 }
