@@ -111,6 +111,12 @@ pub enum ConfigField {
     AttitudeRateBandwidth,
     /// The rate bound of [`crate::AttitudeRateFilter`].
     AttitudeRateLimit,
+    /// A stated residual noise of [`crate::FaultDetector`].
+    FaultNoise,
+    /// The threshold of [`crate::FaultDetector`].
+    FaultThreshold,
+    /// The persistence of [`crate::FaultDetector`].
+    FaultPersistence,
 }
 
 impl ConfigField {
@@ -158,6 +164,9 @@ impl ConfigField {
             Self::OffsetFreeTorqueBound => "offset_free.max_torque",
             Self::AttitudeRateBandwidth => "attitude_rate.bandwidth",
             Self::AttitudeRateLimit => "attitude_rate.max_rate",
+            Self::FaultNoise => "fault.noise",
+            Self::FaultThreshold => "fault.threshold",
+            Self::FaultPersistence => "fault.persistence",
         }
     }
 }

@@ -23,7 +23,8 @@
 //! Beyond the paper, each optional and off in [`ControllerSettings::paper`]: offset-free
 //! tracking ([`offset_free`]: a [`disturbance`] observer or [`integral`] action, under
 //! [`anti_windup`]), gains that fit any team ([`gain_schedule`], [`natural_gains`]) and the
-//! planned attitude's rates ([`attitude_rate`]).
+//! planned attitude's rates ([`attitude_rate`]); agent faults detected and isolated from the
+//! wrench residual ([`fault`]).
 //!
 //! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
 //! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
@@ -62,6 +63,7 @@ pub mod disturbance;
 pub mod effectiveness;
 pub mod error;
 pub mod failure;
+pub mod fault;
 pub mod gain_schedule;
 pub mod gimbal;
 pub mod hover;
@@ -96,6 +98,7 @@ pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
 pub use failure::FailureMask;
+pub use fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
 pub use gain_schedule::GainSchedule;
 pub use gimbal::GimbalCommand;
 pub use hover::{HoverCapability, HoverLimit};
