@@ -11,6 +11,7 @@ use super::guard::{check_range, first_non_finite, first_non_finite_allocation};
 use super::{ControlOutput, Controller, CycleError};
 use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceReport};
 use crate::anti_windup::Saturation;
+use crate::attitude_rate::PlannedRates;
 use crate::command::{invert, AgentCommand};
 use crate::error::InputError;
 use crate::law::{attitude_law, control_wrench, force_request, AttitudeLaw, LawOutput};
@@ -116,11 +117,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         validate_rotation(r_d, "planner.r_d")?;
         reference.validate()?;
         let rates = match self.planned_rates() {
-            Some(p) => Reference {
-                angular_velocity: p.omega_d,
-                angular_acceleration: p.omega_d_dot,
-                ..*reference
-            },
+            Some(p) => with_rates(reference, &p),
             None => *reference,
         };
         let mut law = attitude_law(&self.plant, &self.gains, state, &rates, r_d);
@@ -283,11 +280,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             )
         };
         let mut law = match planned {
-            Some(rates) => law_of(&Reference {
-                angular_velocity: rates.omega_d,
-                angular_acceleration: rates.omega_d_dot,
-                ..*reference
-            }),
+            Some(rates) => law_of(&with_rates(reference, &rates)),
             None => law_of(reference),
         };
         let pending = match compensation {
@@ -382,6 +375,15 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             error,
             commands: self.previous,
         }
+    }
+}
+
+/// `reference` with the planned attitude's rates in place of its `Omega_d`, `Omega_d_dot`.
+fn with_rates<T: Real>(reference: &Reference<T>, rates: &PlannedRates<T>) -> Reference<T> {
+    Reference {
+        angular_velocity: rates.omega_d,
+        angular_acceleration: rates.omega_d_dot,
+        ..*reference
     }
 }
 

@@ -52,23 +52,7 @@ pub(crate) fn identity() -> [f32; 9] {
 }
 
 pub(crate) fn step(handle: &mut TvmdController, x: f32) -> (TvmdStatus, TvmdOutput) {
-    let state = TvmdState {
-        size: size_of::<TvmdState>() as u32,
-        position: [x, 0.0, 1.5],
-        attitude: identity(),
-        ..TvmdState::default()
-    };
-    let reference = TvmdReference {
-        size: size_of::<TvmdReference>() as u32,
-        position: [0.0, 0.0, 1.5],
-        attitude: identity(),
-        ..TvmdReference::default()
-    };
-    let mut out: TvmdOutput = unsafe { std::mem::zeroed() };
-    out.size = size_of::<TvmdOutput>() as u32;
-    // SAFETY: valid pointers to live values.
-    let status = unsafe { tvmd_step(handle, &state, &reference, &mut out) };
-    (status, out)
+    step_state(handle, &RigidState::at_rest(Vector3::new(x, 0.0, 1.5)))
 }
 
 #[test]
