@@ -3,8 +3,9 @@
 
 use nalgebra::Vector3;
 
+use crate::linalg::EuclideanNorm;
 use crate::linalg::{max_abs, plain_is_exact};
-use crate::real::Real;
+use crate::real::{sqrt, Real};
 
 /// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
 /// unit thrust direction in the agent frame.
@@ -46,14 +47,14 @@ impl<T: Real> GimbalCommand<T> {
     pub fn from_force(force: &Vector3<T>) -> Self {
         let squared = force.norm_squared();
         let (unit_scaled, n, m) = if plain_is_exact(squared) {
-            (*force, squared.sqrt(), T::one())
+            (*force, sqrt(squared), T::one())
         } else {
             let m = max_abs(force);
             if m == T::zero() || !m.is_finite() {
                 return Self::idle();
             }
             let unit_scaled = force / m;
-            (unit_scaled, unit_scaled.norm(), m)
+            (unit_scaled, unit_scaled.euclidean_norm(), m)
         };
         // Rounding can push |f_y|/T a hair above 1.
         let sin_x = (-unit_scaled.y / n).clamp(-T::one(), T::one());

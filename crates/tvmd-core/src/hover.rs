@@ -23,6 +23,7 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use crate::admissible::{AdmissibleSet, Interval};
 use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
+use crate::linalg::EuclideanNorm;
 use crate::linalg::GramSolver;
 use crate::real::{eps, lit, Real};
 
@@ -145,7 +146,8 @@ pub fn hover_allocation<T: Real, const N: usize>(
     // Half-widths of the box in force units near its centre, relative to the thrust's (a
     // common scale cancels, so huge thrust ranges cannot overflow the Gram matrix).
     let thrust_half = half(&set.thrust());
-    let lateral = |eta_half: T| (centre.norm() * eta_half.sin() / thrust_half).max(eps::<T>());
+    let lateral =
+        |eta_half: T| (centre.euclidean_norm() * eta_half.sin() / thrust_half).max(eps::<T>());
     let d2 = Vector3::new(
         lateral(half(&set.eta_y())).powi(2),
         lateral(half(&set.eta_x())).powi(2),

@@ -2,7 +2,7 @@
 //! rate limits, and the intervals admissible sets are made of.
 
 use crate::error::{ConfigError, ConfigField, GimbalAxis};
-use crate::real::Real;
+use crate::real::{sqrt, Real};
 
 /// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
 /// `T = rho d^4 c_l omega^2` (eq. 5).
@@ -182,7 +182,7 @@ impl<T: Real> AgentLimits<T> {
 
     /// Rotor speed for a thrust (eq. 5 inverted); negative thrust maps to 0.
     pub fn speed_for_thrust(&self, thrust: T) -> T {
-        (thrust.max(T::zero()) / self.thrust_coefficient).sqrt()
+        sqrt(thrust.max(T::zero()) / self.thrust_coefficient)
     }
 
     /// Thrust for a rotor speed (eq. 5).

@@ -4,9 +4,10 @@
 // Triangular solves read clearest with index loops over the fixed 6x6 arrays.
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
-use nalgebra::{Matrix6, Matrix6x3, SVector, Vector6};
+use nalgebra::storage::Storage;
+use nalgebra::{Dim, Matrix, Matrix6, Matrix6x3, SVector, Vector6};
 
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 
 /// `||v||` without overflow or underflow (hand-written: nalgebra's `norm()` squares the
 /// components, which overflows above `sqrt(MAX)` and underflows below `sqrt(MIN_POSITIVE)`).
@@ -16,28 +17,42 @@ use crate::real::{eps, lit, Real};
 pub(crate) fn norm<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
     let squared = v.norm_squared();
     if plain_is_exact(squared) {
-        return squared.sqrt();
+        return sqrt(squared);
     }
     let m = max_abs(v);
     if m == T::zero() {
         return m;
     }
     // Divided, not multiplied by `1 / m`, which overflows for a subnormal `m`.
-    (v / m).norm() * m
+    (v / m).euclidean_norm() * m
+}
+
+/// `||v||` in the same bits as nalgebra's `norm()` (the root of `norm_squared()`), the root
+/// taken by [`sqrt`]: the FPU's on a hard-float Arm target, where nalgebra's is software.
+pub(crate) trait EuclideanNorm<T> {
+    /// `sqrt(sum v_i^2)`, unscaled (it overflows as nalgebra's `norm` does; see [`norm`]).
+    fn euclidean_norm(&self) -> T;
+}
+
+impl<T: Real, R: Dim, C: Dim, S: Storage<T, R, C>> EuclideanNorm<T> for Matrix<T, R, C, S> {
+    #[inline]
+    fn euclidean_norm(&self) -> T {
+        sqrt(self.norm_squared())
+    }
 }
 
 /// `v / ||v||` through [`norm`]'s scaling (zero for `v = 0`, NaN for a non-finite `v`).
 pub(crate) fn normalize<T: Real, const D: usize>(v: &SVector<T, D>) -> SVector<T, D> {
     let squared = v.norm_squared();
     if plain_is_exact(squared) {
-        return v / squared.sqrt();
+        return v / sqrt(squared);
     }
     let m = max_abs(v);
     if m == T::zero() {
         return *v;
     }
     let u = v / m;
-    u / u.norm()
+    u / u.euclidean_norm()
 }
 
 /// `v` scaled onto the ball `||v|| <= bound` when it lies outside (its direction kept); zero

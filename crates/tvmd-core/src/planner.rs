@@ -5,8 +5,9 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::error::{ConfigError, ConfigField, InputError};
+use crate::linalg::EuclideanNorm;
 use crate::linalg::{norm, normalize};
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 use crate::rotation::validate_rotation;
 
 /// How the planner reached its output.
@@ -259,7 +260,7 @@ impl<T: Real> AttitudePlanner<T> {
                 (t, tilt.direction(t))
             } else {
                 let sum = z_lo + z_hi;
-                let norm = sum.norm();
+                let norm = sum.euclidean_norm();
                 // The great-circle midpoint without trigonometry; |sum| = 2 cos(width / 2)
                 // vanishes only for a half-turn bracket.
                 let mid = (lo + hi) * half;
@@ -309,7 +310,7 @@ fn guide<T: Real>(cone: &EllipticCone<T>, u: &Vector3<T>) -> (T, bool) {
     }
     let q = cone.quadratic_form(u);
     // `u.z >= 0` is not implied here: a NaN height reaches this line and is not admitted.
-    (q.sqrt() - T::one(), u.z >= T::zero() && q <= T::one())
+    (sqrt(q) - T::one(), u.z >= T::zero() && q <= T::one())
 }
 
 /// `R_d(theta)` of eqs. (10)-(11): `R_r` tilted by `theta` toward `f_r`, the family the planner
@@ -343,7 +344,7 @@ impl<T: Real> Tilt<T> {
         // The direction of f_r only: scaled so a huge or tiny f_r neither overflows nor underflows.
         let f_hat = normalize(f_r);
         let cross = b_zr.cross(&f_hat);
-        let cross_norm = cross.norm();
+        let cross_norm = cross.euclidean_norm();
         // f_r (anti)parallel to b_zr: no unique axis; roll about b_xr (documented choice).
         let k = if cross_norm > eps::<T>() * lit(8.0) {
             cross / cross_norm
@@ -376,7 +377,7 @@ impl<T: Real> Tilt<T> {
     /// `R_d = [b_xd b_yd b_zd]` completed from `b_zd` as in [`Self::attitude`].
     fn frame(&self, b_zd: Vector3<T>) -> Matrix3<T> {
         let y = b_zd.cross(&self.b_xr);
-        let y_norm = y.norm();
+        let y_norm = y.euclidean_norm();
         let (b_xd, b_yd) = if y_norm > eps::<T>().sqrt() {
             let b_yd = y * (T::one() / y_norm);
             (b_yd.cross(&b_zd), b_yd)

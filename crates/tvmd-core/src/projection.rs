@@ -3,8 +3,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
+use crate::linalg::EuclideanNorm;
 use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 
 /// The projected force and the factors of `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,7 +71,7 @@ pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> F
     // rounding of the products (`contains` at `s = 1` holds exactly).
     let shrink = T::one() - eps::<T>() * lit(4.0);
     let t_tf = if m > T::zero() && norm(u_fr) > limit {
-        (limit / m) / (u_fr / m).norm() * shrink
+        (limit / m) / (u_fr / m).euclidean_norm() * shrink
     } else {
         T::one()
     };
@@ -79,7 +80,7 @@ pub fn project_force_in<T: Real>(cone: &EllipticCone<T>, u_fr: &Vector3<T>) -> F
     let t_eta = if q <= T::one() {
         T::one()
     } else if q.is_finite() {
-        (T::one() / q).sqrt() * shrink
+        sqrt(T::one() / q) * shrink
     } else {
         T::zero()
     };

@@ -35,6 +35,45 @@ pub(crate) fn eps<T: Real>() -> T {
     T::default_epsilon()
 }
 
+/// `sqrt(x)`, correctly rounded (IEEE 754), so the same bits as `T::sqrt`. Why by hand: on a
+/// hard-float Arm target (Cortex-M4F, M7) a `no_std` build's `f32::sqrt` is the `libm` crate's
+/// software `sqrtf` (an integer iteration of about 60 instructions a call), where the FPU has
+/// `vsqrt.f32`, one instruction; norms are the allocators' inner loop. Elsewhere `T::sqrt`.
+#[inline]
+pub(crate) fn sqrt<T: Real>(x: T) -> T {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    if let Some(v) = (&x as &dyn core::any::Any).downcast_ref::<f32>() {
+        let root = vsqrt_f32(*v);
+        if let Some(r) = (&root as &dyn core::any::Any).downcast_ref::<T>() {
+            return *r;
+        }
+    }
+    x.sqrt()
+}
+
+/// The FPU's square root (`vsqrt.f32`): IEEE 754's correctly rounded `sqrt`. Through a core
+/// register and `s15` (saved and restored around it): Rust gives the single-precision register
+/// class to `asm!` only with the `vfp2` feature, which the Cortex-M4F's FPv4-SP lacks.
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[inline]
+fn vsqrt_f32(x: f32) -> f32 {
+    let mut bits = x.to_bits();
+    // SAFETY: `s15` is pushed before and popped after, so no register the compiler uses
+    // changes; the stack is balanced; only FPSCR's cumulative exception bits may change.
+    unsafe {
+        core::arch::asm!(
+            "vpush {{s15}}",
+            "vmov s15, {bits}",
+            "vsqrt.f32 s15, s15",
+            "vmov {bits}, s15",
+            "vpop {{s15}}",
+            bits = inout(reg) bits,
+            options(pure, nomem, preserves_flags)
+        );
+    }
+    f32::from_bits(bits)
+}
+
 /// `(sin x, cos x)`. In `f32` for `|x| <= pi`, an `f32`-only kernel ([`sin_cos_f32`]); else the
 /// type's own `sin_cos`. Why by hand: the `libm` crate's `sincosf` (what nalgebra's `f32`
 /// `sin_cos` is on a `no_std` target) evaluates in `f64`, which a Cortex-M4F (single-precision

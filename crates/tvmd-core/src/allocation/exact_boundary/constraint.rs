@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use crate::admissible::AdmissibleSet;
 use crate::limits::Interval;
 use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 
 /// Number of constraints of one agent.
 pub(in crate::allocation) const CONSTRAINTS: usize = 6;
@@ -118,7 +118,7 @@ impl<T: Real> Constraint<T> {
                 return None;
             }
             // The stable pair: no cancellation between `b` and the root of the discriminant.
-            let w = -(b + disc.sqrt().copysign(b));
+            let w = -(b + sqrt(disc).copysign(b));
             roots[0] = Some(w / a);
             if w != T::zero() {
                 roots[1] = Some(c / w);
@@ -130,7 +130,7 @@ impl<T: Real> Constraint<T> {
             .filter(|t| t.is_finite() && *t >= T::zero())
             .filter(|t| {
                 let x = f + d * *t;
-                self.s * (p + q * *t) <= T::zero() && slope(x.dot(d), x.dot(&x).sqrt()) > T::zero()
+                self.s * (p + q * *t) <= T::zero() && slope(x.dot(d), sqrt(x.dot(&x))) > T::zero()
             })
             .fold(None, |best: Option<T>, t| match best {
                 Some(b) if b <= t => Some(b),
@@ -156,7 +156,7 @@ impl<T: Real> Constraint<T> {
             let fy = -(self.s * n + self.k) / self.c.y;
             let side = Vector3::new(f.x, zero, f.z);
             let side_len = norm(&side);
-            let rest = (n * n - fy * fy).max(zero).sqrt();
+            let rest = sqrt((n * n - fy * fy).max(zero));
             if side_len <= zero {
                 return *f;
             }
@@ -210,8 +210,8 @@ impl<T: Real> Ray<T> {
             ff,
             dd,
             fd: f.dot(&d),
-            f_len: ff.sqrt(),
-            d_len: dd.sqrt(),
+            f_len: sqrt(ff),
+            d_len: sqrt(dd),
         })
     }
 }
