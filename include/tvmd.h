@@ -990,6 +990,12 @@ typedef struct TvmdPlanOutput {
 #define TVMD_ERR_CONFIG_UNUSED_OPTION 38
 
 /*
+ [`ConfigError::StageUnavailable`]: a stage this build does not link (the null-space stage;
+ not reachable through this API, whose configuration has none; kept one-to-one).
+ */
+#define TVMD_ERR_CONFIG_STAGE_UNAVAILABLE 39
+
+/*
  The actuator map's agent count is not the controller's.
  */
 #define TVMD_ERR_MAP_AGENT_COUNT 50

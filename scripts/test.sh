@@ -64,6 +64,9 @@ step "cargo test --features clarabel (the constrained allocator; the paper scena
 cargo test -p tvmd-core --features clarabel
 cargo test -p tvmd-sim --features clarabel --test flight closed_loop::
 
+step "tvmd-core without the null-space stage (the C interface's build): a setting for it is refused"
+cargo test -p tvmd-core --no-default-features --features std --test config_bounds
+
 step "randomized control cycle: 1,000,000 steps per type (f32, f64), then 200,000 per type with clarabel"
 # Optimized build (ci profile); prints the counts (steps, Ok, each error variant, rejected teams).
 # Measured on the 2-core development machine in the ci profile: 11 s for both types and 7 s for

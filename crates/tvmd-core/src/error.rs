@@ -291,6 +291,14 @@ pub enum ConfigError {
         /// `clarabel`).
         name: &'static str,
     },
+    /// A stage the settings ask for that this build does not link: the null-space stage
+    /// (`ControllerSettings::null_space`) without the cargo feature `null-space`.
+    StageUnavailable {
+        /// The stage (`"null-space"`).
+        name: &'static str,
+        /// The cargo feature of `tvmd-core` that links it.
+        feature: &'static str,
+    },
     /// An option given to [`crate::AnyAllocator::from_name`] that the named allocator does not
     /// take.
     UnusedOption {
@@ -336,7 +344,8 @@ impl ConfigError {
             | Self::AgentCount { .. }
             | Self::FailureIndex { .. }
             | Self::UnknownAllocator
-            | Self::AllocatorUnavailable { .. } => None,
+            | Self::AllocatorUnavailable { .. }
+            | Self::StageUnavailable { .. } => None,
         }
     }
 }
@@ -401,6 +410,11 @@ impl fmt::Display for ConfigError {
             Self::AllocatorUnavailable { name } => write!(
                 f,
                 "allocator `{name}` needs the cargo feature `clarabel`, which this build lacks"
+            ),
+            Self::StageUnavailable { name, feature } => write!(
+                f,
+                "the {name} stage needs the cargo feature `{feature}` of tvmd-core, which this \
+                 build lacks"
             ),
             Self::UnusedOption { field } => {
                 write!(f, "the allocator takes no `{field}` option")

@@ -256,3 +256,27 @@ fn controller_period_is_bounded() {
         assert!(with_period(good).is_ok(), "{good}");
     }
 }
+
+/// A null-space stage is linked with the cargo feature `null-space` (on by default); a build
+/// without it (the C interface's) refuses the setting by name instead of ignoring it.
+#[test]
+fn a_null_space_stage_needs_its_feature() {
+    use tvmd_core::{NullSpaceObjective, NullSpaceStage};
+    let team = presets::a4_inc::<f32, 4>().unwrap();
+    let settings = ControllerSettings {
+        null_space: Some(NullSpaceStage::new(NullSpaceObjective::Margin, 8).unwrap()),
+        ..ControllerSettings::paper()
+    };
+    let result = Controller::new(team, settings, RedistributedPseudoInverse);
+    if cfg!(feature = "null-space") {
+        assert!(result.is_ok());
+    } else {
+        assert_eq!(
+            result.map(|_| ()).unwrap_err(),
+            ConfigError::StageUnavailable {
+                name: "null-space",
+                feature: "null-space"
+            }
+        );
+    }
+}

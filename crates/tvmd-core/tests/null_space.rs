@@ -3,6 +3,7 @@
 //! forces are finite and admissible, failed agents stay at zero, the wrench moves by at most
 //! the stated drift bound, and the objective (and, for the margin objective, the smallest
 //! margin) never falls. The controller runs the stage only when configured.
+#![cfg(feature = "null-space")]
 
 use nalgebra::{Vector3, Vector6};
 use proptest::prelude::*;

@@ -80,6 +80,9 @@ pub const TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR: TvmdStatus = 36;
 pub const TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE: TvmdStatus = 37;
 /// [`ConfigError::UnusedOption`]: an option the chosen allocator does not take.
 pub const TVMD_ERR_CONFIG_UNUSED_OPTION: TvmdStatus = 38;
+/// [`ConfigError::StageUnavailable`]: a stage this build does not link (the null-space stage;
+/// not reachable through this API, whose configuration has none; kept one-to-one).
+pub const TVMD_ERR_CONFIG_STAGE_UNAVAILABLE: TvmdStatus = 39;
 
 /// The actuator map's agent count is not the controller's.
 pub const TVMD_ERR_MAP_AGENT_COUNT: TvmdStatus = 50;
@@ -128,6 +131,7 @@ pub fn config_status(error: &ConfigError) -> TvmdStatus {
         ConfigError::UnknownAllocator => TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR,
         ConfigError::AllocatorUnavailable { .. } => TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE,
         ConfigError::UnusedOption { .. } => TVMD_ERR_CONFIG_UNUSED_OPTION,
+        ConfigError::StageUnavailable { .. } => TVMD_ERR_CONFIG_STAGE_UNAVAILABLE,
     }
 }
 
@@ -189,6 +193,7 @@ pub extern "C" fn tvmd_status_name(status: TvmdStatus) -> *const core::ffi::c_ch
         TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR => "TVMD_ERR_CONFIG_UNKNOWN_ALLOCATOR\0",
         TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE => "TVMD_ERR_CONFIG_ALLOCATOR_UNAVAILABLE\0",
         TVMD_ERR_CONFIG_UNUSED_OPTION => "TVMD_ERR_CONFIG_UNUSED_OPTION\0",
+        TVMD_ERR_CONFIG_STAGE_UNAVAILABLE => "TVMD_ERR_CONFIG_STAGE_UNAVAILABLE\0",
         TVMD_ERR_MAP_AGENT_COUNT => "TVMD_ERR_MAP_AGENT_COUNT\0",
         TVMD_ERR_MAP_CHANNEL_RANGE => "TVMD_ERR_MAP_CHANNEL_RANGE\0",
         TVMD_ERR_MAP_DUPLICATE_CHANNEL => "TVMD_ERR_MAP_DUPLICATE_CHANNEL\0",

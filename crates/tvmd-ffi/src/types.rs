@@ -318,7 +318,9 @@ pub(crate) fn vector(v: &[f32; 3]) -> Vector3<f32> {
 }
 
 pub(crate) fn matrix(m: &[f32; 9]) -> Matrix3<f32> {
-    Matrix3::from_row_slice(m)
+    // Not `from_row_slice`: its length check is a panic path that only `opt-level = 3` removes.
+    let [a, b, c, d, e, f, g, h, i] = *m;
+    Matrix3::new(a, b, c, d, e, f, g, h, i)
 }
 
 pub(crate) fn row_major(m: &Matrix3<f32>) -> [f32; 9] {

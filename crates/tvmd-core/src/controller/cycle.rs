@@ -316,9 +316,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             wrench: *wrench,
         };
         let allocation = self.allocator.allocate(&request);
+        // Without the feature `validate` refuses a stage, so `None` is the only case left.
         let (allocation, null_space) = match &self.settings.null_space {
+            #[cfg(feature = "null-space")]
             Some(stage) => stage.refine(&request, &allocation),
-            None => (allocation, NullSpaceReport::off()),
+            _ => (allocation, NullSpaceReport::off()),
         };
         let mut commands = [AgentCommand::idle(); N];
         let mut command_clamp = T::zero();

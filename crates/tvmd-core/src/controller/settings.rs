@@ -128,9 +128,16 @@ impl<T: Real> ControllerSettings<T> {
     }
 
     /// Gains, relaxation, rate limits, the offset-free action and the rate filter are valid by
-    /// construction (private fields); only the two plain numbers are checked here: gravity
-    /// finite and positive, the period in [[`MIN_PERIOD`], [`MAX_PERIOD`]].
+    /// construction (private fields); checked here: gravity finite and positive, the period in
+    /// [[`MIN_PERIOD`], [`MAX_PERIOD`]], and a null-space stage only in a build that links it
+    /// (cargo feature `null-space`).
     pub(crate) fn validate(&self) -> Result<(), ConfigError> {
+        if cfg!(not(feature = "null-space")) && self.null_space.is_some() {
+            return Err(ConfigError::StageUnavailable {
+                name: "null-space",
+                feature: "null-space",
+            });
+        }
         if !self.gravity.is_finite() || self.gravity <= T::zero() {
             return Err(ConfigError::Parameter {
                 field: ConfigField::Gravity,

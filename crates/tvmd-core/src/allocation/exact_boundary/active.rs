@@ -143,6 +143,7 @@ impl<T: Real> ActiveSet<T> {
     }
 
     /// The orthonormal normals of the held tangent planes (up to two).
+    #[cfg(feature = "null-space")]
     pub(in crate::allocation) fn normals(&self) -> impl Iterator<Item = &Vector3<T>> {
         self.basis.iter().flatten()
     }

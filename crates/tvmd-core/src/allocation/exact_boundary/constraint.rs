@@ -63,6 +63,7 @@ impl<T: Real> Constraint<T> {
     /// (or, by round-off, just beyond) the boundary and `d` points out; `None` when the ray never
     /// leaves. `f` and `d` finite. (The walk scales one ray for all six; the null-space stage
     /// asks one constraint at a time.)
+    #[cfg(any(test, feature = "null-space"))]
     pub(in crate::allocation) fn first_exit(&self, f: &Vector3<T>, d: &Vector3<T>) -> Option<T> {
         Ray::new(f, d, self.k.abs())
             .and_then(|ray| self.first_exit_along(&ray, T::max_value().unwrap_or_else(T::one)))

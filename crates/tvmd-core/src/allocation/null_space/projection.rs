@@ -2,9 +2,12 @@
 
 use nalgebra::Vector3;
 
+#[cfg(feature = "null-space")]
 use super::super::exact_boundary::active::ActiveSet;
 use crate::effectiveness::Effectiveness;
-use crate::linalg::{norm, solve_gram};
+use crate::linalg::norm;
+#[cfg(feature = "null-space")]
+use crate::linalg::solve_gram;
 use crate::real::{eps, lit, Real};
 
 /// The step direction in `null(M)` for gradient `g`, with every agent that sits on a boundary
@@ -15,6 +18,7 @@ use crate::real::{eps, lit, Real};
 /// and a held agent moves along or into its set, never out (`P = I`, `q = 0` without held
 /// boundaries: `d = g - M^T (M M^T)^-1 M g`). Zero for failed agents. `None` when the result is
 /// not finite. A `frozen` agent does not move (`P_i = 0`, `q_i = 0`).
+#[cfg(feature = "null-space")]
 pub(super) fn project_null<T: Real, const N: usize>(
     effectiveness: &Effectiveness<T, N>,
     active: &[ActiveSet<T>; N],
@@ -86,7 +90,7 @@ pub(super) fn drift_bound<T: Real, const N: usize>(
     eps::<T>() * lit(1e3) * scale * total(before).max(total(after))
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "null-space"))]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
