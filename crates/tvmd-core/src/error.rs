@@ -1,8 +1,7 @@
 //! Typed errors: [`ConfigError`] for a team, limits, gains or settings that cannot be used, and
 //! [`InputError`] for a control-cycle input that cannot be used.
 //!
-//! Values are reported as `f64` so the enums are not generic and print the same for `f32` and
-//! `f64` builds.
+//! Values are reported as `f64`: the enums are not generic and print the same in `f32` and `f64`.
 
 use core::fmt;
 
@@ -287,12 +286,10 @@ pub enum ConfigError {
     UnknownAllocator,
     /// The named allocator needs a cargo feature this build does not have.
     AllocatorUnavailable {
-        /// The allocator (`"clarabel"` or `"clarabel-sequential"`, both of the feature
-        /// `clarabel`).
+        /// The allocator (`"clarabel"` or `"clarabel-sequential"`, feature `clarabel`).
         name: &'static str,
     },
-    /// A stage the settings ask for that this build does not link: the null-space stage
-    /// (`ControllerSettings::null_space`) without the cargo feature `null-space`.
+    /// A stage this build does not link (the null-space stage without the feature `null-space`).
     StageUnavailable {
         /// The stage (`"null-space"`).
         name: &'static str,
@@ -411,11 +408,9 @@ impl fmt::Display for ConfigError {
                 f,
                 "allocator `{name}` needs the cargo feature `clarabel`, which this build lacks"
             ),
-            Self::StageUnavailable { name, feature } => write!(
-                f,
-                "the {name} stage needs the cargo feature `{feature}` of tvmd-core, which this \
-                 build lacks"
-            ),
+            Self::StageUnavailable { name, feature } => {
+                write!(f, "the {name} stage needs tvmd-core's cargo feature `{feature}`")
+            }
             Self::UnusedOption { field } => {
                 write!(f, "the allocator takes no `{field}` option")
             }
