@@ -274,7 +274,7 @@ typedef struct TvmdActuatorOutputs {
    */
   uint32_t size;
   /*
-   Motor channels in `[0, 1]`, NaN when unused.
+   Motor channels in `[0, 1]`; NaN when unused or the agent failed (stopped).
    */
   float motors[TVMD_MAX_AGENTS];
   /*
@@ -1063,7 +1063,7 @@ TvmdStatus tvmd_actuator_map_validate(const struct TvmdController *handle,
 /*
  Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
  and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
- mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
+ mask) get NaN motors (PX4's "stopped") and servos at trim; channels no agent uses are NaN. A working agent's
  command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
  clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status
  too: its commands are the held ones.

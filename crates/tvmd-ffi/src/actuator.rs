@@ -14,8 +14,9 @@
 //! - Servo value: `trim + direction * eta / range`, `range` the gimbal angle (rad) of a unit
 //!   deflection from trim. The map is refused unless the whole gimbal travel `[-sigma, sigma]`
 //!   lands inside `[-1, 1]`, so no admissible command is ever clipped.
-//! - Unused channels are NaN, as PX4 marks a channel it does not drive; a failed agent's
-//!   motors are 0 and its servos at trim.
+//! - Unused channels are NaN, as PX4 marks a channel it does not drive; so are a failed
+//!   agent's motors (PX4's "stopped": 0 would be an armed motor at its lowest command), and its
+//!   servos are at trim.
 
 use tvmd_core::command::command_tolerance;
 use tvmd_core::AgentLimits;
@@ -73,7 +74,7 @@ pub struct TvmdActuatorMap {
 pub struct TvmdActuatorOutputs {
     /// `sizeof(TvmdActuatorOutputs)`, set by the caller.
     pub size: u32,
-    /// Motor channels in `[0, 1]`, NaN when unused.
+    /// Motor channels in `[0, 1]`; NaN when unused or the agent failed (stopped).
     pub motors: [f32; TVMD_MAX_AGENTS],
     /// Servo channels in `[-1, 1]`, NaN when unused.
     pub servos: [f32; TVMD_MAX_AGENTS],
@@ -242,7 +243,7 @@ pub unsafe extern "C" fn tvmd_actuator_map_validate(
 
 /// Maps `tvmd_step`'s commands (`commands`, `count` entries, normally `TvmdOutput.commands`
 /// and `TVMD_MAX_AGENTS`) to normalized outputs through `map`. Failed agents (the controller's
-/// mask) get motors 0 and servos at trim; channels no agent uses are NaN. A working agent's
+/// mask) get NaN motors (PX4's "stopped") and servos at trim; channels no agent uses are NaN. A working agent's
 /// command that is not finite or outside `E_f` is refused (`TVMD_ERR_ACTUATOR_VALUE`), never
 /// clipped. On an error `outputs` is not written. Map `tvmd_step`'s output on an error status
 /// too: its commands are the held ones.
@@ -288,7 +289,7 @@ pub unsafe extern "C" fn tvmd_actuator_outputs(
     for (i, (agent, c)) in agents.iter().zip(commands).enumerate() {
         let failed = failures.is_failed(i);
         let motor = if failed {
-            0.0
+            f32::NAN
         } else {
             motor_value(curve, limits, c)
         };

@@ -111,12 +111,14 @@ fn actuator_channels_follow_the_map_and_round_trip() {
     for (i, (c, b)) in out.commands.iter().zip(&back).enumerate().take(4) {
         let (m0, m1) = (act.motors[11 - i], act.motors[4 + i]);
         let (sx, sy) = (act.servos[i], act.servos[4 + i]);
-        assert_eq!(m0, m1, "agent {i}: one speed for the coaxial pair");
         if i == 1 {
-            assert_eq!((m0, sx, sy), (0.0, 0.0, 0.0), "a failed agent is safe");
+            // PX4's "stopped" for both motors, the servos at trim.
+            assert!(m0.is_nan() && m1.is_nan(), "a failed agent's motors stop");
+            assert_eq!((sx, sy), (0.0, 0.0), "a failed agent's gimbal at trim");
             assert_eq!(*b, TvmdAgentCommand::default());
             continue;
         }
+        assert_eq!(m0, m1, "agent {i}: one speed for the coaxial pair");
         assert!(
             (m0 - c.omega).abs() <= 1e-6,
             "agent {i}: motor = omega / sigma_omega"
