@@ -104,6 +104,10 @@ step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"
 # processor-in-the-loop flights (the whole step: 82 s with the firmware built).
 bash scripts/target.sh
 
+step "the C interface in a bare-metal C program: arm-none-eabi-gcc, a linker script, run on QEMU"
+# See scripts/c-link.sh (about 15 s to apt-get install gcc-arm-none-eabi where it is missing).
+bash scripts/c-link.sh
+
 step "Python wheel (maturin, abi3) and pytest"
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip

@@ -37,7 +37,7 @@ pub(crate) fn eps<T: Real>() -> T {
 
 /// `sqrt(x)`, correctly rounded (IEEE 754), so the same bits as `T::sqrt`. Why by hand: on a
 /// hard-float Arm target (Cortex-M4F, M7) a `no_std` build's `f32::sqrt` is the `libm` crate's
-/// software `sqrtf` (an integer iteration of about 60 instructions a call), where the FPU has
+/// software `sqrtf` (an integer iteration per call), where the FPU has
 /// `vsqrt.f32`, one instruction; norms are the allocators' inner loop. Elsewhere `T::sqrt`.
 #[inline]
 pub(crate) fn sqrt<T: Real>(x: T) -> T {

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# tvmd's C interface linked into a bare-metal C program by arm-none-eabi-gcc, the way a
+# Cortex-M4F flight stack links it: the staticlib (thumbv7em-none-eabihf, no default features),
+# embedded/c-link/main.c (start-up code, a hover of 50 periods with the default controller),
+# the linker script embedded/c-link/link.ld, no C library. Then it runs on QEMU's Cortex-M4F
+# (mps2-an386) and Cortex-M7 (mps2-an500) boards and must exit with success.
+# Installs gcc-arm-none-eabi (about 50 MB, without recommends) with apt-get where it is missing;
+# qemu-system-arm comes from scripts/target.sh, which the test command runs first.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! command -v arm-none-eabi-gcc >/dev/null 2>&1; then
+  echo "==> arm-none-eabi-gcc not found: installing gcc-arm-none-eabi with apt-get"
+  if [ "$(id -u)" -eq 0 ]; then
+    sudo_cmd=()
+  elif command -v sudo >/dev/null 2>&1; then
+    sudo_cmd=(sudo)
+  else
+    echo "error: arm-none-eabi-gcc is missing and neither root nor sudo can apt-get install gcc-arm-none-eabi" >&2
+    exit 1
+  fi
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
+    gcc-arm-none-eabi >/dev/null
+fi
+arm-none-eabi-gcc --version | head -n 1
+
+rustup target add thumbv7em-none-eabihf
+cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release
+target_dir="${CARGO_TARGET_DIR:-target}"
+lib="$target_dir/thumbv7em-none-eabihf/release/libtvmd_ffi.a"
+elf="$target_dir/c-link/tvmd-c-link.elf"
+mkdir -p "$(dirname "$elf")"
+
+# The flags a Cortex-M4F build of a flight stack uses (hard float: the staticlib's ABI), plus
+# freestanding and no C library; --gc-sections drops the parts of the core no entry point uses.
+flags=(-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os -std=c99
+  -Wall -Wextra -Werror -pedantic -ffreestanding -nostdlib -ffunction-sections -fdata-sections)
+arm-none-eabi-gcc "${flags[@]}" -Iinclude -T embedded/c-link/link.ld \
+  -Wl,--gc-sections -Wl,-z,noexecstack embedded/c-link/main.c "$lib" -lgcc -o "$elf"
+python3 scripts/elf_size.py "$elf"
+
+for machine in mps2-an386 mps2-an500; do
+  echo "==> $machine: the C program hovers with tvmd"
+  timeout 60 qemu-system-arm -machine "$machine" -nographic -monitor none \
+    -semihosting-config enable=on,target=native -kernel "$elf"
+done
