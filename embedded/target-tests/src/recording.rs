@@ -1,8 +1,10 @@
-//! The recorded f32 `paper-tilt` flight replayed on the target: the 1,000 consecutive control
-//! cycles `tvmd-sim record-cycles` (crate tvmd-cli) wrote into `crates/tvmd-sim/tests/data/paper_tilt_f32.cycles`
-//! (the core's exact f32 inputs, failure masks, and the host's outputs), fed in order to a fresh
-//! controller built from the recording's configuration words by the simulator's own code
-//! (`wire::CoreConfig::build`), each output compared with the host's: bit-identical, or within
+//! Recorded f32 flights replayed on the target: the 1,000 consecutive control cycles
+//! `tvmd-sim record-cycles` (crate tvmd-cli) wrote into
+//! `crates/tvmd-sim/tests/data/paper_tilt_f32.cycles` (`paper-tilt`, the paper's allocator) and
+//! `agent_failure_default_f32.cycles` (`agent-failure`, the default allocator, whose walk runs
+//! after the loss) (the core's exact f32 inputs, failure masks, and the host's outputs), fed in
+//! order to a fresh controller built from the recording's configuration words by the simulator's
+//! own code (`wire::CoreConfig::build`), each output compared with the host's: bit-identical, or within
 //! [`crate::HOST_REL`] of the quantity's scale.
 //!
 //! Scales: commanded gimbal angles and rotor speeds relative to the cycle's largest magnitude of
@@ -18,17 +20,25 @@ use tvmd_wire as wire;
 
 use wire::{Reader, Writer, AGENTS};
 
-/// The committed recording.
-static RECORDING: &[u8] =
-    include_bytes!("../../../crates/tvmd-sim/tests/data/paper_tilt_f32.cycles");
+/// The committed recordings, each with the allocator it names.
+static RECORDINGS: [(&str, &[u8]); 2] = [
+    (
+        "paper-tilt, paper's allocator",
+        include_bytes!("../../../crates/tvmd-sim/tests/data/paper_tilt_f32.cycles"),
+    ),
+    (
+        "agent-failure, default allocator",
+        include_bytes!("../../../crates/tvmd-sim/tests/data/agent_failure_default_f32.cycles"),
+    ),
+];
 
 /// Largest cycle of the recording format.
 const MAX_CYCLE_WORDS: usize = wire::cycle_words(AGENTS);
 
-/// Words `at..at + K` of the recording (little-endian).
-fn words<const K: usize>(at: usize, len: usize) -> Option<[u32; K]> {
+/// Words `at..at + K` of a recording (little-endian).
+fn words<const K: usize>(recording: &[u8], at: usize, len: usize) -> Option<[u32; K]> {
     let mut w = [0u32; K];
-    let bytes = RECORDING.get(4 * at..4 * (at + len))?;
+    let bytes = recording.get(4 * at..4 * (at + len))?;
     for (slot, c) in w.iter_mut().zip(bytes.chunks_exact(4)) {
         *slot = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
     }
@@ -93,14 +103,23 @@ fn compare(
     Ok(())
 }
 
-/// Replays the recording; prints its summary and returns whether every cycle passed.
+/// Replays every recording; prints their summaries and returns whether every cycle passed.
 pub fn replay() -> bool {
-    match run() {
+    let mut ok = true;
+    for (name, recording) in RECORDINGS {
+        ok &= replay_one(name, recording);
+    }
+    ok
+}
+
+fn replay_one(name: &str, recording: &[u8]) -> bool {
+    match run(recording) {
         Ok((cycles, identical, planner, worst)) => {
             let ok = worst.rel <= crate::HOST_REL;
             hprintln!(
-                "{} recording: {} consecutive paper-tilt f32 cycles, {} bit-identical to the host ({} differ in R_d or theta, {} in the commands only), worst rel diff {:e} ({} at cycle {}; limit {:e})",
+                "{} recording ({}): {} consecutive f32 cycles, {} bit-identical to the host ({} differ in R_d or theta, {} in the commands only), worst rel diff {:e} ({} at cycle {}; limit {:e})",
                 if ok { "ok  " } else { "FAIL" },
+                name,
                 cycles,
                 identical,
                 planner,
@@ -113,23 +132,24 @@ pub fn replay() -> bool {
             ok
         }
         Err(why) => {
-            hprintln!("FAIL recording: {}", why);
+            hprintln!("FAIL recording ({}): {}", name, why);
             false
         }
     }
 }
 
 /// Cycles, bit-identical cycles, cycles whose `R_d` or `theta` differ, the worst difference.
-fn run() -> Result<(usize, usize, usize, Worst), &'static str> {
+fn run(recording: &[u8]) -> Result<(usize, usize, usize, Worst), &'static str> {
     let [magic, version, n, cycles, c] =
-        words::<{ wire::RECORDING_HEADER_WORDS }>(0, wire::RECORDING_HEADER_WORDS)
+        words::<{ wire::RECORDING_HEADER_WORDS }>(recording, 0, wire::RECORDING_HEADER_WORDS)
             .ok_or("truncated header")?;
     if magic != wire::RECORDING_MAGIC || version != wire::RECORDING_VERSION {
         return Err("not a version-1 recording");
     }
     let (n, cycles, c) = (n as usize, cycles as usize, c as usize);
-    let config_words = words::<{ wire::config_words(AGENTS) }>(wire::RECORDING_HEADER_WORDS, c)
-        .ok_or("truncated configuration")?;
+    let config_words =
+        words::<{ wire::config_words(AGENTS) }>(recording, wire::RECORDING_HEADER_WORDS, c)
+            .ok_or("truncated configuration")?;
     let config = wire::CoreConfig::get(&mut Reader::new(config_words.get(..c).ok_or("config")?))
         .filter(|k| k.n == n)
         .ok_or("malformed configuration")?;
@@ -138,12 +158,13 @@ fn run() -> Result<(usize, usize, usize, Worst), &'static str> {
         .map_err(|_| "configuration refused by the core")?;
     let len = wire::cycle_words(n);
     let start = wire::RECORDING_HEADER_WORDS + c;
-    if RECORDING.len() != 4 * (start + cycles * len) {
+    if recording.len() != 4 * (start + cycles * len) {
         return Err("length does not match the header");
     }
     let (mut identical, mut planner, mut worst) = (0, 0, Worst::default());
     for k in 0..cycles {
-        let all = words::<MAX_CYCLE_WORDS>(start + k * len, len).ok_or("truncated cycle")?;
+        let all =
+            words::<MAX_CYCLE_WORDS>(recording, start + k * len, len).ok_or("truncated cycle")?;
         let cycle = all.get(..len).ok_or("cycle")?;
         let mut r = Reader::new(cycle);
         let event = r.u32().ok_or("event")?;

@@ -1,6 +1,7 @@
-//! The committed recording of 1,000 f32 control cycles of `paper-tilt`
-//! (`tests/data/paper_tilt_f32.cycles`, replayed on the emulated Cortex-M by
-//! `embedded/target-tests`) is what the current code records, and replaying it through a
+//! The committed recordings of 1,000 f32 control cycles (`tests/data/paper_tilt_f32.cycles`:
+//! `paper-tilt` with the paper's allocator; `tests/data/agent_failure_default_f32.cycles`:
+//! `agent-failure` with the default allocator; both replayed on the emulated Cortex-M by
+//! `embedded/target-tests`) are what the current code records, and replaying each through a
 //! controller built from its configuration words (as the firmware does) reproduces every
 //! output bit for bit on the host.
 
@@ -10,29 +11,67 @@ use tvmd_sim::recording::{cycle_words, CycleRecording};
 use tvmd_sim::runner::record_cycles;
 use tvmd_wire::{self as wire, Reader, Writer};
 
-const COMMITTED: &[u8] = include_bytes!("../data/paper_tilt_f32.cycles");
+/// A committed recording: its file, its bytes, the scenario and allocator it pins, and the
+/// failure-mask events it holds.
+struct Committed {
+    file: &'static str,
+    bytes: &'static [u8],
+    scenario: &'static str,
+    allocator: &'static str,
+    events: usize,
+    /// What it must exercise, at least: cycles whose planner bisects, cycles with a saturated
+    /// agent.
+    min_planned: usize,
+    min_saturated: usize,
+}
 
-/// The recording pins the paper's allocator, the redistributed pseudo-inverse (not the
-/// default exact-boundary redistribution): it is the paper's f32 cycle the firmware replays, and
-/// the on-target cost and stack numbers (BENCHMARKS.md) are of that cycle.
-const RECORDED_ALLOCATOR: &str = "redistributed-pseudo-inverse";
+/// The paper's f32 cycle (the redistributed pseudo-inverse), whose on-target cost and stack
+/// numbers (docs/benchmarks.md) are of that cycle; and the default allocator, the exact-boundary
+/// redistribution, where its walk runs: on `paper-tilt` the planner keeps every request inside
+/// the agents' sets and the two allocators' 1,000 cycles are the same bits, while after
+/// `agent-failure`'s loss of agent 0 (t = 5 s) the three others saturate.
+const RECORDINGS: [Committed; 2] = [
+    Committed {
+        file: "paper_tilt_f32.cycles",
+        bytes: include_bytes!("../data/paper_tilt_f32.cycles"),
+        scenario: "paper-tilt",
+        allocator: "redistributed-pseudo-inverse",
+        events: 0,
+        min_planned: 10,
+        min_saturated: 0,
+    },
+    Committed {
+        file: "agent_failure_default_f32.cycles",
+        bytes: include_bytes!("../data/agent_failure_default_f32.cycles"),
+        scenario: "agent-failure",
+        allocator: "exact-boundary-redistribution",
+        events: 1,
+        min_planned: 0,
+        min_saturated: 10,
+    },
+];
 
 #[test]
-fn committed_recording_is_current() {
-    let scenario = Scenario {
-        allocator: RECORDED_ALLOCATOR.into(),
-        ..Scenario::builtin("paper-tilt").unwrap()
-    };
-    let fresh = record_cycles(&scenario, 1000).unwrap();
-    assert_eq!(fresh.cycles, 1000);
-    assert_eq!(fresh.config.allocator_name(), RECORDED_ALLOCATOR);
-    assert!(
-        fresh.to_bytes() == COMMITTED,
-        "tests/data/paper_tilt_f32.cycles is stale: regenerate it with `cargo run -p tvmd-cli \
-         -- record-cycles paper-tilt --allocator redistributed-pseudo-inverse \
-         --out crates/tvmd-sim/tests/data/paper_tilt_f32.cycles`"
-    );
-    assert_eq!(CycleRecording::from_bytes(COMMITTED).unwrap(), fresh);
+fn committed_recordings_are_current() {
+    for committed in &RECORDINGS {
+        let scenario = Scenario {
+            allocator: committed.allocator.into(),
+            ..Scenario::builtin(committed.scenario).unwrap()
+        };
+        let fresh = record_cycles(&scenario, 1000).unwrap();
+        assert_eq!(fresh.cycles, 1000);
+        assert_eq!(fresh.config.allocator_name(), committed.allocator);
+        assert!(
+            fresh.to_bytes() == committed.bytes,
+            "tests/data/{file} is stale: regenerate it with `cargo run --release -p tvmd-cli \
+             -- record-cycles {scenario} --allocator {allocator} \
+             --out crates/tvmd-sim/tests/data/{file}`",
+            file = committed.file,
+            scenario = committed.scenario,
+            allocator = committed.allocator
+        );
+        assert_eq!(CycleRecording::from_bytes(committed.bytes).unwrap(), fresh);
+    }
 }
 
 #[test]
@@ -58,11 +97,17 @@ fn configuration_words_build_the_simulators_controller() {
 }
 
 #[test]
-fn host_replay_is_bit_identical_and_covers_the_planner_saturation() {
-    let rec = CycleRecording::from_bytes(COMMITTED).unwrap();
+fn host_replays_are_bit_identical_and_cover_the_planner_saturation() {
+    for committed in &RECORDINGS {
+        host_replay(committed);
+    }
+}
+
+fn host_replay(committed: &Committed) {
+    let rec = CycleRecording::from_bytes(committed.bytes).unwrap();
     let n = rec.config.n;
     let mut ctl = rec.config.build().unwrap();
-    let (mut planned, mut events) = (0, 0);
+    let (mut planned, mut saturated, mut events) = (0, 0, 0);
     for k in 0..rec.cycles {
         let words = rec.cycle(k).unwrap();
         assert_eq!(words.len(), cycle_words(n));
@@ -84,9 +129,21 @@ fn host_replay_is_bit_identical_and_covers_the_planner_saturation() {
         if matches!(&got_out, Ok(o) if o.planner.status == tvmd_core::PlannerStatus::Planned) {
             planned += 1;
         }
+        if matches!(&got_out, Ok(o) if o.allocation.saturated.iter().any(|s| *s)) {
+            saturated += 1;
+        }
     }
-    // paper-tilt has no failure; the planner saturates (bisects) over part of the flight.
-    assert_eq!(events, 0);
-    eprintln!("{planned} of {} recorded cycles bisect", rec.cycles);
-    assert!(planned > 10, "{planned} bisecting cycles");
+    eprintln!(
+        "{}: of {} recorded cycles {planned} bisect, {saturated} saturate an agent",
+        committed.file, rec.cycles
+    );
+    assert_eq!(events, committed.events, "{}", committed.file);
+    assert!(
+        planned >= committed.min_planned,
+        "{planned} bisecting cycles"
+    );
+    assert!(
+        saturated >= committed.min_saturated,
+        "{saturated} saturating cycles"
+    );
 }

@@ -187,3 +187,26 @@ fn pil_firmware_reports_a_corrupted_frame_and_an_unconfigured_cycle() {
     assert_eq!((reply.kind, reply.seq), (wire::KIND_ERROR, 8));
     assert_eq!(reply.text(0), "controller not configured");
 }
+
+/// The default allocator (the exact-boundary redistribution) in the loop on the Cortex-M4F,
+/// where its walk runs: `agent-failure` (agent 0 loses its thrust at t = 5 s, the controller
+/// is told, the three others saturate) flown by the firmware matches the in-process f32 flight.
+#[test]
+#[ignore = "needs qemu-system-arm and the PIL firmware; run by scripts/target.sh"]
+fn cortex_m4_pil_flight_with_the_default_allocator() {
+    let s = Scenario {
+        controller_precision: Precision::F32,
+        allocator: "exact-boundary-redistribution".into(),
+        ..Scenario::builtin("agent-failure").unwrap()
+    };
+    let host = run_scenario(&s, None, None).unwrap();
+    let pil = run_scenario_on(&s, Some(PilTarget::CortexM4), None, None).unwrap();
+    let d = FlightDifference::between(&host.samples, &pil.samples).expect("matching samples");
+    eprintln!("cortex-m4 PIL vs host f32, agent-failure, default allocator: {d:#?}");
+    assert_eq!(pil.summary.cycle_errors, 0);
+    // The same bounds as paper-tilt's (the same libm ulps carried by the closed loop).
+    assert!(d.position < 1e-5, "{d:?}");
+    assert!(d.attitude < 2e-6, "{d:?}");
+    assert!(d.gimbal < 5e-6, "{d:?}");
+    assert!(d.thrust < 5e-4, "{d:?}");
+}

@@ -104,8 +104,9 @@ fn run() -> bool {
         };
         let mut out: TvmdOutput = zeroed();
         out.size = size_of::<TvmdOutput>() as u32;
-        let bytes =
-            stack::peak(&mut || status = black_box(tvmd_step(handle, &state, &reference, &mut out)));
+        let bytes = stack::peak(&mut || {
+            status = black_box(tvmd_step(handle, &state, &reference, &mut out))
+        });
         report("tvmd_step", bytes, status);
         let mut law: TvmdLawOutput = zeroed();
         law.size = size_of::<TvmdLawOutput>() as u32;
