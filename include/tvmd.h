@@ -509,6 +509,13 @@ typedef struct TvmdConfig {
    */
   float agent_weights[TVMD_MAX_AGENTS];
   /*
+   Non-zero: cap the exact-boundary redistribution's walk at this many rounds per period
+   (a bound on its work: the best admissible forces found so far, with their true `e_f`);
+   zero: no cap (the walk's own `2 n + 4`). With another allocator a non-zero value is
+   refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`).
+   */
+  uint32_t allocator_max_rounds;
+  /*
    The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
    zeros: the paper's law).
    */

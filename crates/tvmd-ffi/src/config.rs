@@ -61,6 +61,7 @@ unsafe fn fill(
         rate_limits: [0.0; 2],
         allocator: TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
         agent_weights: [1.0; TVMD_MAX_AGENTS],
+        allocator_max_rounds: 0,
         law,
     };
     TVMD_OK

@@ -193,6 +193,9 @@ pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> 
         }
         options.agent_weights = Some(weights);
     }
+    if config.allocator_max_rounds != 0 {
+        options.max_rounds = Some(config.allocator_max_rounds);
+    }
     let allocator = AnyAllocator::from_name(name, &options)?;
     Ok(Controller::new(team, settings, allocator)?)
 }

@@ -121,6 +121,11 @@ pub struct TvmdConfig {
     /// Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
     /// are used; ignored by the other allocators).
     pub agent_weights: [f32; TVMD_MAX_AGENTS],
+    /// Non-zero: cap the exact-boundary redistribution's walk at this many rounds per period
+    /// (a bound on its work: the best admissible forces found so far, with their true `e_f`);
+    /// zero: no cap (the walk's own `2 n + 4`). With another allocator a non-zero value is
+    /// refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`).
+    pub allocator_max_rounds: u32,
     /// The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
     /// zeros: the paper's law).
     pub law: TvmdLaw,

@@ -216,6 +216,23 @@ static void test_create_errors(void) {
   bad.limits.rho = 1.225f; bad.limits.rotor_diameter = 0.254f;
   bad.limits.lift_coefficient = 0.11f; bad.limits.max_rotor_speed = 900.0f;
   CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+
+  /* The round cap is the exact-boundary redistribution's alone. Capped, a step is as good as
+   * the cap allows: never a smaller e_f than the uncapped walk's. */
+  bad = config; bad.allocator = TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE;
+  bad.allocator_max_rounds = 2;
+  CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_ERR_CONFIG_UNUSED_OPTION);
+  {
+    TvmdController uncapped;
+    TvmdOutput capped_out = o, uncapped_out = o;
+    bad = config; bad.allocator = TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION;
+    CHECK_STATUS(tvmd_create(&uncapped, sizeof uncapped, &bad), TVMD_OK);
+    bad.allocator_max_rounds = 1;
+    CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&storage, &s, &r, &capped_out), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&uncapped, &s, &r, &uncapped_out), TVMD_OK);
+    CHECK(capped_out.e_f >= uncapped_out.e_f - 1e-5f);
+  }
 }
 
 static void test_actuators(TvmdController *c, const TvmdOutput *o, uint32_t failed_mask) {
