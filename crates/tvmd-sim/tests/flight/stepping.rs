@@ -1,0 +1,192 @@
+//! The steppable entry (`Simulation::observe`, `step_output`, `step`, `step_wrench`,
+//! `reset`): the tvmd controller flown through it reproduces `run_scenario`'s flight bit for
+//! bit, user laws hold a hover through commands and through a body wrench, bad input is an
+//! error that changes nothing.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::common::PdHover;
+use tvmd_plant::actuators::ActuatorCommand;
+use tvmd_scenario::{Scenario, StateNoise, TeamSpec};
+use tvmd_sim::flight::FlightController;
+use tvmd_sim::sim::Simulation;
+use tvmd_sim::{run_scenario, AnyTvmdController, SimError, GRAVITY};
+
+/// A6-Inc losing an agent at 1.5 s, with state noise, one period of feedback latency and a
+/// steady wind: every input the loop feeds the controller.
+fn busy_scenario() -> Scenario {
+    let mut s = Scenario::builtin("a6-agent-failure").unwrap();
+    s.duration = 3.0;
+    s.failures[0].time = 1.5;
+    s.disturbances.state_noise = Some(StateNoise {
+        position: 0.002,
+        velocity: 0.01,
+        attitude: 0.002,
+        angular_velocity: 0.01,
+        seed: 7,
+    });
+    s.disturbances.feedback_latency = 1;
+    s.disturbances.wind = [0.3, -0.2, 0.0];
+    s
+}
+
+/// Flies the tvmd controller of `s` through `observe` and `step_output`.
+fn fly_stepped(s: &Scenario) -> tvmd_sim::RunResult {
+    let mut sim = Simulation::new(s).unwrap();
+    let mut controller = AnyTvmdController::from_scenario(s).unwrap();
+    while !sim.is_finished() {
+        let input = sim.observe().unwrap().clone();
+        let out = controller.step(&input.input()).unwrap();
+        let stepped = sim.step_output(out).unwrap();
+        assert_eq!(stepped.t, sim.time());
+    }
+    sim.take_result()
+}
+
+#[test]
+fn the_tvmd_controller_through_the_steps_reproduces_run_bit_for_bit() {
+    let s = busy_scenario();
+    let run = run_scenario(&s, None, None).unwrap();
+    let stepped = fly_stepped(&s);
+    assert_eq!(run.samples.len(), 300);
+    assert!(run.samples.iter().any(|x| x.failed[0]), "the failure flew");
+    // Every sample (state, reference, commands, actual outputs, diagnostics) equal, not close.
+    assert_eq!(stepped.samples, run.samples);
+    assert_eq!(stepped.summary.final_position, run.summary.final_position);
+    assert_eq!(stepped.summary.final_velocity, run.summary.final_velocity);
+    assert_eq!(stepped.paper, run.paper);
+}
+
+#[test]
+fn commands_without_diagnostics_fly_the_same_trajectory() {
+    // `step` (commands only) is `step_output` without diagnostics: the same flight.
+    let s = busy_scenario();
+    let run = run_scenario(&s, None, None).unwrap();
+    let mut sim = Simulation::new(&s).unwrap();
+    let mut controller = AnyTvmdController::from_scenario(&s).unwrap();
+    while !sim.is_finished() {
+        let input = sim.observe().unwrap().clone();
+        let out = controller.step(&input.input()).unwrap();
+        sim.step(&out.commands).unwrap();
+    }
+    let stepped = sim.take_result();
+    for (a, b) in stepped.samples.iter().zip(&run.samples) {
+        assert_eq!((a.t, a.position, a.velocity), (b.t, b.position, b.velocity));
+        assert_eq!(a.commands, b.commands);
+        assert_eq!(a.e_f, None);
+    }
+    assert_eq!(stepped.samples.len(), run.samples.len());
+}
+
+fn hover_sim() -> Simulation {
+    Simulation::for_team(TeamSpec {
+        preset: Some("a4-inc".into()),
+        ..TeamSpec::default()
+    })
+    .unwrap()
+}
+
+fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(m[(2, 1)], m[(0, 2)], m[(1, 0)])
+}
+
+#[test]
+fn a_user_pd_law_holds_hover_through_the_wrench() {
+    let mut sim = hover_sim();
+    let mass = sim.team().mass();
+    let mut worst: f64 = 0.0;
+    for _ in 0..300 {
+        let o = sim.observe().unwrap().clone();
+        let (s, r) = (&o.state, &o.reference);
+        // World force from a PD law on the position, rotated into the body frame; a PD
+        // torque towards R_r.
+        let f = mass
+            * (GRAVITY * Vector3::z()
+                - 4.0 * (s.position - r.position)
+                - 4.0 * (s.velocity - r.velocity));
+        let f_body = s.rotation.transpose() * f;
+        let e_r =
+            0.5 * vee(&(r.rotation.transpose() * s.rotation - s.rotation.transpose() * r.rotation));
+        let tau = -2.0 * e_r - 0.5 * s.omega;
+        let u = [tau.x, tau.y, tau.z, f_body.x, f_body.y, f_body.z];
+        let stepped = sim.step_wrench(&u).unwrap();
+        worst = worst.max((stepped.state.position - r.position).norm());
+    }
+    assert_eq!(sim.time(), 3.0);
+    assert!(worst < 0.01, "hover error {worst} m");
+    // The team hovers on thrust: the commands hold it up.
+    let last = sim.samples().last().unwrap();
+    let total: f64 = last.commands.iter().map(|c| c.thrust).sum();
+    assert!(
+        (total - mass * GRAVITY).abs() < 0.05 * mass * GRAVITY,
+        "{total}"
+    );
+}
+
+#[test]
+fn a_user_pd_law_holds_hover_through_commands() {
+    let mut sim = hover_sim();
+    let mut pd = PdHover::new(sim.team());
+    let mut worst: f64 = 0.0;
+    while !sim.is_finished() {
+        let o = sim.observe().unwrap().clone();
+        let out = pd.step(&o.input()).unwrap();
+        let stepped = sim.step(&out.commands).unwrap();
+        worst = worst.max((stepped.state.position - o.reference.position).norm());
+    }
+    assert!(worst < 0.02, "hover error {worst} m");
+    assert!(
+        sim.step(&[ActuatorCommand::default(); 4]).is_err(),
+        "past the end"
+    );
+}
+
+#[test]
+fn bad_input_is_an_error_that_changes_nothing() {
+    let mut sim = hover_sim();
+    let ok = vec![ActuatorCommand::default(); 4];
+    sim.step(&ok).unwrap();
+    let (t, state) = (sim.time(), sim.state());
+    let nan = ActuatorCommand {
+        thrust: f64::NAN,
+        ..ActuatorCommand::default()
+    };
+    for bad in [vec![ActuatorCommand::default(); 3], vec![nan; 4], vec![]] {
+        let e = sim.step(&bad).unwrap_err();
+        assert!(matches!(e, SimError::Physics(_)), "{e}");
+    }
+    let e = sim
+        .step_wrench(&[0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY])
+        .unwrap_err();
+    assert!(e.to_string().contains("non-finite wrench"), "{e}");
+    assert_eq!((sim.time(), sim.state()), (t, state));
+    assert_eq!(sim.samples().len(), 1);
+    sim.step(&ok).unwrap();
+    assert_eq!(sim.samples().len(), 2);
+}
+
+#[test]
+fn reset_starts_over_and_reseeds_the_noise() {
+    let mut s = busy_scenario();
+    s.duration = 0.5;
+    let fly = |sim: &mut Simulation| {
+        let mut c = AnyTvmdController::from_scenario(&s).unwrap();
+        let mut fed = Vec::new();
+        while !sim.is_finished() {
+            let o = sim.observe().unwrap().clone();
+            fed.push(o.state.position);
+            sim.step_output(c.step(&o.input()).unwrap()).unwrap();
+        }
+        fed
+    };
+    let mut sim = Simulation::new(&s).unwrap();
+    let first = fly(&mut sim);
+    sim.reset(None).unwrap();
+    assert_eq!(sim.time(), 0.0);
+    assert_eq!(fly(&mut sim), first, "the same seed, the same flight");
+    sim.reset(Some(8)).unwrap();
+    let other = fly(&mut sim);
+    assert_ne!(other, first, "another seed, other noise");
+    sim.reset(Some(8)).unwrap();
+    assert_eq!(fly(&mut sim), other);
+}
