@@ -99,14 +99,21 @@ impl Simulation {
         self.team.len()
     }
 
+    /// The largest thrust of one agent, `sigma_Tf` (N): the thrust at the normalized rotor
+    /// speed 1 (`T = sigma_Tf omega^2`).
+    pub fn max_thrust(&self) -> f64 {
+        self.max_thrust
+    }
+
     /// The scenario's duration is reached: no tick is left to step.
     pub fn is_finished(&self) -> bool {
         self.step_index >= self.total_steps
     }
 
-    /// The current tick's observation, taken once per tick (the noise is drawn then).
+    /// The current tick's observation, taken once per tick (the noise is drawn then). At the
+    /// end of the run it is the last state's, which no step follows.
     ///
-    /// Errors: the duration is reached, the state diverged, a payload could not attach.
+    /// Errors: the state diverged, a payload could not attach.
     pub fn observe(&mut self) -> Result<&Observation, SimError> {
         if self.observed.is_none() {
             self.observed = Some(self.new_observation()?);
@@ -128,6 +135,9 @@ impl Simulation {
     /// Holds a controller's output for one controller period, recording its diagnostics with
     /// the tick: the step [`Simulation::run`] takes at every tick.
     pub fn step_output(&mut self, out: FlightOutput) -> Result<Stepped, SimError> {
+        if self.is_finished() {
+            return Err(self.past_the_end());
+        }
         self.check_commands(self.time(), &out.commands)?;
         let observation = self.take_observation()?;
         self.apply_output(observation, out, None)?;
@@ -182,9 +192,6 @@ impl Simulation {
     }
 
     fn new_observation(&mut self) -> Result<Observation, SimError> {
-        if self.is_finished() {
-            return Err(self.past_the_end());
-        }
         let t = self.time();
         if self.apply_failures(t) {
             self.forces_stale = true;

@@ -139,6 +139,10 @@ fn a_user_pd_law_holds_hover_through_commands() {
         sim.step(&[ActuatorCommand::default(); 4]).is_err(),
         "past the end"
     );
+    // The last state is still observed (no step follows it).
+    let last = sim.observe().unwrap().clone();
+    assert_eq!(last.t, 12.0);
+    assert_eq!(last.truth, sim.state());
 }
 
 #[test]
