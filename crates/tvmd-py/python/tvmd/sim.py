@@ -6,6 +6,10 @@ Scenarios are TOML (every field defaults to the paper's simulation, ``"paper-til
 ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``).
 
 * :func:`builtin_scenarios`, :func:`scenario_toml` -- the built-in scenarios.
+* :class:`Simulation` -- the simulator stepped one controller period at a time with your own
+  controller: ``reset``, ``step`` (per-agent commands), ``step_wrench`` (a body wrench through
+  tvmd's allocation), each returning the next :class:`Observation`; :class:`ScenarioController`
+  is the tvmd controller as :func:`run` flies it, for the same steps.
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
 * :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads, or one task per
@@ -80,6 +84,10 @@ def monte_carlo(
 
 
 SimResult = _sim.SimResult
+Simulation = _sim.Simulation
+Observation = _sim.Observation
+ScenarioController = _sim.ScenarioController
+ControllerOutput = _sim.ControllerOutput
 builtin_scenarios = _sim.builtin_scenarios
 run = _sim.run
 scenario_toml = _sim.scenario_toml
@@ -150,7 +158,11 @@ def relaxation_sweep(
     return _on_executor(items, jobs, executor, _run_swept)
 
 __all__ = [
+    "ControllerOutput",
+    "Observation",
+    "ScenarioController",
     "SimResult",
+    "Simulation",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

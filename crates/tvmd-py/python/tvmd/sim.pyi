@@ -26,7 +26,7 @@ from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, T
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._tvmd import AllocatorName
+from ._tvmd import AllocatorName, Reference, State
 
 _F64 = NDArray[np.float64]
 _ScenarioArg = Union[str, "os.PathLike[str]"]
@@ -209,6 +209,201 @@ class SimResult:
         """Every field as a dict."""
     def __len__(self) -> int:
         """The number of samples ``K``."""
+
+@final
+class Observation:
+    """One controller tick as a controller sees it (read-only): what ``Simulation.reset``,
+    ``observe``, ``step`` and ``step_wrench`` return.
+
+    Attributes:
+        t: simulation time ``t_k`` (s).
+        state: the fed-back state (the scenario's state noise and feedback latency applied), a
+            ``tvmd.State``: position ``x``, attitude ``R``, body rates ``Omega`` and the
+            body-frame velocity ``v`` (``x_dot = R v``); what ``tvmd.Controller.step`` takes.
+        true_state: the true state, a ``tvmd.State``.
+        velocity_world: (3,) the fed-back world-frame velocity ``x_dot`` (m/s).
+        reference: the scenario's reference at ``t_k``, a ``tvmd.Reference``.
+        failed: (n,) bool, the failures the controller is told of.
+        done: the scenario's duration is reached (the last state; no step follows).
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+    @property
+    def t(self) -> float:
+        """Simulation time ``t_k`` (s)."""
+    @property
+    def state(self) -> State:
+        """The fed-back state (noise and latency applied)."""
+    @property
+    def true_state(self) -> State:
+        """The true state."""
+    @property
+    def velocity_world(self) -> _F64:
+        """(3,) world-frame velocity ``x_dot`` of the fed-back state (m/s)."""
+    @property
+    def reference(self) -> Reference:
+        """The reference at ``t_k``."""
+    @property
+    def failed(self) -> NDArray[np.bool_]:
+        """(n,) the failures the controller is told of."""
+    @property
+    def done(self) -> bool:
+        """The scenario's duration is reached (no step follows)."""
+    def to_dict(self) -> dict[str, Any]:
+        """Every field as a dict (the states and the reference as dicts)."""
+
+@final
+class ControllerOutput:
+    """What ``ScenarioController.step`` returns for one tick: the commands and the diagnostics;
+    ``Simulation.step`` takes it as it is (the diagnostics then reach ``Simulation.result()``).
+    """
+
+    @property
+    def commands(self) -> _F64:
+        """(n, 3) commands ``eta_x``, ``eta_y`` (rad), ``thrust`` (N)."""
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """The controller's diagnostics of the tick (planner, law, allocation, Lyapunov values)."""
+
+@final
+class Simulation:
+    """The simulator stepped one controller period at a time, with your own controller.
+
+    The plant is ``run``'s (rapier3d rigid body at ``physics.dt``; the scenario's actuators,
+    failures, payloads, wind, gusts, external wrench, state noise and feedback latency apply), and
+    so is the loop: ``run`` is one client of these steps, so ``ScenarioController`` flown through
+    ``step`` reproduces ``run``'s flight exactly. Each step holds its commands for
+    ``controller_period`` (zero-order hold) and returns the next tick's ``Observation``.
+
+    Two action modes:
+
+    * ``step(commands)``: per-agent gimbal angles and thrusts (or normalized rotor speeds);
+    * ``step_wrench(wrench)``: a body wrench ``[u_tau; u_f]`` (N m, N; body frame, about the
+      centre of mass) that the scenario controller's planner-free allocation stage
+      (``tvmd_core::Controller::allocate``: its allocator, limits, rate limits; in f64) turns into
+      admissible commands, the failed agents the controller is told of idle.
+
+    Example::
+
+        sim = tvmd.sim.Simulation("hover")
+        obs = sim.reset()
+        while not obs.done:
+            s, r = obs.state, obs.reference
+            f = sim.mass * (9.81 * e3 - kp * (s.position - r.position) - kd * (obs.velocity_world - r.velocity))
+            obs = sim.step_wrench(np.r_[tau, s.attitude.T @ f])
+
+    Args:
+        scenario: a built-in name or a TOML scenario file, as ``run``'s; default ``"hover"``
+            (A4-Inc holding a hover at 1.5 m for 12 s; with ``team`` another team).
+        toml: inline TOML scenario text instead of ``scenario``.
+        team: a catalogue team (``"a6-inc"``, ...) instead of the scenario's.
+        relaxation, allocator, precision, null_space, law: ``run``'s overrides (the allocator and
+            the null-space stage are ``step_wrench``'s; ``precision`` and ``law`` concern
+            ``ScenarioController`` built with the same arguments).
+        max_samples: the samples ``result()`` keeps, as ``run``'s.
+
+    Raises:
+        ValueError: a scenario or override that cannot be used; a step with commands of the
+            wrong shape or with NaN or infinite values, a negative rotor speed, a wrench that is
+            not (6,) finite values, or a step after the duration (``done``: ``reset`` first).
+        RuntimeError: the state diverged.
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        toml: Optional[str] = None,
+        team: Optional[str] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+        max_samples: Optional[int] = None,
+    ) -> "Simulation": ...
+    def reset(self, seed: Optional[int] = None) -> Observation:
+        """Starts over (initial state, actuators at rest, no failure applied, time 0, nothing
+        recorded) and returns the first observation. ``seed`` (0 to 2**64 - 1) reseeds the
+        state noise; without it the scenario's ``disturbances.state_noise.seed`` is used, so
+        every reset replays the same noise. No effect without state noise."""
+    def observe(self) -> Observation:
+        """The current tick's observation (the noise is drawn once per tick: calling it again
+        returns the same values)."""
+    def step(self, commands: Union[ArrayLike, ControllerOutput], *, rotor_speeds: bool = False) -> Observation:
+        """Holds per-agent commands for one controller period; returns the next observation.
+
+        Args:
+            commands: (n, 3) rows ``eta_x, eta_y`` (rad), ``thrust`` (N); or (n, 4), the layout of
+                ``tvmd.Controller``'s commands (``eta_x, eta_y, thrust, omega``); or a
+                ``ControllerOutput`` (its diagnostics are recorded too). Failed agents' commands
+                are overridden as their failure dictates.
+            rotor_speeds: the last column is the normalized rotor speed ``omega`` (1 at
+                ``max_thrust``; thrust ``max_thrust * omega**2``) instead of the thrust.
+        """
+    def step_wrench(self, wrench: ArrayLike) -> Observation:
+        """Holds the admissible commands of the (6,) body wrench ``[u_tau; u_f]`` (N m, N; body
+        frame) for one controller period; returns the next observation. A wrench the
+        allocation cannot serve (zero thrust for a non-zero force) holds the previous commands."""
+    def result(self) -> SimResult:
+        """The flight so far as a ``SimResult`` (the samples copied; the simulation goes on)."""
+    @property
+    def state(self) -> State:
+        """The true state now."""
+    @property
+    def time(self) -> float:
+        """Simulation time (s)."""
+    @property
+    def done(self) -> bool:
+        """The scenario's duration is reached: ``reset`` before the next step."""
+    @property
+    def n_agents(self) -> int:
+        """Number of agents ``n``."""
+    @property
+    def mass(self) -> float:
+        """Team mass ``m_C`` (kg)."""
+    @property
+    def max_thrust(self) -> float:
+        """Largest thrust of one agent ``sigma_Tf`` (N)."""
+    @property
+    def controller_period(self) -> float:
+        """The time one step holds its commands (s)."""
+    @property
+    def duration(self) -> float:
+        """The scenario's duration (s)."""
+    @property
+    def scenario_toml(self) -> str:
+        """The scenario (overrides applied) as TOML."""
+
+@final
+class ScenarioController:
+    """The tvmd controller of a scenario exactly as ``run`` flies it (its precision, law,
+    allocator, failure handling, landing), to fly through ``Simulation.step``: with the same
+    arguments, ``sim.step(ctrl.step(obs))`` from ``sim.reset()`` to ``done`` reproduces
+    ``run``'s flight.
+
+    Args: as ``Simulation``'s (default scenario ``"hover"``).
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        toml: Optional[str] = None,
+        team: Optional[str] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+    ) -> "ScenarioController": ...
+    def step(self, observation: Observation) -> ControllerOutput:
+        """The commands and diagnostics for one tick's observation (advances the controller's
+        state: call it once per tick).
+
+        Raises:
+            RuntimeError: the controller failed.
+        """
 
 def builtin_scenarios() -> list[str]:
     """The names of the built-in scenarios (``"paper-tilt"`` is the paper's simulation, see
@@ -477,7 +672,11 @@ def monte_carlo_report(rows: list[str], *, out: Optional[_PathArg] = None) -> di
 
 
 __all__ = [
+    "ControllerOutput",
+    "Observation",
+    "ScenarioController",
     "SimResult",
+    "Simulation",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

@@ -253,6 +253,17 @@ impl Simulation {
         self.samples.take()
     }
 
+    /// What has been simulated so far, copied (the simulation goes on): the kept samples, the
+    /// summary and the paper's metrics.
+    pub fn result(&self) -> RunResult {
+        RunResult {
+            summary: self.summary(),
+            paper: self.paper_metrics(),
+            sample_stride: self.samples.stride(),
+            samples: self.samples().to_vec(),
+        }
+    }
+
     /// What has been simulated so far: the kept samples (moved out), the summary and the
     /// paper's metrics.
     pub fn take_result(&mut self) -> RunResult {
