@@ -203,6 +203,76 @@ pub(crate) fn run_items(runs: &Bound<'_, PyAny>) -> PyResult<Vec<RunSpec>> {
     Ok(specs)
 }
 
+/// A `run_many(..., errors="keep")` batch: each run's `SimResult`, or the exception it would
+/// have raised (a bad entry or log, a failure while flying), by index. Only what concerns the
+/// batch as a whole raises: `runs` not a sequence, two runs on one log, an interrupt.
+pub(crate) fn run_items_keeping(
+    py: Python<'_>,
+    runs: &Bound<'_, PyAny>,
+    jobs: Option<usize>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
+        return Err(PyTypeError::new_err(
+            "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
+        ));
+    }
+    let mut slots: Vec<Option<Py<PyAny>>> = Vec::new();
+    let mut flown: Vec<(usize, RunSpec, Option<PathBuf>)> = Vec::new();
+    let items = runs
+        .try_iter()
+        .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?;
+    for (k, item) in items.enumerate() {
+        let checked = run_request(&item?, k).and_then(|(spec, input)| {
+            check_logs(std::slice::from_ref(&spec), &|_, s| batch_label(k, s))?;
+            Ok((spec, input))
+        });
+        match checked {
+            Ok((spec, input)) => {
+                flown.push((k, spec, input));
+                slots.push(None);
+            }
+            Err(e) => slots.push(Some(e.into_value(py).into_any())),
+        }
+    }
+    let inputs: Vec<(String, &Path)> = flown
+        .iter()
+        .filter_map(|(k, _, input)| {
+            Some((format!("scenario file of runs[{k}]"), input.as_deref()?))
+        })
+        .collect();
+    let specs: Vec<RunSpec> = flown.iter().map(|(_, spec, _)| spec.clone()).collect();
+    runner::check_batch_paths(&specs, &[], &inputs).map_err(value_error)?;
+    let outcomes = run_interruptibly(py, specs, jobs)?;
+    for ((k, _, _), RunOutcome { spec, result }) in flown.into_iter().zip(outcomes) {
+        let value = match result {
+            Ok(result) => Py::new(
+                py,
+                PySimResult {
+                    inner: SimData::new(spec, result),
+                },
+            )?
+            .into_any(),
+            Err(e) => {
+                let log = spec.log.as_deref().map(|l| (WRITE, l));
+                sim_error(e, &batch_label(k, &spec), log)
+                    .into_value(py)
+                    .into_any()
+            }
+        };
+        if let Some(slot) = slots.get_mut(k) {
+            *slot = Some(value);
+        }
+    }
+    slots
+        .into_iter()
+        .map(|s| {
+            s.ok_or_else(|| {
+                pyo3::exceptions::PyRuntimeError::new_err("a run of the batch returned nothing")
+            })
+        })
+        .collect()
+}
+
 /// The runs of a relaxation study as `relaxation_sweep` takes them: `args`' scenario once per
 /// relaxation (default 0.25, 0.5, 0.75, 1), each with `args`' target and sample retention.
 pub(crate) fn sweep_run_specs(

@@ -16,7 +16,7 @@ use tvmd_sim::sim::{Observation, SimOptions, Simulation, Verdict};
 use tvmd_sim::{AnyTvmdController, FlightController, FlightOutput};
 
 use crate::convert::{commands_arg, law_arg, matrix, record_to_py, retention_arg, shaped};
-use crate::convert::{wrench_arg, Int};
+use crate::convert::{finite, wrench_arg, Int};
 use crate::errors::value_error;
 use crate::law::{PyReference, PyState};
 use crate::record::record;
@@ -141,13 +141,27 @@ impl PySimulation {
         Ok(Self { sim, spec })
     }
 
-    /// Starts over (optionally reseeding the state noise); the first observation. See the stub.
-    #[pyo3(signature = (seed = None))]
-    fn reset(&mut self, seed: Option<Int>) -> PyResult<PyObservation> {
+    /// Starts over (optionally reseeding the state noise, from another initial pose); the
+    /// first observation. See the stub.
+    #[pyo3(signature = (seed = None, *, position = None, attitude_rpy = None))]
+    fn reset(
+        &mut self,
+        seed: Option<Int>,
+        position: Option<&Bound<'_, PyAny>>,
+        attitude_rpy: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyObservation> {
         let seed = seed
             .map(|s| s.to("seed", 0, i128::from(u64::MAX)))
             .transpose()?;
-        self.sim.reset(seed).map_err(step_error)?;
+        let position = position
+            .map(|p| finite::<3, 1>(p, "position"))
+            .transpose()?;
+        let attitude = attitude_rpy
+            .map(|a| finite::<3, 1>(a, "attitude_rpy"))
+            .transpose()?;
+        self.sim
+            .reset_at(seed, position.map(Into::into), attitude.map(Into::into))
+            .map_err(step_error)?;
         self.observation()
     }
 
@@ -224,6 +238,21 @@ impl PySimulation {
     #[getter]
     fn max_thrust(&self) -> f64 {
         self.sim.max_thrust()
+    }
+
+    /// (n, 3) the agents' positions `p_i` relative to the centre of mass (m, body frame).
+    #[getter]
+    fn agent_positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let agents = &self.sim.team().agents;
+        let values = agents.iter().flat_map(|a| a.position).collect();
+        shaped(py, values, &[agents.len(), 3])
+    }
+
+    /// `(sigma_x, sigma_y)`: the gimbal limits `|eta_x| <= sigma_x`, `|eta_y| <= sigma_y` (rad).
+    #[getter]
+    fn gimbal_limits(&self) -> (f64, f64) {
+        let limits = &self.sim.scenario().limits;
+        (limits.sigma_x, limits.sigma_y)
     }
 
     /// Controller period (s): the time one step holds its commands.

@@ -21,7 +21,7 @@ Log paths are checked before anything runs: two runs of a batch on one file rais
 """
 
 import os
-from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, TypedDict, Union, final
+from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, TypedDict, Union, final, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -60,7 +60,9 @@ class SimResult:
         mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
         planned roll at which the planner saturates in hover).
         t: (K,) time (s).
-        position, velocity, reference_position: (K, 3) ``x`` (m), ``x_dot`` (m/s), ``x_r`` (m).
+        position, velocity_world, reference_position: (K, 3) ``x`` (m), ``x_dot`` (m/s, world
+            frame; ``velocity`` is its old name), ``x_r`` (m). velocity_body: (K, 3) ``R^T x_dot``.
+        angular_velocity: (K, 3) body rates ``Omega``. rotation: (K, 3, 3) ``R``.
         attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of ``R``, ``R_r``
             and the planned ``R_d``.
         reference_roll: (K,) ``phi_r``. planned_roll: (K,) ``phi_d = atan2(R_d[2,1], R_d[2,2])``.
@@ -72,6 +74,8 @@ class SimResult:
         V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
         commands, actual: (K, n, 3) commanded and actual actuator values, columns
             ``eta_x, eta_y`` (rad), ``thrust`` (N). failed: (K, n) bool, true failure flags.
+        forces: (K, n, 3) body-frame forces of the actual outputs (N). rotor_speeds: (K, n)
+            normalized commanded rotor speeds.
         summary: dict, every field of tvmd-sim's ``RunSummary`` (``max_planned_roll``, ``max_e_f``,
             ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...),
             with ``metrics`` (settling time, steady-state, peak and integral errors, force and
@@ -136,7 +140,20 @@ class SimResult:
         """(K, 3) ``x`` (m)."""
     @property
     def velocity(self) -> _F64:
-        """(K, 3) ``x_dot`` (m/s)."""
+        """(K, 3) ``x_dot`` (m/s), world frame: ``velocity_world`` under its old name (kept for
+        compatibility; not a column of ``to_columns``)."""
+    @property
+    def velocity_world(self) -> _F64:
+        """(K, 3) ``x_dot`` (m/s), world frame."""
+    @property
+    def velocity_body(self) -> _F64:
+        """(K, 3) ``v = R^T x_dot`` (m/s), body frame (the frame of ``tvmd.State.velocity``)."""
+    @property
+    def angular_velocity(self) -> _F64:
+        """(K, 3) body rates ``Omega`` (rad/s), body frame."""
+    @property
+    def rotation(self) -> _F64:
+        """(K, 3, 3) attitude ``R`` (body to world)."""
     @property
     def reference_position(self) -> _F64:
         """(K, 3) ``x_r`` (m)."""
@@ -194,6 +211,14 @@ class SimResult:
     def actual(self) -> _F64:
         """(K, n, 3) actual actuator outputs, same columns."""
     @property
+    def forces(self) -> _F64:
+        """(K, n, 3) the agents' body-frame forces (N) of the actual outputs, with the plant's
+        actuation error (gimbal offsets, rotor efficiency): what the plant applied."""
+    @property
+    def rotor_speeds(self) -> _F64:
+        """(K, n) commanded rotor speeds, normalized (1 at the largest thrust ``sigma_Tf``):
+        ``sqrt(thrust / sigma_Tf)``."""
+    @property
     def failed(self) -> NDArray[np.bool_]:
         """(K, n) true failure flags."""
     @property
@@ -206,7 +231,19 @@ class SimResult:
     def scenario_toml(self) -> str:
         """The scenario that ran, as TOML."""
     def to_dict(self) -> dict[str, Any]:
-        """Every field as a dict."""
+        """Every field as a dict (arrays as they are: (K, ...))."""
+    def to_columns(self) -> dict[str, _F64]:
+        """Every time series as flat (K,) columns, in field order, for ``pandas.DataFrame``:
+        vectors as ``<name>_x/_y/_z`` (``attitude_rpy_roll/_pitch/_yaw``, ...), matrices as
+        ``rotation_<row><col>``, per-agent values as ``<name>_<i>`` and
+        ``commands_<i>_eta_x/_eta_y/_thrust``, ``forces_<i>_x/_y/_z``; ``velocity`` appears once,
+        as ``velocity_world``."""
+    def to_pandas(self) -> Any:
+        """``pandas.DataFrame(to_columns())``: one row per sample.
+
+        Raises:
+            ImportError: pandas is not installed.
+        """
     def __len__(self) -> int:
         """The number of samples ``K``."""
 
@@ -322,11 +359,29 @@ class Simulation:
         law: Optional[_LawArg] = None,
         max_samples: Optional[int] = None,
     ) -> "Simulation": ...
-    def reset(self, seed: Optional[int] = None) -> Observation:
+    def reset(
+        self,
+        seed: Optional[int] = None,
+        *,
+        position: Optional[ArrayLike] = None,
+        attitude_rpy: Optional[ArrayLike] = None,
+    ) -> Observation:
         """Starts over (initial state, actuators at rest, no failure applied, time 0, nothing
-        recorded) and returns the first observation. ``seed`` (0 to 2**64 - 1) reseeds the
-        state noise; without it the scenario's ``disturbances.state_noise.seed`` is used, so
-        every reset replays the same noise. No effect without state noise."""
+        recorded) and returns the first observation.
+
+        Args:
+            seed: 0 to 2**64 - 1, reseeds the state noise; without it the scenario's
+                ``disturbances.state_noise.seed`` is used, so every reset replays the same
+                noise. No effect without state noise.
+            position: (3,) another initial position of the centre of mass (m).
+            attitude_rpy: (3,) another initial attitude, roll, pitch, yaw (rad, ZYX).
+                ``position`` and ``attitude_rpy`` replace the scenario's initial pose (later
+                resets start there too); the team starts at rest.
+
+        Raises:
+            ValueError: a seed out of range, a pose that is not 3 finite values or that the
+                scenario's validation refuses (the simulation is then unchanged).
+        """
     def observe(self) -> Observation:
         """The current tick's observation (the noise is drawn once per tick: calling it again
         returns the same values)."""
@@ -365,6 +420,13 @@ class Simulation:
     @property
     def max_thrust(self) -> float:
         """Largest thrust of one agent ``sigma_Tf`` (N)."""
+    @property
+    def agent_positions(self) -> _F64:
+        """(n, 3) the agents' positions ``p_i`` relative to the centre of mass (m, body frame)."""
+    @property
+    def gimbal_limits(self) -> Tuple[float, float]:
+        """``(sigma_x, sigma_y)``: the gimbal limits ``|eta_x| <= sigma_x``, ``|eta_y| <= sigma_y``
+        (rad)."""
     @property
     def controller_period(self) -> float:
         """The time one step holds its commands (s)."""
@@ -502,8 +564,23 @@ def run(
             found (the message says how to install or build it).
     """
 
+@overload
 def run_many(
-    runs: Iterable[_RunItem], *, jobs: Optional[int] = None, executor: Optional[Any] = None
+    runs: Iterable[_RunItem],
+    *,
+    jobs: Optional[int] = None,
+    executor: Optional[Any] = None,
+    errors: Literal["keep"],
+) -> list[Union[SimResult, Exception]]:
+    """``run_many`` with ``errors="keep"``: each failed run's exception in its place (see the
+    other overload for every argument)."""
+@overload
+def run_many(
+    runs: Iterable[_RunItem],
+    *,
+    jobs: Optional[int] = None,
+    executor: Optional[Any] = None,
+    errors: Literal["raise"] = "raise",
 ) -> list[SimResult]:
     """Runs many scenarios in parallel threads (GIL released) and returns their results in input
     order.
@@ -521,8 +598,16 @@ def run_many(
             run, each ``SimResult`` pickled back; logs are written where the task runs. The
             batch is checked here first (items, no two runs on one log); not with ``jobs``.
 
-    Every item is loaded and validated before any run starts. If runs fail, the first failure
-    in input order is raised, its message prefixed with ``runs[k]``.
+        errors: ``"raise"`` (default): if runs fail, the first failure in input order is
+            raised. ``"keep"``: every successful run's ``SimResult`` is returned, and each failed
+            run's exception (the one ``"raise"`` would raise: ``ValueError`` for a bad item or
+            log, ``RuntimeError`` for a failure while flying, ...) stands in its place, so
+            ``[r for r in out if isinstance(r, Exception)]`` lists the failures by index. What
+            concerns the whole batch still raises (``runs`` not a sequence, two runs on one log,
+            ``jobs``, an interrupt).
+
+    Every item is loaded and validated before any run starts. A failure's message is prefixed
+    with ``runs[k]``.
 
     Raises:
         ValueError, TypeError, OSError, KeyboardInterrupt, RuntimeError: as ``run``;

@@ -50,6 +50,7 @@ use tvmd_plant::PhysicsError;
 use tvmd_scenario::{Failure, Payload, Scenario, StateNoise};
 
 pub use difference::FlightDifference;
+pub use forces::agent_forces;
 use forces::body_forces;
 pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;

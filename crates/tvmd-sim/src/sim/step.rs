@@ -76,9 +76,28 @@ impl Simulation {
     /// 0, nothing recorded. `seed` reseeds the state noise (the scenario's
     /// `disturbances.state_noise.seed` otherwise); it has no effect without state noise.
     pub fn reset(&mut self, seed: Option<u64>) -> Result<(), SimError> {
+        self.reset_at(seed, None, None)
+    }
+
+    /// As [`Simulation::reset`], from another initial pose: the centre of mass at `position`
+    /// (m) and the attitude `roll_pitch_yaw` (rad, ZYX), at rest. The pose replaces the
+    /// scenario's `initial_position` and `initial_attitude` (later resets start there too); a
+    /// pose the scenario's validation refuses is an error that changes nothing.
+    pub fn reset_at(
+        &mut self,
+        seed: Option<u64>,
+        position: Option<[f64; 3]>,
+        roll_pitch_yaw: Option<[f64; 3]>,
+    ) -> Result<(), SimError> {
         let mut scenario = self.scenario.clone();
         if let (Some(seed), Some(noise)) = (seed, scenario.disturbances.state_noise.as_mut()) {
             noise.seed = seed;
+        }
+        if let Some(p) = position {
+            scenario.initial_position = p;
+        }
+        if let Some(a) = roll_pitch_yaw {
+            scenario.initial_attitude = a;
         }
         *self = Self::with_options(&scenario, self.options)?;
         Ok(())

@@ -194,3 +194,27 @@ fn reset_starts_over_and_reseeds_the_noise() {
     sim.reset(Some(8)).unwrap();
     assert_eq!(fly(&mut sim), other);
 }
+
+#[test]
+fn reset_at_starts_from_another_pose_or_refuses_it() {
+    let mut sim = hover_sim();
+    sim.reset_at(None, Some([0.5, -0.25, 2.0]), Some([0.1, 0.0, 0.3]))
+        .unwrap();
+    let s = sim.state();
+    assert_eq!(s.position, Vector3::new(0.5, -0.25, 2.0));
+    let rpy = tvmd_plant::math::roll_pitch_yaw(&s.rotation);
+    assert!(
+        (rpy[0] - 0.1).abs() < 1e-12 && (rpy[2] - 0.3).abs() < 1e-12,
+        "{rpy:?}"
+    );
+    sim.step(&[ActuatorCommand::default(); 4]).unwrap();
+    // A NaN pose is refused and the simulation goes on where it was.
+    let t = sim.time();
+    assert!(sim
+        .reset_at(None, Some([f64::NAN, 0.0, 1.0]), None)
+        .is_err());
+    assert_eq!(sim.time(), t);
+    // Later resets start from the new pose.
+    sim.reset(None).unwrap();
+    assert_eq!(sim.state().position, Vector3::new(0.5, -0.25, 2.0));
+}
