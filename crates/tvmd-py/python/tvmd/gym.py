@@ -1,0 +1,172 @@
+"""tvmd.gym: Gymnasium environments of the tvmd simulator (needs ``gymnasium``).
+
+Importing the module registers ``"tvmd/Hover-v0"`` (:class:`HoverEnv`): hold a hover at the
+scenario's reference from a perturbed initial pose. The plant is :class:`tvmd.sim.Simulation`
+(the scenario's actuators, failures, disturbances and noise apply); one environment step is one
+controller period (0.01 s by default). Everything is in SI units, z up.
+
+Observation (``Box`` of 18 float32): the position error ``x - x_r`` (3, m, world frame), the
+velocity error ``x_dot - x_dot_r`` (3, m/s, world frame), the attitude ``R`` (9, body to world,
+row-major) and the body rates ``Omega`` (3, rad/s), of the fed-back (noisy, delayed) state.
+
+Actions, two modes (``action=``):
+
+* ``"wrench"`` (default): the body wrench ``[u_tau; u_f]`` (6, N m and N; body frame, about the
+  centre of mass) that tvmd's allocation (the scenario controller's allocation stage) turns
+  into admissible gimbal angles and thrusts. Bounds: ``|u_f_i| <= n sigma_Tf`` and
+  ``|u_tau_i| <= n sigma_Tf max_i |p_i|``; actions outside are clipped.
+* ``"commands"``: per-agent commands ``(n, 3)``: ``eta_x`` in ``[-sigma_x, sigma_x]``, ``eta_y``
+  in ``[-sigma_y, sigma_y]`` (rad), thrust in ``[0, sigma_Tf]`` (N); clipped likewise.
+
+Reward per step: ``alive - (w_position |e_x|^2 + w_velocity |e_v|^2 + w_attitude psi +
+w_rate |Omega|^2 + w_action |a / a_max|^2)``, ``psi = (3 - trace(R_r^T R)) / 2`` in [0, 2]; the
+weights are the ``weights`` argument over :data:`DEFAULT_WEIGHTS`, and ``info["reward_terms"]``
+holds each term (before weighting). ``terminated``: the position error exceeds
+``max_position_error``, the tilt ``acos(R_33)`` exceeds ``max_tilt``, or the simulation diverged;
+``truncated``: the scenario's duration is reached. ``reset(seed=...)`` seeds the initial pose's
+draw (uniform within ``initial_offset`` m per axis and ``initial_tilt`` rad in roll and pitch)
+and the state noise.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Optional
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from . import sim as _sim
+
+#: The reward weights a ``weights`` argument updates.
+DEFAULT_WEIGHTS = {
+    "alive": 1.0,
+    "position": 1.0,
+    "velocity": 0.1,
+    "attitude": 0.5,
+    "rate": 0.01,
+    "action": 0.0,
+}
+
+HOVER_ID = "tvmd/Hover-v0"
+
+
+class HoverEnv(gym.Env):
+    """Hold a hover from a perturbed initial pose (see the module's documentation).
+
+    Args:
+        scenario: a scenario for ``tvmd.sim.Simulation`` (default ``"hover"``: A4-Inc at 1.5 m,
+            12 s, so 1200 steps).
+        action: ``"wrench"`` or ``"commands"``.
+        weights: reward weights over ``DEFAULT_WEIGHTS`` (unknown keys raise ``ValueError``).
+        initial_offset: largest initial position offset per axis (m).
+        initial_tilt: largest initial roll and pitch (rad).
+        max_position_error: the episode terminates beyond it (m).
+        max_tilt: the episode terminates beyond it (rad).
+        **simulation: further ``tvmd.sim.Simulation`` keywords (``team``, ``toml``, ``allocator``,
+            ...).
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        action: str = "wrench",
+        weights: Optional[dict[str, float]] = None,
+        initial_offset: float = 0.2,
+        initial_tilt: float = 0.1,
+        max_position_error: float = 2.0,
+        max_tilt: float = 1.2,
+        render_mode: Optional[str] = None,
+        **simulation: Any,
+    ) -> None:
+        if action not in ("wrench", "commands"):
+            raise ValueError(f'`action` must be "wrench" or "commands", got {action!r}')
+        unknown = set(weights or {}) - set(DEFAULT_WEIGHTS)
+        if unknown:
+            raise ValueError(f"unknown reward weights {sorted(unknown)} (known: {sorted(DEFAULT_WEIGHTS)})")
+        if render_mode is not None:
+            raise ValueError("HoverEnv does not render")
+        self.render_mode = render_mode
+        self.sim = _sim.Simulation(scenario, **simulation)
+        self.action_mode = action
+        self.weights = {**DEFAULT_WEIGHTS, **(weights or {})}
+        self.initial_offset = float(initial_offset)
+        self.initial_tilt = float(initial_tilt)
+        self.max_position_error = float(max_position_error)
+        self.max_tilt = float(max_tilt)
+        first = self.sim.observe()
+        self._home = first.true_state.position.copy()
+        n, thrust = self.sim.n_agents, self.sim.max_thrust
+        if action == "wrench":
+            arm = float(np.linalg.norm(self.sim.agent_positions, axis=1).max())
+            high = np.array([n * thrust * arm] * 3 + [n * thrust] * 3)
+            low = -high
+        else:
+            sx, sy = self.sim.gimbal_limits
+            low = np.tile([-sx, -sy, 0.0], (n, 1))
+            high = np.tile([sx, sy, thrust], (n, 1))
+        self.action_space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+        self._low, self._high = low, high
+        self._scale = np.maximum(np.abs(low), np.abs(high))
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(18,), dtype=np.float32)
+        self._last = self._vector(first)
+
+    @staticmethod
+    def _vector(obs: Any) -> np.ndarray:
+        s, r = obs.state, obs.reference
+        return np.concatenate(
+            [s.position - r.position, obs.velocity_world - r.velocity, s.attitude.reshape(9), s.angular_velocity]
+        ).astype(np.float32)
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
+        """Starts an episode from a perturbed pose (drawn with the environment's generator)."""
+        super().reset(seed=seed)
+        rng = self.np_random
+        offset = rng.uniform(-self.initial_offset, self.initial_offset, 3)
+        tilt = rng.uniform(-self.initial_tilt, self.initial_tilt, 2)
+        noise_seed = int(rng.integers(0, 2**63))
+        obs = self.sim.reset(noise_seed, position=self._home + offset, attitude_rpy=[tilt[0], tilt[1], 0.0])
+        self._last = self._vector(obs)
+        return self._last.copy(), {"time": obs.t}
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """One controller period with ``action`` held."""
+        a = np.clip(np.asarray(action, dtype=np.float64).reshape(self._low.shape), self._low, self._high)
+        try:
+            obs = self.sim.step_wrench(a) if self.action_mode == "wrench" else self.sim.step(a)
+        except RuntimeError as e:
+            # The state diverged: the episode ends where it was.
+            obs = None
+            diverged = str(e)
+        if obs is None:
+            return self._last.copy(), -100.0, True, False, {"diverged": diverged}
+        s, r = obs.state, obs.reference
+        e_x = s.position - r.position
+        e_v = obs.velocity_world - r.velocity
+        psi = 0.5 * (3.0 - float(np.trace(r.attitude.T @ s.attitude)))
+        terms = {
+            "position": float(e_x @ e_x),
+            "velocity": float(e_v @ e_v),
+            "attitude": psi,
+            "rate": float(s.angular_velocity @ s.angular_velocity),
+            "action": float(np.sum((a / self._scale) ** 2)),
+        }
+        w = self.weights
+        reward = w["alive"] - sum(w[k] * v for k, v in terms.items())
+        tilt = math.acos(max(-1.0, min(1.0, float(obs.true_state.attitude[2, 2]))))
+        error = float(np.linalg.norm(obs.true_state.position - r.position))
+        terminated = error > self.max_position_error or tilt > self.max_tilt
+        truncated = bool(obs.done) and not terminated
+        info = {"time": obs.t, "reward_terms": terms, "position_error": error, "tilt": tilt}
+        self._last = self._vector(obs)
+        return self._last.copy(), float(reward), bool(terminated), truncated, info
+
+
+if HOVER_ID not in gym.registry:
+    gym.register(id=HOVER_ID, entry_point="tvmd.gym:HoverEnv")
+
+__all__ = ["DEFAULT_WEIGHTS", "HOVER_ID", "HoverEnv"]
