@@ -26,7 +26,7 @@ use crate::sim_result::{PySimResult, SimData};
 /// The scenario of a `Simulation` or `ScenarioController`: `run`'s arguments, the built-in
 /// `"hover"` when neither `scenario` nor `toml` is given.
 #[allow(clippy::too_many_arguments)]
-fn spec(
+pub(crate) fn spec(
     py: Python<'_>,
     scenario: Option<&Bound<'_, PyAny>>,
     toml: Option<String>,

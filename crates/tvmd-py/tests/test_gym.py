@@ -75,3 +75,42 @@ def test_bad_arguments_raise():
         tgym.HoverEnv(action="thrusts")
     with pytest.raises(ValueError, match="weights"):
         tgym.HoverEnv(weights={"speed": 1.0})
+
+
+def test_the_vector_env_steps_every_team_in_one_call():
+    toml = 'name = "short-hover"\nduration = 0.5\ninitial_position = [0.0, 0.0, 1.5]\n[reference]\nkind = "hover"\nposition = [0.0, 0.0, 1.5]\n'
+    env = gym.make_vec(tgym.HOVER_ID, num_envs=4, vectorization_mode="vector_entry_point", toml=toml, jobs=2)
+    base = env.unwrapped if hasattr(env, "unwrapped") else env
+    assert isinstance(base, tgym.HoverVectorEnv)
+    obs, _ = env.reset(seed=3)
+    assert obs.shape == (4, 18) and obs.dtype == np.float32 and env.observation_space.contains(obs)
+    again, _ = env.reset(seed=3)
+    np.testing.assert_array_equal(obs, again)
+    assert len({tuple(row[:3]) for row in obs}) == 4, "each team draws its own initial pose"
+    mass = base.batch.mass
+    steps = 0
+    while True:
+        obs, reward, terminated, truncated, _ = env.step(np.stack([pd(o, mass) for o in obs]))
+        steps += 1
+        assert reward.shape == (4,) and not terminated.any()
+        if truncated.any():
+            break
+    assert steps == 50 and truncated.all(), "every team reaches the 0.5 s duration together"
+    # Next-step autoreset: the ended teams restart from a drawn pose, reward 0, the action ignored.
+    obs, reward, terminated, truncated, _ = env.step(np.zeros((4, 6), np.float32))
+    assert (reward == 0).all() and not (terminated | truncated).any()
+    assert np.abs(obs[:, :3]).max() <= 0.2 + 1e-6
+
+
+def test_the_vector_env_ends_a_falling_team_alone():
+    env = tgym.HoverVectorEnv(2, max_position_error=0.5, initial_offset=0.0, initial_tilt=0.0)
+    env.reset(seed=0)
+    mass = env.batch.mass
+    hold = np.array([0, 0, 0, 0, 0, mass * 9.81], np.float32)
+    actions = np.stack([hold, np.zeros(6, np.float32)])
+    for _ in range(100):
+        _, reward, terminated, _, _ = env.step(actions)
+        if terminated[1]:
+            break
+    assert terminated[1] and not terminated[0], "team 1 falls without thrust, team 0 holds"
+    assert reward[0] > reward[1]

@@ -1,7 +1,9 @@
 """tvmd.gym: Gymnasium environments of the tvmd simulator (needs ``gymnasium``).
 
 Importing the module registers ``"tvmd/Hover-v0"`` (:class:`HoverEnv`): hold a hover at the
-scenario's reference from a perturbed initial pose. The plant is :class:`tvmd.sim.Simulation`
+scenario's reference from a perturbed initial pose; :class:`HoverVectorEnv` is the same task for
+many teams stepped together inside Rust (``gymnasium.make_vec("tvmd/Hover-v0", num_envs,
+vectorization_mode="vector_entry_point")``). The plant is :class:`tvmd.sim.Simulation`
 (the scenario's actuators, failures, disturbances and noise apply); one environment step is one
 controller period (0.01 s by default). Everything is in SI units, z up.
 
@@ -51,6 +53,29 @@ DEFAULT_WEIGHTS = {
 
 HOVER_ID = "tvmd/Hover-v0"
 
+_OBSERVATION = spaces.Box(-np.inf, np.inf, shape=(18,), dtype=np.float32)
+
+
+def _action_bounds(simulation: Any, action: str) -> tuple[np.ndarray, np.ndarray]:
+    # The action box of a team (a ``Simulation``): a wrench or per-agent commands, SI units.
+    n, thrust = simulation.n_agents, simulation.max_thrust
+    if action == "wrench":
+        arm = float(np.linalg.norm(simulation.agent_positions, axis=1).max())
+        high = np.array([n * thrust * arm] * 3 + [n * thrust] * 3)
+        return -high, high
+    sx, sy = simulation.gimbal_limits
+    return np.tile([-sx, -sy, 0.0], (n, 1)), np.tile([sx, sy, thrust], (n, 1))
+
+
+def _check(action: str, weights: Optional[dict[str, float]]) -> dict[str, float]:
+    # The checked action mode; the weights over the defaults.
+    if action not in ("wrench", "commands"):
+        raise ValueError(f'`action` must be "wrench" or "commands", got {action!r}')
+    unknown = set(weights or {}) - set(DEFAULT_WEIGHTS)
+    if unknown:
+        raise ValueError(f"unknown reward weights {sorted(unknown)} (known: {sorted(DEFAULT_WEIGHTS)})")
+    return {**DEFAULT_WEIGHTS, **(weights or {})}
+
 
 class HoverEnv(gym.Env):
     """Hold a hover from a perturbed initial pose (see the module's documentation).
@@ -83,36 +108,22 @@ class HoverEnv(gym.Env):
         render_mode: Optional[str] = None,
         **simulation: Any,
     ) -> None:
-        if action not in ("wrench", "commands"):
-            raise ValueError(f'`action` must be "wrench" or "commands", got {action!r}')
-        unknown = set(weights or {}) - set(DEFAULT_WEIGHTS)
-        if unknown:
-            raise ValueError(f"unknown reward weights {sorted(unknown)} (known: {sorted(DEFAULT_WEIGHTS)})")
+        self.weights = _check(action, weights)
         if render_mode is not None:
             raise ValueError("HoverEnv does not render")
         self.render_mode = render_mode
         self.sim = _sim.Simulation(scenario, **simulation)
         self.action_mode = action
-        self.weights = {**DEFAULT_WEIGHTS, **(weights or {})}
         self.initial_offset = float(initial_offset)
         self.initial_tilt = float(initial_tilt)
         self.max_position_error = float(max_position_error)
         self.max_tilt = float(max_tilt)
         first = self.sim.observe()
         self._home = first.true_state.position.copy()
-        n, thrust = self.sim.n_agents, self.sim.max_thrust
-        if action == "wrench":
-            arm = float(np.linalg.norm(self.sim.agent_positions, axis=1).max())
-            high = np.array([n * thrust * arm] * 3 + [n * thrust] * 3)
-            low = -high
-        else:
-            sx, sy = self.sim.gimbal_limits
-            low = np.tile([-sx, -sy, 0.0], (n, 1))
-            high = np.tile([sx, sy, thrust], (n, 1))
-        self.action_space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
-        self._low, self._high = low, high
-        self._scale = np.maximum(np.abs(low), np.abs(high))
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(18,), dtype=np.float32)
+        self._low, self._high = _action_bounds(self.sim, action)
+        self._scale = np.maximum(np.abs(self._low), np.abs(self._high))
+        self.action_space = spaces.Box(self._low.astype(np.float32), self._high.astype(np.float32), dtype=np.float32)
+        self.observation_space = _OBSERVATION
         self._last = self._vector(first)
 
     @staticmethod
@@ -166,7 +177,117 @@ class HoverEnv(gym.Env):
         return self._last.copy(), float(reward), bool(terminated), truncated, info
 
 
-if HOVER_ID not in gym.registry:
-    gym.register(id=HOVER_ID, entry_point="tvmd.gym:HoverEnv")
+class HoverVectorEnv(gym.vector.VectorEnv):
+    """``num_envs`` hover tasks stepped together inside Rust (``tvmd.sim.SimulationBatch``: one
+    call per batch step on ``jobs`` threads, no Python loop per team). Spaces, reward, initial
+    poses and episode ends are :class:`HoverEnv`'s, batched; episodes reset automatically on the
+    step after they end (Gymnasium's next-step autoreset: that step's action is ignored, its
+    reward 0). A team whose simulation fails (diverges) is terminated with reward -100.
 
-__all__ = ["DEFAULT_WEIGHTS", "HOVER_ID", "HoverEnv"]
+    Args: ``num_envs``, then as :class:`HoverEnv`, plus ``jobs`` (worker threads).
+    """
+
+    metadata = {"autoreset_mode": gym.vector.AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(
+        self,
+        num_envs: int,
+        scenario: Optional[str] = None,
+        *,
+        action: str = "wrench",
+        weights: Optional[dict[str, float]] = None,
+        initial_offset: float = 0.2,
+        initial_tilt: float = 0.1,
+        max_position_error: float = 2.0,
+        max_tilt: float = 1.2,
+        jobs: Optional[int] = None,
+        **simulation: Any,
+    ) -> None:
+        self.weights = _check(action, weights)
+        self.num_envs = int(num_envs)
+        self.batch = _sim.SimulationBatch(scenario, count=self.num_envs, jobs=jobs, **simulation)
+        one = _sim.Simulation(scenario, **simulation)
+        self._home = one.observe().true_state.position.copy()
+        self.action_mode = action
+        self._low, self._high = _action_bounds(one, action)
+        self._scale = np.maximum(np.abs(self._low), np.abs(self._high))
+        self.single_action_space = spaces.Box(self._low.astype(np.float32), self._high.astype(np.float32), dtype=np.float32)
+        self.single_observation_space = _OBSERVATION
+        self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.initial_offset, self.initial_tilt = float(initial_offset), float(initial_tilt)
+        self.max_position_error, self.max_tilt = float(max_position_error), float(max_tilt)
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._last = np.zeros((self.num_envs, 18), dtype=np.float32)
+
+    def _reset_teams(self, indices: np.ndarray) -> dict[str, Any]:
+        m = len(indices)
+        rng = self.np_random
+        offsets = rng.uniform(-self.initial_offset, self.initial_offset, (m, 3))
+        tilts = rng.uniform(-self.initial_tilt, self.initial_tilt, (m, 2))
+        seeds = [int(x) for x in rng.integers(0, 2**63, m)]
+        attitudes = np.column_stack([tilts, np.zeros(m)])
+        return self.batch.reset([int(k) for k in indices], seeds=seeds, positions=self._home + offsets, attitudes_rpy=attitudes)
+
+    @staticmethod
+    def _vectors(d: dict[str, Any]) -> np.ndarray:
+        b = len(d["t"])
+        return np.concatenate(
+            [
+                d["position"] - d["reference_position"],
+                d["velocity_world"] - d["reference_velocity"],
+                d["rotation"].reshape(b, 9),
+                d["angular_velocity"],
+            ],
+            axis=1,
+        ).astype(np.float32)
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
+        """Resets every team (initial poses drawn with the environment's generator)."""
+        super().reset(seed=seed)
+        d = self._reset_teams(np.arange(self.num_envs))
+        self._autoreset[:] = False
+        self._last = self._vectors(d)
+        return self._last.copy(), {}
+
+    def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """One controller period for every team (teams that ended last step are reset instead)."""
+        shape = (self.num_envs, *self._low.shape)
+        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(shape), self._low, self._high)
+        resetting = self._autoreset.copy()
+        if resetting.any():
+            self._reset_teams(np.flatnonzero(resetting))
+        active = [bool(x) for x in ~resetting]
+        d = self.batch.step_wrench(a, active=active) if self.action_mode == "wrench" else self.batch.step(a, active=active)
+        obs = self._vectors(d)
+        failed = np.array([e is not None for e in d["errors"]])
+        obs[failed] = self._last[failed]
+        e_x = d["position"] - d["reference_position"]
+        e_v = d["velocity_world"] - d["reference_velocity"]
+        trace = np.einsum("kji,kji->k", d["reference_rotation"], d["rotation"])
+        omega = d["angular_velocity"]
+        w = self.weights
+        reward = w["alive"] - (
+            w["position"] * np.einsum("ki,ki->k", e_x, e_x)
+            + w["velocity"] * np.einsum("ki,ki->k", e_v, e_v)
+            + w["attitude"] * 0.5 * (3.0 - trace)
+            + w["rate"] * np.einsum("ki,ki->k", omega, omega)
+            + w["action"] * np.sum((a / self._scale) ** 2, axis=tuple(range(1, a.ndim)))
+        )
+        error = np.linalg.norm(d["true_position"] - d["reference_position"], axis=1)
+        tilt = np.arccos(np.clip(d["rotation"][:, 2, 2], -1.0, 1.0))
+        terminated = (error > self.max_position_error) | (tilt > self.max_tilt) | failed
+        truncated = d["done"] & ~terminated
+        reward = np.where(failed, -100.0, reward)
+        reward[resetting] = 0.0
+        terminated[resetting] = False
+        truncated[resetting] = False
+        self._autoreset = terminated | truncated
+        self._last = obs
+        return obs.copy(), reward.astype(np.float64), terminated, truncated, {}
+
+
+if HOVER_ID not in gym.registry:
+    gym.register(id=HOVER_ID, entry_point="tvmd.gym:HoverEnv", vector_entry_point="tvmd.gym:HoverVectorEnv")
+
+__all__ = ["DEFAULT_WEIGHTS", "HOVER_ID", "HoverEnv", "HoverVectorEnv"]

@@ -85,6 +85,7 @@ def monte_carlo(
 
 SimResult = _sim.SimResult
 Simulation = _sim.Simulation
+SimulationBatch = _sim.SimulationBatch
 Observation = _sim.Observation
 ScenarioController = _sim.ScenarioController
 ControllerOutput = _sim.ControllerOutput
@@ -226,6 +227,7 @@ __all__ = [
     "ScenarioController",
     "SimResult",
     "Simulation",
+    "SimulationBatch",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

@@ -467,6 +467,82 @@ class ScenarioController:
             RuntimeError: the controller failed.
         """
 
+@final
+class SimulationBatch:
+    """Many teams of one scenario stepped together inside Rust: one call steps every team one
+    controller period on a worker pool (``jobs`` threads, the GIL released), each team with its
+    own action, and returns every team's observation as ``(B, ...)`` arrays. Each team is a
+    ``Simulation`` of its own (its noise, failures and errors); a team whose step fails (a
+    divergence) reports it in ``errors`` and NaN in the arrays, the others go on. The batch keeps
+    no samples.
+
+    Every call returns a dict of the teams' observations (the fed-back state):
+    ``t`` (B,), ``position``, ``velocity_world``, ``angular_velocity`` (B, 3), ``rotation``
+    (B, 3, 3), ``true_position`` (B, 3), ``reference_position``, ``reference_velocity`` (B, 3),
+    ``reference_rotation`` (B, 3, 3),
+    ``done`` (B,) bool (the duration is reached: reset that team) and ``errors`` (a list of
+    B messages or None).
+
+    Args:
+        scenario, toml, team, relaxation, allocator, precision, null_space, law: as
+            ``Simulation``'s (default scenario ``"hover"``).
+        count: the number of teams ``B`` (1 to 2**20).
+        jobs: worker threads (default: the available cores).
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        count: int,
+        jobs: Optional[int] = None,
+        toml: Optional[str] = None,
+        team: Optional[str] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+    ) -> "SimulationBatch": ...
+    def reset(
+        self,
+        indices: Optional[list[int]] = None,
+        *,
+        seeds: Optional[list[int]] = None,
+        positions: Optional[ArrayLike] = None,
+        attitudes_rpy: Optional[ArrayLike] = None,
+    ) -> dict[str, Any]:
+        """Resets the teams ``indices`` (default all) as ``Simulation.reset`` does, with one seed
+        and optional (m, 3) initial positions and attitudes per reset team; every team's
+        observation."""
+    def step_wrench(self, wrenches: ArrayLike, *, active: Optional[list[bool]] = None) -> dict[str, Any]:
+        """Holds each team's (B, 6) body wrench ``[u_tau; u_f]`` (N m, N) for one controller
+        period (only the ``active`` teams step, all by default); every team's observation.
+
+        Raises:
+            ValueError: not (B, 6) finite values, ``active`` not B flags.
+        """
+    def step(
+        self, commands: ArrayLike, *, active: Optional[list[bool]] = None, rotor_speeds: bool = False
+    ) -> dict[str, Any]:
+        """Holds each team's (B, n, 3) or (B, n, 4) per-agent commands (as ``Simulation.step``)
+        for one controller period; every team's observation."""
+    @property
+    def n_teams(self) -> int:
+        """The number of teams ``B``."""
+    @property
+    def n_agents(self) -> int:
+        """Number of agents ``n`` per team."""
+    @property
+    def mass(self) -> float:
+        """Team mass ``m_C`` (kg)."""
+    @property
+    def max_thrust(self) -> float:
+        """Largest thrust of one agent ``sigma_Tf`` (N)."""
+    @property
+    def controller_period(self) -> float:
+        """The time one step holds its commands (s)."""
+
 def builtin_scenarios() -> list[str]:
     """The names of the built-in scenarios (``"paper-tilt"`` is the paper's simulation, see
     docs/method.md; ``"relaxation-<s>"`` the relaxation study; failures, A4-Con, ...).
@@ -762,6 +838,7 @@ __all__ = [
     "ScenarioController",
     "SimResult",
     "Simulation",
+    "SimulationBatch",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

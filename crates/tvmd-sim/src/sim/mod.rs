@@ -25,6 +25,7 @@
 //! a caller with its own controller calls too ([`Simulation::step`] with commands,
 //! [`Simulation::step_wrench`] with a body wrench).
 
+pub mod batch;
 pub mod difference;
 mod forces;
 pub mod latency;
@@ -49,6 +50,7 @@ use tvmd_plant::physics::{MassError, PhysicsWorld, PlantState, TeamBody};
 use tvmd_plant::PhysicsError;
 use tvmd_scenario::{Failure, Payload, Scenario, StateNoise};
 
+pub use batch::{BatchAction, SimulationBatch, TeamStep};
 pub use difference::FlightDifference;
 pub use forces::agent_forces;
 use forces::body_forces;

@@ -218,3 +218,46 @@ fn reset_at_starts_from_another_pose_or_refuses_it() {
     sim.reset(None).unwrap();
     assert_eq!(sim.state().position, Vector3::new(0.5, -0.25, 2.0));
 }
+
+#[test]
+fn a_batch_steps_each_team_as_alone_and_keeps_errors_per_team() {
+    use tvmd_sim::sim::{BatchAction, SimOptions, SimulationBatch};
+    let scenario = Scenario::builtin("hover").unwrap();
+    let batch = SimulationBatch::new(&scenario, 3, SimOptions::default(), Some(2)).unwrap();
+    let mut alone = Simulation::new(&scenario).unwrap();
+    let hover = |dz: f64| [0.0, 0.0, 0.0, 0.0, 0.0, alone_weight() + dz];
+    let wrenches = [hover(1.0), hover(0.0), [f64::NAN; 6]];
+    let mut last = Vec::new();
+    for _ in 0..20 {
+        last = batch.step(BatchAction::Wrench(&wrenches), None).unwrap();
+        alone.step_wrench(&wrenches[0]).unwrap();
+    }
+    let first = last[0].as_ref().unwrap();
+    // The same flight as the team flown alone, bit for bit.
+    assert_eq!(first.observation.truth, alone.state());
+    assert!(
+        first.observation.truth.position.z > 1.5,
+        "the extra newton lifts team 0"
+    );
+    assert!(last[2].is_err(), "team 2's NaN wrench is its own error");
+    assert_eq!(batch.with(2, |s| s.time()).unwrap(), 0.0);
+    assert_eq!(batch.with(1, |s| s.time()).unwrap(), 0.2);
+    // Only the active teams step; a wrong count is the batch's error.
+    let out = batch
+        .step(BatchAction::Wrench(&wrenches), Some(&[false, true, false]))
+        .unwrap();
+    assert_eq!(out[0].as_ref().unwrap().observation.t, 0.2);
+    assert_eq!(out[1].as_ref().unwrap().observation.t, 0.21);
+    assert!(batch
+        .step(BatchAction::Wrench(&wrenches[..2]), None)
+        .is_err());
+    let reset = batch.reset(0, None, Some([1.0, 0.0, 1.5]), None).unwrap();
+    assert_eq!((reset.observation.t, reset.finished), (0.0, false));
+    assert_eq!(reset.observation.truth.position.x, 1.0);
+    assert!(SimulationBatch::new(&scenario, 0, SimOptions::default(), None).is_err());
+}
+
+/// The weight of the built-in hover's team (N).
+fn alone_weight() -> f64 {
+    hover_sim().team().mass() * GRAVITY
+}
