@@ -13,9 +13,9 @@ use tvmd_scenario::{Scenario, BUILTIN_NAMES};
 
 use crate::convert::{jobs_arg, law_arg, retention_arg, Int};
 use crate::errors::value_error;
-use crate::runs::RunArgs;
 use crate::runs::{batch_label, run_items, run_items_keeping, run_specs};
 use crate::runs::{sweep_label, sweep_run_specs};
+use crate::runs::{team_arg, RunArgs};
 use crate::sim_result::PySimResult;
 
 /// The names of the built-in scenarios.
@@ -48,9 +48,10 @@ fn run(
     pil: Option<String>,
     null_space: Option<String>,
     max_samples: Option<Int>,
-    team: Option<String>,
+    team: Option<&Bound<'_, PyAny>>,
     law: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PySimResult> {
+    let (team, team_config) = team_arg(team)?;
     let samples = retention_arg(max_samples.as_ref(), "max_samples")?;
     let law = law.map(|l| law_arg(l, "law")).transpose()?;
     let spec = RunArgs {
@@ -64,6 +65,7 @@ fn run(
         pil,
         samples,
         team,
+        team_config,
         law,
     }
     .spec("scenario")?;

@@ -115,7 +115,7 @@ impl PySimulationBatch {
         count: Int,
         jobs: Option<Int>,
         toml: Option<String>,
-        team: Option<String>,
+        team: Option<&Bound<'_, PyAny>>,
         relaxation: Option<f64>,
         allocator: Option<String>,
         precision: Option<String>,

@@ -20,7 +20,7 @@ use crate::convert::{finite, wrench_arg, Int};
 use crate::errors::value_error;
 use crate::law::{PyReference, PyState};
 use crate::record::record;
-use crate::runs::RunArgs;
+use crate::runs::{team_arg, RunArgs};
 use crate::sim_result::{PySimResult, SimData};
 
 /// The scenario of a `Simulation` or `ScenarioController`: `run`'s arguments, the built-in
@@ -30,7 +30,7 @@ pub(crate) fn spec(
     py: Python<'_>,
     scenario: Option<&Bound<'_, PyAny>>,
     toml: Option<String>,
-    team: Option<String>,
+    team: Option<&Bound<'_, PyAny>>,
     relaxation: Option<f64>,
     allocator: Option<String>,
     precision: Option<String>,
@@ -38,6 +38,7 @@ pub(crate) fn spec(
     law: Option<&Bound<'_, PyAny>>,
     max_samples: Option<&Int>,
 ) -> PyResult<RunSpec> {
+    let (team, team_config) = team_arg(team)?;
     let hover = PyString::new(py, "hover").into_any();
     let scenario = scenario
         .filter(|s| !s.is_none())
@@ -46,6 +47,7 @@ pub(crate) fn spec(
         scenario,
         toml,
         team,
+        team_config,
         relaxation,
         allocator,
         precision,
@@ -114,7 +116,7 @@ impl PySimulation {
         py: Python<'_>,
         scenario: Option<&Bound<'_, PyAny>>,
         toml: Option<String>,
-        team: Option<String>,
+        team: Option<&Bound<'_, PyAny>>,
         relaxation: Option<f64>,
         allocator: Option<String>,
         precision: Option<String>,
@@ -325,7 +327,7 @@ impl PyScenarioController {
         py: Python<'_>,
         scenario: Option<&Bound<'_, PyAny>>,
         toml: Option<String>,
-        team: Option<String>,
+        team: Option<&Bound<'_, PyAny>>,
         relaxation: Option<f64>,
         allocator: Option<String>,
         precision: Option<String>,

@@ -9,6 +9,8 @@ nothing; ``reset`` replays or reseeds the noise.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -172,3 +174,22 @@ def test_a_team_flies_the_hover():
     assert errors.max() < 0.01
     obs = s.observe()
     assert obs.done and set(obs.to_dict()) == set(sim.Observation.FIELDS)
+
+
+def test_a_tvmd_team_flies_in_run_and_in_the_simulation():
+    # A Team built in Python (a ring of six, not a preset of the scenarios) flies everywhere.
+    ring = tvmd.Team.ring(6, 0.4, True, math.pi / 6, math.pi / 4, 2 * 0.7 * G)
+    s = sim.Simulation(team=ring)
+    assert s.n_agents == 6 and s.mass == pytest.approx(ring.mass)
+    np.testing.assert_allclose(s.agent_positions, ring.positions, atol=1e-12)
+    assert s.max_thrust == ring.max_thrust and s.gimbal_limits == (ring.sigma_x, ring.sigma_y)
+    errors = fly(s, lambda obs: s.step_wrench(pd_wrench(obs, s.mass)))
+    assert errors.max() < 0.01
+    r = sim.run("hover", team=ring)
+    assert r.n_agents == 6 and abs(r.position[-1] - r.reference_position[-1]).max() < 0.01
+    # The catalogue's A6-Inc as a tvmd.Team flies as the name does, to round-off.
+    by_name = sim.run("hover", team="a6-inc")
+    by_team = sim.run("hover", team=tvmd.Team.preset("a6-inc"))
+    np.testing.assert_allclose(by_team.position, by_name.position, atol=1e-9)
+    with pytest.raises(TypeError, match="team"):
+        sim.Simulation(team=6)

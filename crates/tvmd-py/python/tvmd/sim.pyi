@@ -26,7 +26,7 @@ from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, T
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._tvmd import AllocatorName, Reference, State
+from ._tvmd import AllocatorName, Reference, State, Team
 
 _F64 = NDArray[np.float64]
 _ScenarioArg = Union[str, "os.PathLike[str]"]
@@ -333,7 +333,8 @@ class Simulation:
         scenario: a built-in name or a TOML scenario file, as ``run``'s; default ``"hover"``
             (A4-Inc holding a hover at 1.5 m for 12 s; with ``team`` another team).
         toml: inline TOML scenario text instead of ``scenario``.
-        team: a catalogue team (``"a6-inc"``, ...) instead of the scenario's.
+        team: a catalogue team (``"a6-inc"``, ...) or a ``tvmd.Team`` instead of the scenario's
+            (as ``run``'s ``team``).
         relaxation, allocator, precision, null_space, law: ``run``'s overrides (the allocator and
             the null-space stage are ``step_wrench``'s; ``precision`` and ``law`` concern
             ``ScenarioController`` built with the same arguments).
@@ -351,7 +352,7 @@ class Simulation:
         scenario: Optional[_ScenarioArg] = None,
         *,
         toml: Optional[str] = None,
-        team: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
         relaxation: Optional[float] = None,
         allocator: Optional[AllocatorName] = None,
         precision: Optional[_Precision] = None,
@@ -452,7 +453,7 @@ class ScenarioController:
         scenario: Optional[_ScenarioArg] = None,
         *,
         toml: Optional[str] = None,
-        team: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
         relaxation: Optional[float] = None,
         allocator: Optional[AllocatorName] = None,
         precision: Optional[_Precision] = None,
@@ -497,7 +498,7 @@ class SimulationBatch:
         count: int,
         jobs: Optional[int] = None,
         toml: Optional[str] = None,
-        team: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
         relaxation: Optional[float] = None,
         allocator: Optional[AllocatorName] = None,
         precision: Optional[_Precision] = None,
@@ -567,7 +568,7 @@ def run(
     pil: Optional[_PilTarget] = None,
     null_space: Optional[str] = None,
     max_samples: Optional[int] = None,
-    team: Optional[str] = None,
+    team: Optional[Union[str, Team]] = None,
     law: Optional[_LawArg] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
@@ -613,7 +614,12 @@ def run(
             ``"a3-con"`` ... ``"a10-inc"``, ``"a4-diamond-inc"``, ``"t10-con"``, ``"t10-inc"``);
             the scenario families (``"hover"``, ``"wind"``, ``"payload"``, ``"model-error"``,
             ``"reference-jump"``, ``"sine"``, ``"figure-eight"``, ``"initial-attitude-<rad>"``)
-            are built for any of them (docs/method.md "Scenario families").
+            are built for any of them (docs/method.md "Scenario families"). Or a ``tvmd.Team``
+            (a preset or one built in Python): its agents (positions, quarter turns, masses),
+            navigator, gimbal limits and largest thrust replace the scenario's ``[team]`` and
+            ``[limits]``; a team with agent inertias or a ``min_thrust`` raises ``ValueError``
+            (the simulator's agents are point masses that idle at zero thrust). In ``run_many``
+            dicts, a name only.
         law: override the scenario's control law (scenario field ``law``): ``"paper"`` (the
             paper's eq. 12), ``"offset-free"`` (natural gains, disturbance observer, planned
             rates), or a dict with the keys of the TOML ``[law]`` table (as
