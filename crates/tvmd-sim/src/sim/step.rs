@@ -172,6 +172,8 @@ impl Simulation {
         if self.is_finished() {
             return Err(self.past_the_end());
         }
+        // The tick's failures are applied with its observation: the allocation knows them.
+        self.observe()?;
         let failed = self.failed_told.clone();
         let t = self.time();
         let allocation = match self.allocation.as_mut() {

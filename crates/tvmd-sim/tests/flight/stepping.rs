@@ -261,3 +261,36 @@ fn a_batch_steps_each_team_as_alone_and_keeps_errors_per_team() {
 fn alone_weight() -> f64 {
     hover_sim().team().mass() * GRAVITY
 }
+
+#[test]
+fn the_wrench_allocation_idles_an_agent_from_its_failure_tick() {
+    use tvmd_plant::actuators::FailureKind;
+    use tvmd_scenario::Failure;
+    let mut scenario = Scenario::builtin("hover").unwrap();
+    scenario.team.preset = Some("a6-inc".into());
+    scenario.failures = vec![Failure {
+        agent: 2,
+        time: 0.05,
+        kind: FailureKind::NoThrust,
+        controller_informed: true,
+    }];
+    let mut sim = Simulation::new(&scenario).unwrap();
+    let weight = sim.team().mass() * GRAVITY;
+    for _ in 0..10 {
+        // No observe between the steps: the step itself applies the tick's failures first.
+        sim.step_wrench(&[0.0, 0.0, 0.0, 0.0, 0.0, weight]).unwrap();
+    }
+    let samples = sim.samples();
+    assert!(samples[4].commands[2].thrust > 0.0);
+    assert_eq!(
+        samples[5].commands[2].thrust, 0.0,
+        "idle from the failure's tick on"
+    );
+    assert!(samples[5].failed[2]);
+    let total: f64 = samples[9].commands.iter().map(|c| c.thrust).sum();
+    // The five working agents hold the weight (their thrusts' vertical parts).
+    assert!(
+        total >= weight * (1.0 - 1e-9) && total < 1.1 * weight,
+        "{total} against {weight}"
+    );
+}
