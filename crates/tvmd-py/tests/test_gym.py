@@ -20,6 +20,29 @@ pytestmark = pytest.mark.filterwarnings(
 )
 
 
+@pytest.mark.parametrize("env_id", sorted(tgym.ENVIRONMENTS))
+def test_check_env_passes_for_every_registered_environment(env_id):
+    env = gym.make(env_id)
+    check_env(env.unwrapped, skip_render_check=True)
+    obs, _ = env.reset(seed=1)
+    assert env.observation_space.contains(obs)
+
+
+def test_the_agent_failure_environment_loses_an_agent():
+    env = gym.make("tvmd/AgentFailure-v0", initial_offset=0.0, initial_tilt=0.0)
+    obs, _ = env.reset(seed=0)
+    base = env.unwrapped
+    mass = base.sim.mass
+    assert base.sim.n_agents == 6
+    for _ in range(400):
+        obs, _, terminated, truncated, info = env.step(pd(obs, mass))
+        assert not terminated
+    # The failure came at 3 s; the five working agents hold the hover through the allocation.
+    assert info["time"] == pytest.approx(4.0)
+    assert base.sim.observe().failed[0]
+    assert info["position_error"] < 0.05
+
+
 @pytest.mark.parametrize("action", ["wrench", "commands"])
 def test_check_env_passes(action):
     env = tgym.HoverEnv(action=action)

@@ -1,11 +1,21 @@
 """tvmd.gym: Gymnasium environments of the tvmd simulator (needs ``gymnasium``).
 
-Importing the module registers ``"tvmd/Hover-v0"`` (:class:`HoverEnv`): hold a hover at the
-scenario's reference from a perturbed initial pose; :class:`HoverVectorEnv` is the same task for
-many teams stepped together inside Rust (``gymnasium.make_vec("tvmd/Hover-v0", num_envs,
-vectorization_mode="vector_entry_point")``). The plant is :class:`tvmd.sim.Simulation`
-(the scenario's actuators, failures, disturbances and noise apply); one environment step is one
-controller period (0.01 s by default). Everything is in SI units, z up.
+Importing the module registers four environments, each :class:`TeamEnv` on a scenario: follow
+the scenario's reference from a perturbed initial pose.
+
+* ``"tvmd/Hover-v0"``: the built-in ``"hover"`` (A4-Inc holds 1.5 m for 12 s);
+* ``"tvmd/Tracking-v0"``: ``"figure-eight"`` (a figure eight at 1.5 m, 21 s);
+* ``"tvmd/Wind-v0"``: ``"wind"`` (hover in a 1 m/s wind with a 3 m/s gust at 4-6 s: disturbance
+  rejection);
+* ``"tvmd/AgentFailure-v0"``: A6-Inc hovering at 1.5 m loses agent 0's thrust at 3 s (the
+  wrench allocation is told and idles it), 12 s.
+
+:class:`TeamVectorEnv` is the same task for many teams stepped together inside Rust
+(``gymnasium.make_vec(id, num_envs, vectorization_mode="vector_entry_point")``).
+``HoverEnv`` and ``HoverVectorEnv`` are their names with the default scenario. The plant is
+:class:`tvmd.sim.Simulation` (the scenario's actuators, failures, disturbances and noise apply);
+one environment step is one controller period (0.01 s by default). Everything is in SI units,
+z up.
 
 Observation (``Box`` of 18 float32): the position error ``x - x_r`` (3, m, world frame), the
 velocity error ``x_dot - x_dot_r`` (3, m/s, world frame), the attitude ``R`` (9, body to world,
@@ -26,8 +36,8 @@ weights are the ``weights`` argument over :data:`DEFAULT_WEIGHTS`, and ``info["r
 holds each term (before weighting). ``terminated``: the position error exceeds
 ``max_position_error``, the tilt ``acos(R_33)`` exceeds ``max_tilt``, or the simulation diverged;
 ``truncated``: the scenario's duration is reached. ``reset(seed=...)`` seeds the initial pose's
-draw (uniform within ``initial_offset`` m per axis and ``initial_tilt`` rad in roll and pitch)
-and the state noise.
+draw (uniform within ``initial_offset`` m per axis, upwards only for a scenario that starts on
+the ground, and ``initial_tilt`` rad in roll and pitch) and the state noise.
 """
 
 from __future__ import annotations
@@ -53,6 +63,30 @@ DEFAULT_WEIGHTS = {
 
 HOVER_ID = "tvmd/Hover-v0"
 
+#: A6-Inc hovering at 1.5 m loses agent 0's thrust at 3 s (``"tvmd/AgentFailure-v0"``).
+AGENT_FAILURE_TOML = """name = "hover-agent-failure"
+description = "A6-Inc hovers at 1.5 m and loses agent 0's thrust at 3 s (controller told)"
+duration = 12.0
+initial_position = [0.0, 0.0, 1.5]
+[team]
+preset = "a6-inc"
+[reference]
+kind = "hover"
+position = [0.0, 0.0, 1.5]
+[[failures]]
+agent = 0
+time = 3.0
+kind = "no-thrust"
+"""
+
+#: The registered environments: id -> keyword arguments of :class:`TeamEnv`.
+ENVIRONMENTS = {
+    HOVER_ID: {},
+    "tvmd/Tracking-v0": {"scenario": "figure-eight"},
+    "tvmd/Wind-v0": {"scenario": "wind"},
+    "tvmd/AgentFailure-v0": {"toml": AGENT_FAILURE_TOML},
+}
+
 _OBSERVATION = spaces.Box(-np.inf, np.inf, shape=(18,), dtype=np.float32)
 
 
@@ -77,8 +111,18 @@ def _check(action: str, weights: Optional[dict[str, float]]) -> dict[str, float]
     return {**DEFAULT_WEIGHTS, **(weights or {})}
 
 
-class HoverEnv(gym.Env):
-    """Hold a hover from a perturbed initial pose (see the module's documentation).
+def _draw_offsets(rng: np.random.Generator, home: np.ndarray, bound: float, m: int) -> np.ndarray:
+    # Initial position offsets within `bound` per axis; never below the ground (z = 0) for a
+    # scenario that starts on it.
+    offsets = rng.uniform(-bound, bound, (m, 3))
+    if home[2] < bound:
+        offsets[:, 2] = np.abs(offsets[:, 2])
+    return offsets
+
+
+class TeamEnv(gym.Env):
+    """Follow a scenario's reference from a perturbed initial pose (see the module's
+    documentation).
 
     Args:
         scenario: a scenario for ``tvmd.sim.Simulation`` (default ``"hover"``: A4-Inc at 1.5 m,
@@ -110,7 +154,7 @@ class HoverEnv(gym.Env):
     ) -> None:
         self.weights = _check(action, weights)
         if render_mode is not None:
-            raise ValueError("HoverEnv does not render")
+            raise ValueError("TeamEnv does not render")
         self.render_mode = render_mode
         self.sim = _sim.Simulation(scenario, **simulation)
         self.action_mode = action
@@ -137,7 +181,7 @@ class HoverEnv(gym.Env):
         """Starts an episode from a perturbed pose (drawn with the environment's generator)."""
         super().reset(seed=seed)
         rng = self.np_random
-        offset = rng.uniform(-self.initial_offset, self.initial_offset, 3)
+        offset = _draw_offsets(rng, self._home, self.initial_offset, 1)[0]
         tilt = rng.uniform(-self.initial_tilt, self.initial_tilt, 2)
         noise_seed = int(rng.integers(0, 2**63))
         obs = self.sim.reset(noise_seed, position=self._home + offset, attitude_rpy=[tilt[0], tilt[1], 0.0])
@@ -177,14 +221,14 @@ class HoverEnv(gym.Env):
         return self._last.copy(), float(reward), bool(terminated), truncated, info
 
 
-class HoverVectorEnv(gym.vector.VectorEnv):
-    """``num_envs`` hover tasks stepped together inside Rust (``tvmd.sim.SimulationBatch``: one
+class TeamVectorEnv(gym.vector.VectorEnv):
+    """``num_envs`` teams of one task stepped together inside Rust (``tvmd.sim.SimulationBatch``: one
     call per batch step on ``jobs`` threads, no Python loop per team). Spaces, reward, initial
-    poses and episode ends are :class:`HoverEnv`'s, batched; episodes reset automatically on the
+    poses and episode ends are :class:`TeamEnv`'s, batched; episodes reset automatically on the
     step after they end (Gymnasium's next-step autoreset: that step's action is ignored, its
     reward 0). A team whose simulation fails (diverges) is terminated with reward -100.
 
-    Args: ``num_envs``, then as :class:`HoverEnv`, plus ``jobs`` (worker threads).
+    Args: ``num_envs``, then as :class:`TeamEnv`, plus ``jobs`` (worker threads).
     """
 
     metadata = {"autoreset_mode": gym.vector.AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -223,7 +267,7 @@ class HoverVectorEnv(gym.vector.VectorEnv):
     def _reset_teams(self, indices: np.ndarray) -> dict[str, Any]:
         m = len(indices)
         rng = self.np_random
-        offsets = rng.uniform(-self.initial_offset, self.initial_offset, (m, 3))
+        offsets = _draw_offsets(rng, self._home, self.initial_offset, m)
         tilts = rng.uniform(-self.initial_tilt, self.initial_tilt, (m, 2))
         seeds = [int(x) for x in rng.integers(0, 2**63, m)]
         attitudes = np.column_stack([tilts, np.zeros(m)])
@@ -287,7 +331,22 @@ class HoverVectorEnv(gym.vector.VectorEnv):
         return obs.copy(), reward.astype(np.float64), terminated, truncated, {}
 
 
-if HOVER_ID not in gym.registry:
-    gym.register(id=HOVER_ID, entry_point="tvmd.gym:HoverEnv", vector_entry_point="tvmd.gym:HoverVectorEnv")
+#: :class:`TeamEnv` under its first name (its default scenario is the hover).
+HoverEnv = TeamEnv
+#: :class:`TeamVectorEnv` under its first name.
+HoverVectorEnv = TeamVectorEnv
 
-__all__ = ["DEFAULT_WEIGHTS", "HOVER_ID", "HoverEnv", "HoverVectorEnv"]
+for _id, _kwargs in ENVIRONMENTS.items():
+    if _id not in gym.registry:
+        gym.register(id=_id, entry_point="tvmd.gym:TeamEnv", vector_entry_point="tvmd.gym:TeamVectorEnv", kwargs=_kwargs)
+
+__all__ = [
+    "AGENT_FAILURE_TOML",
+    "DEFAULT_WEIGHTS",
+    "ENVIRONMENTS",
+    "HOVER_ID",
+    "HoverEnv",
+    "HoverVectorEnv",
+    "TeamEnv",
+    "TeamVectorEnv",
+]
