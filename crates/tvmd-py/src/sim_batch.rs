@@ -12,7 +12,13 @@ use crate::convert::{batch_commands_arg, batch_wrench_arg, shaped, table, Int};
 use crate::errors::value_error;
 use crate::stepping::spec;
 
-/// Many simulations of one scenario stepped together. See the stub.
+/// Many teams of one scenario stepped together inside Rust, one call per batch step.
+///
+/// `SimulationBatch(scenario="hover", *, count, jobs, ...)` (`Simulation`'s scenario
+/// arguments). `reset`, `step_wrench((B, 6))` and `step((B, n, 3))` return a dict of `(B, ...)`
+/// arrays (`t`, `position`, `velocity_world`, `angular_velocity`, `rotation`, `true_position`,
+/// `reference_position`, `reference_velocity`, `reference_rotation`, `done`) and `errors` (one
+/// message or None per team: a failed team does not stop the others).
 #[pyclass(module = "tvmd.sim", name = "SimulationBatch")]
 pub(crate) struct PySimulationBatch {
     batch: SimulationBatch,
@@ -143,7 +149,8 @@ impl PySimulationBatch {
         })
     }
 
-    /// Resets the teams `indices` (default all). See the stub.
+    /// Resets the teams `indices` (default all), with optional `seeds`, (m, 3) `positions` and
+    /// `attitudes_rpy`; every team's observation.
     #[pyo3(signature = (indices = None, *, seeds = None, positions = None, attitudes_rpy = None))]
     fn reset<'py>(
         &self,
@@ -196,7 +203,8 @@ impl PySimulationBatch {
         self.fly(py, BatchAction::Wrench(&vec![[0.0; 6]; b]), Some(all))
     }
 
-    /// Holds each team's body wrench for one controller period. See the stub.
+    /// Holds each team's (B, 6) body wrench for one controller period (only the `active` teams
+    /// step); every team's observation.
     #[pyo3(signature = (wrenches, *, active = None))]
     fn step_wrench<'py>(
         &self,
@@ -209,7 +217,8 @@ impl PySimulationBatch {
         self.fly(py, BatchAction::Wrench(&w), active)
     }
 
-    /// Holds each team's per-agent commands for one controller period. See the stub.
+    /// Holds each team's (B, n, 3) or (B, n, 4) commands for one controller period (only the
+    /// `active` teams step); every team's observation.
     #[pyo3(signature = (commands, *, active = None, rotor_speeds = false))]
     fn step<'py>(
         &self,

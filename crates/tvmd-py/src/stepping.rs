@@ -66,7 +66,9 @@ pub(crate) struct ObservationData {
 }
 
 record! {
-    /// One controller tick as a controller sees it. See the stub.
+    /// One controller tick as a controller sees it: `t` (s), `state` (the fed-back
+    /// `tvmd.State`, noise and latency applied), `true_state`, `velocity_world` (3,),
+    /// `reference` (a `tvmd.Reference`), `failed` (n,) and `done`.
     "Observation" in "tvmd.sim" => PyObservation(ObservationData) |py, o| {
         /// Simulation time `t_k` (s).
         t => o.observation.t,
@@ -90,7 +92,15 @@ fn step_error(e: tvmd_sim::SimError) -> PyErr {
     value_error(e)
 }
 
-/// The tvmd-sim simulation stepped one controller period at a time. See the stub.
+/// The simulator stepped one controller period at a time with your own controller.
+///
+/// `Simulation(scenario="hover", *, toml, team, relaxation, allocator, precision, null_space,
+/// law, max_samples)`: the plant of `run` (actuators, failures, disturbances, noise). `reset()`
+/// returns the first `Observation`; `step(commands)` holds (n, 3) `eta_x, eta_y, thrust` (or
+/// (n, 4), or normalized rotor speeds with `rotor_speeds=True`, or a `ScenarioController`'s
+/// output) and `step_wrench(u)` the allocation of a (6,) body wrench `[u_tau; u_f]` for one
+/// controller period, each returning the next `Observation`; `result()` is the flight so far.
+/// Bad actions raise `ValueError` and change nothing.
 #[pyclass(module = "tvmd.sim", name = "Simulation")]
 pub(crate) struct PySimulation {
     sim: Simulation,
@@ -144,7 +154,8 @@ impl PySimulation {
     }
 
     /// Starts over (optionally reseeding the state noise, from another initial pose); the
-    /// first observation. See the stub.
+    /// first observation. `seed` reseeds the state noise; `position` (3,) and `attitude_rpy`
+    /// (3,) replace the scenario's initial pose.
     #[pyo3(signature = (seed = None, *, position = None, attitude_rpy = None))]
     fn reset(
         &mut self,
@@ -167,13 +178,15 @@ impl PySimulation {
         self.observation()
     }
 
-    /// The current tick's observation (drawn once per tick). See the stub.
+    /// The current tick's observation (its noise is drawn once per tick).
     fn observe(&mut self) -> PyResult<PyObservation> {
         self.observation()
     }
 
     /// Holds per-agent commands (or a `ScenarioController`'s output) for one controller
-    /// period; the next observation. See the stub.
+    /// period; the next observation. `commands`: (n, 3) rows `eta_x, eta_y` (rad), `thrust` (N);
+    /// (n, 4) in `tvmd.Controller`'s layout; with `rotor_speeds=True` the last column is the
+    /// normalized rotor speed (thrust `max_thrust * omega**2`).
     #[pyo3(signature = (commands, *, rotor_speeds = false))]
     fn step(&mut self, commands: &Bound<'_, PyAny>, rotor_speeds: bool) -> PyResult<PyObservation> {
         if let Ok(out) = commands.cast::<PyControllerOutput>() {
@@ -188,14 +201,15 @@ impl PySimulation {
     }
 
     /// Holds the admissible commands of a body wrench for one controller period; the next
-    /// observation. See the stub.
+    /// observation. `wrench`: (6,) `[u_tau; u_f]` (N m, N), body frame, about the centre of
+    /// mass; the scenario controller's allocation stage makes it admissible commands.
     fn step_wrench(&mut self, wrench: &Bound<'_, PyAny>) -> PyResult<PyObservation> {
         let wrench = wrench_arg(wrench)?;
         self.sim.step_wrench(&wrench).map_err(step_error)?;
         self.observation()
     }
 
-    /// The flight so far as a `SimResult`. See the stub.
+    /// The flight so far as a `SimResult` (copied; the simulation goes on).
     fn result(&self) -> PySimResult {
         let mut result = self.sim.result();
         result.summary.verdict = Verdict::judge(&result.summary, &self.spec.scenario.success);
@@ -285,7 +299,8 @@ impl PySimulation {
     }
 }
 
-/// A `ScenarioController`'s output for one tick: commands and diagnostics. See the stub.
+/// A `ScenarioController`'s output for one tick: `commands` (n, 3) and `diagnostics` (dict);
+/// `Simulation.step` takes it as it is.
 #[pyclass(module = "tvmd.sim", name = "ControllerOutput", frozen)]
 pub(crate) struct PyControllerOutput {
     inner: FlightOutput,
@@ -311,7 +326,8 @@ impl PyControllerOutput {
     }
 }
 
-/// The tvmd controller of a scenario as `run` flies it, for `Simulation.step`. See the stub.
+/// The tvmd controller of a scenario exactly as `run` flies it (same arguments as
+/// `Simulation`): `sim.step(ctrl.step(obs))` from `reset()` to `done` reproduces `run`.
 #[pyclass(module = "tvmd.sim", name = "ScenarioController")]
 pub(crate) struct PyScenarioController {
     /// In a mutex: a Python class must be `Sync`, the controller is `Send` only.
@@ -343,7 +359,7 @@ impl PyScenarioController {
         })
     }
 
-    /// The commands (and diagnostics) for an observation. See the stub.
+    /// The commands and diagnostics for one tick's observation (call it once per tick).
     fn step(&mut self, observation: &Bound<'_, PyObservation>) -> PyResult<PyControllerOutput> {
         let o = &observation.get().inner.observation;
         let mut controller = self
