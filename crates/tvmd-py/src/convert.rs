@@ -21,7 +21,10 @@ use tvmd_sim::ScenarioSource;
 
 use crate::errors::{sim_error, value_error, OrRaise, READ};
 
+mod commands;
 mod law;
+
+pub(crate) use commands::{batch_commands_arg, batch_wrench_arg, commands_arg, wrench_arg};
 
 pub(crate) use law::law_arg;
 

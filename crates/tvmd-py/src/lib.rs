@@ -10,7 +10,7 @@
 //! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
 //! `afs, allocation, law, planner <- step_output`,
 //! `afs, allocation, law, planner, step_output, team <- controller`, and for the simulator
-//! `sim_result <- runs <- sim, executor`; `atlas` and `montecarlo` import only `convert`, `errors` and
+//! `sim_result <- runs <- sim, executor, stepping <- sim_batch` (`stepping` also imports `law`); `atlas` and `montecarlo` import only `convert`, `errors` and
 //! `interrupt`. This file imports every module and no module imports it.
 #![deny(
     clippy::unwrap_used,
@@ -39,8 +39,10 @@ mod planner;
 mod record;
 mod runs;
 mod sim;
+mod sim_batch;
 mod sim_result;
 mod step_output;
+mod stepping;
 mod team;
 
 use convert::CAPACITY;
@@ -68,6 +70,8 @@ fn _tvmd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sim::register(&sim)?;
     sim_result::register(&sim)?;
     executor::register(&sim)?;
+    stepping::register(&sim)?;
+    sim_batch::register(&sim)?;
     montecarlo::register(&sim)?;
     m.add_submodule(&sim)
 }

@@ -9,7 +9,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use tvmd_scenario::LawConfig;
+use tvmd_scenario::{LawConfig, LimitsConfig, TeamSpec};
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{RunRequest, ScenarioSource};
@@ -18,6 +18,10 @@ use crate::convert::{law_arg, retention_arg, scalars, scenario_source, shape_err
 use crate::errors::{sim_error, value_error, WRITE};
 use crate::interrupt::{interruptible, Ended};
 use crate::sim_result::{PySimResult, SimData};
+use crate::team::{team_spec, PyTeam};
+
+/// A `tvmd.Team` as a scenario's team and limits.
+pub(crate) type TeamConfigArg = (TeamSpec, LimitsConfig);
 
 /// The keys a `run_many` dict may hold (the keyword arguments of `run`).
 const RUN_KEYS: &[&str] = &[
@@ -48,6 +52,8 @@ pub(crate) struct RunArgs<'a, 'py> {
     /// The converted `max_samples` ([`retention_arg`]).
     pub(crate) samples: SampleRetention,
     pub(crate) team: Option<String>,
+    /// A `tvmd.Team` flown instead of the scenario's team ([`team_arg`]).
+    pub(crate) team_config: Option<TeamConfigArg>,
     /// The converted `law` ([`law_arg`]), or None for the scenario's.
     pub(crate) law: Option<LawConfig>,
 }
@@ -86,9 +92,36 @@ impl RunArgs<'_, '_> {
 
     /// Loads the scenario, applies the overrides and validates the result
     /// ([`RunRequest::spec`]: the log is checked too, and never the scenario file).
-    pub(crate) fn spec(self, scenario_name: &str) -> PyResult<RunSpec> {
-        self.request(scenario_name)?.spec().map_err(value_error)
+    pub(crate) fn spec(mut self, scenario_name: &str) -> PyResult<RunSpec> {
+        let team = self.team_config.take();
+        let mut spec = self.request(scenario_name)?.spec().map_err(value_error)?;
+        if let Some((team, limits)) = team {
+            spec.scenario.team = team;
+            spec.scenario.limits = limits;
+            spec.scenario.validate().map_err(value_error)?;
+        }
+        Ok(spec)
     }
+}
+
+/// A `team` argument: a catalogue name (a `str`) or a `tvmd.Team` ([`team_spec`]), as the
+/// `team` and `team_config` of [`RunArgs`].
+pub(crate) fn team_arg(
+    team: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Option<String>, Option<TeamConfigArg>)> {
+    let Some(team) = team.filter(|t| !t.is_none()) else {
+        return Ok((None, None));
+    };
+    if let Ok(name) = team.cast::<PyString>() {
+        return Ok((Some(name.to_cow()?.into_owned()), None));
+    }
+    if let Ok(t) = team.cast::<PyTeam>() {
+        return Ok((None, Some(team_spec(&t.get().inner)?)));
+    }
+    let got = team.get_type().name()?;
+    Err(PyTypeError::new_err(format!(
+        "`team` must be a catalogue team name (str) or a tvmd.Team, got {got}"
+    )))
 }
 
 /// A `run_many` entry: a scenario (name or path) or a dict of `run` keyword arguments; `k` its
@@ -171,6 +204,7 @@ pub(crate) fn run_request(
         pil: opt(dict, &name, "pil")?,
         samples,
         team: opt(dict, &name, "team")?,
+        team_config: None,
         law,
     }
     .request(&format!("{name}['scenario']"))?;
@@ -201,6 +235,76 @@ pub(crate) fn run_items(runs: &Bound<'_, PyAny>) -> PyResult<Vec<RunSpec>> {
     let specs: Vec<RunSpec> = items.iter().map(|(spec, _)| spec.clone()).collect();
     runner::check_batch_paths(&specs, &[], &inputs).map_err(value_error)?;
     Ok(specs)
+}
+
+/// A `run_many(..., errors="keep")` batch: each run's `SimResult`, or the exception it would
+/// have raised (a bad entry or log, a failure while flying), by index. Only what concerns the
+/// batch as a whole raises: `runs` not a sequence, two runs on one log, an interrupt.
+pub(crate) fn run_items_keeping(
+    py: Python<'_>,
+    runs: &Bound<'_, PyAny>,
+    jobs: Option<usize>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    if runs.is_instance_of::<PyString>() || runs.is_instance_of::<PyDict>() {
+        return Err(PyTypeError::new_err(
+            "`runs` must be a sequence of runs (names, paths or dicts), not a single str or dict",
+        ));
+    }
+    let mut slots: Vec<Option<Py<PyAny>>> = Vec::new();
+    let mut flown: Vec<(usize, RunSpec, Option<PathBuf>)> = Vec::new();
+    let items = runs
+        .try_iter()
+        .map_err(|_| PyTypeError::new_err("`runs` must be an iterable of runs"))?;
+    for (k, item) in items.enumerate() {
+        let checked = run_request(&item?, k).and_then(|(spec, input)| {
+            check_logs(std::slice::from_ref(&spec), &|_, s| batch_label(k, s))?;
+            Ok((spec, input))
+        });
+        match checked {
+            Ok((spec, input)) => {
+                flown.push((k, spec, input));
+                slots.push(None);
+            }
+            Err(e) => slots.push(Some(e.into_value(py).into_any())),
+        }
+    }
+    let inputs: Vec<(String, &Path)> = flown
+        .iter()
+        .filter_map(|(k, _, input)| {
+            Some((format!("scenario file of runs[{k}]"), input.as_deref()?))
+        })
+        .collect();
+    let specs: Vec<RunSpec> = flown.iter().map(|(_, spec, _)| spec.clone()).collect();
+    runner::check_batch_paths(&specs, &[], &inputs).map_err(value_error)?;
+    let outcomes = run_interruptibly(py, specs, jobs)?;
+    for ((k, _, _), RunOutcome { spec, result }) in flown.into_iter().zip(outcomes) {
+        let value = match result {
+            Ok(result) => Py::new(
+                py,
+                PySimResult {
+                    inner: SimData::new(spec, result),
+                },
+            )?
+            .into_any(),
+            Err(e) => {
+                let log = spec.log.as_deref().map(|l| (WRITE, l));
+                sim_error(e, &batch_label(k, &spec), log)
+                    .into_value(py)
+                    .into_any()
+            }
+        };
+        if let Some(slot) = slots.get_mut(k) {
+            *slot = Some(value);
+        }
+    }
+    slots
+        .into_iter()
+        .map(|s| {
+            s.ok_or_else(|| {
+                pyo3::exceptions::PyRuntimeError::new_err("a run of the batch returned nothing")
+            })
+        })
+        .collect()
 }
 
 /// The runs of a relaxation study as `relaxation_sweep` takes them: `args`' scenario once per

@@ -6,15 +6,16 @@
 
 use std::path::PathBuf;
 
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 use tvmd_scenario::{Scenario, BUILTIN_NAMES};
 
 use crate::convert::{jobs_arg, law_arg, retention_arg, Int};
 use crate::errors::value_error;
-use crate::runs::RunArgs;
-use crate::runs::{batch_label, run_items, run_specs, sweep_label, sweep_run_specs};
+use crate::runs::{batch_label, run_items, run_items_keeping, run_specs};
+use crate::runs::{sweep_label, sweep_run_specs};
+use crate::runs::{team_arg, RunArgs};
 use crate::sim_result::PySimResult;
 
 /// The names of the built-in scenarios.
@@ -47,9 +48,10 @@ fn run(
     pil: Option<String>,
     null_space: Option<String>,
     max_samples: Option<Int>,
-    team: Option<String>,
+    team: Option<&Bound<'_, PyAny>>,
     law: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PySimResult> {
+    let (team, team_config) = team_arg(team)?;
     let samples = retention_arg(max_samples.as_ref(), "max_samples")?;
     let law = law.map(|l| law_arg(l, "law")).transpose()?;
     let spec = RunArgs {
@@ -63,6 +65,7 @@ fn run(
         pil,
         samples,
         team,
+        team_config,
         law,
     }
     .spec("scenario")?;
@@ -71,16 +74,31 @@ fn run(
         .ok_or_else(|| PyRuntimeError::new_err("tvmd-sim returned no result"))
 }
 
-/// Runs many scenarios in parallel threads; results in input order. See the stub.
+/// Runs many scenarios in parallel threads; results in input order (with `errors="keep"`, a
+/// failed run's exception in its place). See the stub.
 #[pyfunction]
-#[pyo3(signature = (runs, *, jobs = None))]
+#[pyo3(signature = (runs, *, jobs = None, errors = "raise"))]
 fn run_many(
     py: Python<'_>,
     runs: &Bound<'_, PyAny>,
     jobs: Option<Int>,
-) -> PyResult<Vec<PySimResult>> {
-    let specs = run_items(runs)?;
-    run_specs(py, specs, jobs_arg(jobs.as_ref())?, batch_label)
+    errors: &str,
+) -> PyResult<Vec<Py<PyAny>>> {
+    let jobs = jobs_arg(jobs.as_ref())?;
+    match errors {
+        "raise" => {
+            let specs = run_items(runs)?;
+            let results = run_specs(py, specs, jobs, batch_label)?;
+            results
+                .into_iter()
+                .map(|r| Ok(Py::new(py, r)?.into_any()))
+                .collect()
+        }
+        "keep" => run_items_keeping(py, runs, jobs),
+        other => Err(PyValueError::new_err(format!(
+            "`errors` must be \"raise\" or \"keep\", got {other:?}"
+        ))),
+    }
 }
 
 /// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.

@@ -10,7 +10,7 @@ use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_scenario::Scenario;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::RunSpec;
-use tvmd_sim::sim::{PaperMetrics, RunResult, RunSummary, Sample};
+use tvmd_sim::sim::{agent_forces, PaperMetrics, RunResult, RunSummary, Sample};
 
 use crate::convert::{record_to_py, shaped};
 use crate::errors::value_error;
@@ -114,6 +114,35 @@ impl SimData {
         })
     }
 
+    /// (K, n, 3) the agents' body-frame forces of the actual outputs; NaN if the team cannot
+    /// be built.
+    fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let team = self.scenario.team_body().ok();
+        self.column(py, &[self.n, 3], |s| {
+            let forces = team
+                .as_ref()
+                .map(|t| agent_forces(&s.actual, t, &self.scenario.plant))
+                .unwrap_or_default();
+            (0..self.n)
+                .flat_map(|i| forces.get(i).copied().unwrap_or([f64::NAN; 3]))
+                .collect::<Vec<_>>()
+        })
+    }
+
+    /// (K, n) normalized commanded rotor speeds `sqrt(T / sigma_Tf)`.
+    fn rotor_speeds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let max = self.scenario.max_thrust().unwrap_or(f64::NAN);
+        self.column(py, &[self.n], |s| {
+            (0..self.n)
+                .map(|i| {
+                    s.commands
+                        .get(i)
+                        .map_or(f64::NAN, |c| (c.thrust.max(0.0) / max).sqrt())
+                })
+                .collect::<Vec<_>>()
+        })
+    }
+
     fn repr(&self) -> String {
         let mcap = self.mcap_string();
         format!(
@@ -165,8 +194,16 @@ record! {
         t => o.scalar(py, |x| Some(x.t))?,
         /// (K, 3) `x` (m).
         position => o.vector(py, |x| Some(x.position))?,
-        /// (K, 3) `x_dot` (m/s).
+        /// (K, 3) `x_dot` (m/s), world frame (`velocity_world`; kept for compatibility).
         velocity => o.vector(py, |x| Some(x.velocity))?,
+        /// (K, 3) `x_dot` (m/s), world frame.
+        velocity_world => o.vector(py, |x| Some(x.velocity))?,
+        /// (K, 3) `v = R^T x_dot` (m/s), body frame (the velocity of `tvmd.State`).
+        velocity_body => o.vector(py, |x| Some(x.velocity_body()))?,
+        /// (K, 3) body rates `Omega` (rad/s), body frame.
+        angular_velocity => o.vector(py, |x| Some(x.omega))?,
+        /// (K, 3, 3) attitude `R` (body to world).
+        rotation => o.column(py, &[3, 3], |x| x.rotation.concat())?,
         /// (K, 3) `x_r` (m).
         reference_position => o.vector(py, |x| Some(x.reference_position))?,
         /// (K, 3) roll, pitch, yaw of `R` (rad, ZYX).
@@ -203,6 +240,12 @@ record! {
         commands => o.agents(py, |x| &x.commands)?,
         /// (K, n, 3) actual actuator outputs.
         actual => o.agents(py, |x| &x.actual)?,
+        /// (K, n, 3) body-frame forces of the actual outputs (N), with the plant's actuation
+        /// error.
+        forces => o.forces(py)?,
+        /// (K, n) commanded rotor speeds, normalized (1 at the largest thrust):
+        /// `sqrt(thrust / max_thrust)`.
+        rotor_speeds => o.rotor_speeds(py)?,
         /// (K, n) bool: true failure flags.
         failed => o.column(py, &[o.n], |x| (0..o.n).map(|i| x.failed.get(i).copied().unwrap_or(false)).collect::<Vec<_>>())?,
         /// Every field of tvmd-sim's `RunSummary` (a fresh dict per access).
@@ -215,6 +258,18 @@ record! {
     methods {
         fn __len__(&self) -> usize {
             self.inner.samples.len()
+        }
+
+        /// The time series as flat (K,) columns (a dict for `pandas.DataFrame`). See the stub.
+        fn to_columns<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+            let py = slf.py();
+            py.import("tvmd.sim")?.getattr("_columns")?.call1((slf,))
+        }
+
+        /// The flat columns as a `pandas.DataFrame` (pandas must be installed). See the stub.
+        fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+            let py = slf.py();
+            py.import("tvmd.sim")?.getattr("_to_pandas")?.call1((slf,))
         }
 
         /// Pickles as `tvmd.sim._sim_result_from_state(bytes)`: every sample and summary in

@@ -8,6 +8,8 @@ use pyo3::prelude::*;
 use tvmd_core::team::presets;
 use tvmd_core::TeamConfig;
 use tvmd_core::{AgentLimits, AgentSpec, Arrangement, FailureMask, HoverCapability, Navigator};
+use tvmd_plant::AgentBody;
+use tvmd_scenario::{LimitsConfig, TeamSpec};
 
 use crate::afs::PyAfs;
 use crate::convert::{array, check_finite, count, indices, int_array, matrix, opt_arg};
@@ -15,6 +17,62 @@ use crate::convert::{shape_error, shape_str, shaped, table, Int, CAPACITY};
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
 use crate::record::record;
+
+/// A `tvmd.Team` as the simulator's team and limits (`[team]` with explicit agents and
+/// `[limits]` of a scenario): the same positions, quarter turns, masses, navigator, gimbal limits
+/// and largest thrust. The simulator models agents as point masses without an idle thrust, so a
+/// team with agent inertias or a `min_thrust` raises `ValueError`.
+pub(crate) fn team_spec(team: &TeamConfig<f64, CAPACITY>) -> PyResult<(TeamSpec, LimitsConfig)> {
+    let unsupported = |what: String| {
+        PyValueError::new_err(format!(
+            "`team`: the simulator cannot fly this tvmd.Team: {what}"
+        ))
+    };
+    if let Some(i) = team
+        .agents()
+        .iter()
+        .position(|a| a.inertia != Matrix3::zeros())
+    {
+        return Err(unsupported(format!(
+            "agent {i} has an inertia (the simulator's agents are point masses)"
+        )));
+    }
+    let limits = team.limits();
+    if limits.min_thrust() != 0.0 {
+        return Err(unsupported(format!(
+            "min_thrust = {} (the simulator's teams idle at zero thrust)",
+            limits.min_thrust()
+        )));
+    }
+    let agents = team
+        .agents()
+        .iter()
+        .map(|a| AgentBody {
+            position: a.position.into(),
+            mass: a.mass,
+            quarter_turns: a.quarter_turns,
+        })
+        .collect();
+    // Rows of J_0: the columns of its transpose.
+    let j0 = team.navigator().inertia.transpose();
+    let row = |r: usize| {
+        let c = j0.column(r);
+        [c.x, c.y, c.z]
+    };
+    let spec = TeamSpec {
+        preset: None,
+        agents: Some(agents),
+        navigator_mass: team.navigator().mass,
+        navigator_inertia: [row(0), row(1), row(2)],
+        ..TeamSpec::default()
+    };
+    let limits = LimitsConfig {
+        sigma_x: limits.sigma_x(),
+        sigma_y: limits.sigma_y(),
+        max_thrust: Some(limits.max_thrust()),
+    };
+    Ok((spec, limits))
+}
 
 /// Agent specs from the array arguments.
 fn agent_specs(

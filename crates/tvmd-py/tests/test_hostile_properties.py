@@ -119,6 +119,10 @@ def _instances():
     made.append(tvmd.AttainableForceSpace(4, 2, 0.5, 0.5, 10.0))
     made.append(tvmd.Gains.paper())
     made.append(sim.run(toml=SHORT, max_samples=5))
+    # The stepped simulator: its methods take hostile actions, seeds and poses too.
+    made.append(sim.Simulation(toml=SHORT))
+    made.append(sim.SimulationBatch(toml=SHORT, count=2))
+    made.append(sim.ScenarioController(toml=SHORT))
     return made
 
 

@@ -8,12 +8,15 @@
 //!   input order);
 //! - [`diagnostics`]: what a controller reports per period (the diagnostics schema);
 //! - [`flight`]: the controller interface [`FlightController`];
-//! - [`sink`]: the loop's listener [`TickSink`] and what it hands over per tick;
-//! - [`sim`]: the loop ([`Simulation`]), its samples, the summary ([`RunSummary`],
-//!   [`PaperMetrics`]) and the verdict ([`Verdict`]);
-//! - [`tick_log`]: a run's MCAP log as a [`TickSink`] ([`McapSink`]);
 //! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller, in
-//!   f64 or f32, in process or on a processor in the loop;
+//!   f64 or f32, in process or on a processor in the loop, and its allocation stage as the
+//!   wrench action of a stepped simulation ([`WrenchAllocation`]);
+//! - [`sink`]: the loop's listener [`TickSink`] and what it hands over per tick;
+//! - [`sim`]: the loop ([`Simulation`]: run to its end with a controller, or stepped one
+//!   controller period at a time with commands or a body wrench, [`Observation`],
+//!   [`Stepped`]), its samples, the summary ([`RunSummary`], [`PaperMetrics`]) and the verdict
+//!   ([`Verdict`]);
+//! - [`tick_log`]: a run's MCAP log as a [`TickSink`] ([`McapSink`]);
 //! - [`runner`]: runs with the tvmd controller: one ([`run_scenario`]) or a batch on one
 //!   worker pool ([`run_many`], [`relaxation_sweep`]);
 //! - [`request`]: one run as the command line and Python ask for it ([`RunRequest`]: the
@@ -38,15 +41,15 @@ pub mod tick_log;
 
 pub use control::pil::{self, PilError, PilTarget};
 pub use control::recording::{self, CycleRecording};
-pub use control::{AnyTvmdController, TvmdController, MAX_AGENTS};
+pub use control::{AnyTvmdController, TvmdController, WrenchAllocation, MAX_AGENTS};
 pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};
 pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{
-    FlightDifference, PaperMetrics, RunResult, RunSummary, Sample, SampleRetention, SimOptions,
-    Simulation, Verdict,
+    FlightDifference, Observation, PaperMetrics, RunResult, RunSummary, Sample, SampleRetention,
+    SimOptions, Simulation, Stepped, Verdict,
 };
 pub use sink::{LoggedTick, SceneRecord, Tick, TickSink};
 pub use tick_log::McapSink;

@@ -21,6 +21,8 @@ UAV*). Equation numbers refer to the paper.
   by default with the offset-free law (``law="offset-free"``: natural gains, a disturbance
   observer, the planned attitude's rates), ``law="paper"`` for the paper's eq. (12).
 * :mod:`tvmd.sim` -- the simulator ``tvmd-sim`` (the paper's simulation, relaxation study).
+* :mod:`tvmd.gym` -- Gymnasium environments of the simulator (``import tvmd.gym``; needs
+  ``gymnasium``): ``"tvmd/Hover-v0"``, a body wrench or per-agent commands as the action.
 
 Arrays are float64 NumPy arrays, SI units, z up, twist ``xi = [Omega; v]`` in the body frame,
 wrenches ``[torque; force]``. Errors: ``ValueError`` (wrong shapes, NaN/inf; the subclasses

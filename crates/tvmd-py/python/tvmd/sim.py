@@ -6,6 +6,10 @@ Scenarios are TOML (every field defaults to the paper's simulation, ``"paper-til
 ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``).
 
 * :func:`builtin_scenarios`, :func:`scenario_toml` -- the built-in scenarios.
+* :class:`Simulation` -- the simulator stepped one controller period at a time with your own
+  controller: ``reset``, ``step`` (per-agent commands), ``step_wrench`` (a body wrench through
+  tvmd's allocation), each returning the next :class:`Observation`; :class:`ScenarioController`
+  is the tvmd controller as :func:`run` flies it, for the same steps.
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
 * :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads, or one task per
@@ -80,11 +84,67 @@ def monte_carlo(
 
 
 SimResult = _sim.SimResult
+Simulation = _sim.Simulation
+SimulationBatch = _sim.SimulationBatch
+Observation = _sim.Observation
+ScenarioController = _sim.ScenarioController
+ControllerOutput = _sim.ControllerOutput
 builtin_scenarios = _sim.builtin_scenarios
 run = _sim.run
 scenario_toml = _sim.scenario_toml
 # `SimResult.__reduce__` names it here: an executor's worker sends its result back pickled.
 _sim_result_from_state = _sim._sim_result_from_state
+
+
+# The flat columns of ``SimResult.to_columns``: the suffixes of the fields whose last axis is not
+# x, y, z, and the fields with one entry (or one row) per agent.
+_XYZ = ("x", "y", "z")
+_RPY = ("roll", "pitch", "yaw")
+_ACTUATOR = ("eta_x", "eta_y", "thrust")
+_SUFFIXES = {"attitude_rpy": _RPY, "reference_rpy": _RPY, "planned_rpy": _RPY, "commands": _ACTUATOR, "actual": _ACTUATOR}
+_PER_AGENT = {"failed", "rotor_speeds", "commands", "actual", "forces"}
+# ``velocity`` is ``velocity_world`` under its old name: one column.
+_ALIASES = {"velocity"}
+
+
+def _columns(result):
+    # ``SimResult.to_columns``: every (K, ...) array field as (K,) columns, in field order.
+    import numpy as np
+
+    columns = {}
+    k = len(result)
+    for name in result.FIELDS:
+        if name in _ALIASES:
+            continue
+        value = getattr(result, name)
+        if not isinstance(value, np.ndarray) or value.ndim == 0 or value.shape[0] != k:
+            continue
+        if value.ndim == 1:
+            columns[name] = value
+        elif name in _PER_AGENT:
+            for i in range(value.shape[1]):
+                if value.ndim == 2:
+                    columns[f"{name}_{i}"] = value[:, i]
+                else:
+                    for j, suffix in enumerate(_SUFFIXES.get(name, _XYZ)):
+                        columns[f"{name}_{i}_{suffix}"] = value[:, i, j]
+        elif value.ndim == 2:
+            for j, suffix in enumerate(_SUFFIXES.get(name, _XYZ)):
+                columns[f"{name}_{suffix}"] = value[:, j]
+        else:
+            for r in range(value.shape[1]):
+                for c in range(value.shape[2]):
+                    columns[f"{name}_{r}{c}"] = value[:, r, c]
+    return columns
+
+
+def _to_pandas(result):
+    # ``SimResult.to_pandas``: pandas is imported only here (an optional dependency).
+    try:
+        import pandas
+    except ImportError as e:
+        raise ImportError("SimResult.to_pandas needs pandas (pip install pandas); to_columns() does not") from e
+    return pandas.DataFrame(_columns(result))
 
 
 def _run_one(item, index):
@@ -113,13 +173,25 @@ def _on_executor(items, jobs, executor, fly):
     return list(executor.map(fly, items, range(len(items))))
 
 
-def run_many(runs, *, jobs=None, executor=None):
+def _run_one_keeping(item, index):
+    # ``_run_one`` for ``errors="keep"``: the exception comes back in the result's place.
+    try:
+        return _sim._run_item(item, index)
+    except Exception as e:  # noqa: BLE001 - every failure of one run is kept, by its index
+        return e
+
+
+def run_many(runs, *, jobs=None, executor=None, errors="raise"):
     """Many runs, results in input order; see the stub (``sim.pyi``)."""
+    if errors not in ("raise", "keep"):
+        raise ValueError(f'`errors` must be "raise" or "keep", got {errors!r}')
     if executor is None:
-        return _sim.run_many(runs, jobs=jobs)
+        return _sim.run_many(runs, jobs=jobs, errors=errors)
     items = runs if isinstance(runs, (str, dict)) else list(runs)
-    _sim._check_runs(items)
-    return _on_executor(items, jobs, executor, _run_one)
+    if errors == "raise":
+        _sim._check_runs(items)
+        return _on_executor(items, jobs, executor, _run_one)
+    return _on_executor(items, jobs, executor, _run_one_keeping)
 
 
 def relaxation_sweep(
@@ -150,7 +222,12 @@ def relaxation_sweep(
     return _on_executor(items, jobs, executor, _run_swept)
 
 __all__ = [
+    "ControllerOutput",
+    "Observation",
+    "ScenarioController",
     "SimResult",
+    "Simulation",
+    "SimulationBatch",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

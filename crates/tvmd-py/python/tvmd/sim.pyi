@@ -21,12 +21,12 @@ Log paths are checked before anything runs: two runs of a batch on one file rais
 """
 
 import os
-from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, TypedDict, Union, final
+from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Tuple, TypedDict, Union, final, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._tvmd import AllocatorName
+from ._tvmd import AllocatorName, Reference, State, Team
 
 _F64 = NDArray[np.float64]
 _ScenarioArg = Union[str, "os.PathLike[str]"]
@@ -60,7 +60,9 @@ class SimResult:
         mass (``m_C``, kg), gravity (``g``, m/s^2), hover_roll_limit (``atan(c_y(1, s))``, rad: the
         planned roll at which the planner saturates in hover).
         t: (K,) time (s).
-        position, velocity, reference_position: (K, 3) ``x`` (m), ``x_dot`` (m/s), ``x_r`` (m).
+        position, velocity_world, reference_position: (K, 3) ``x`` (m), ``x_dot`` (m/s, world
+            frame; ``velocity`` is its old name), ``x_r`` (m). velocity_body: (K, 3) ``R^T x_dot``.
+        angular_velocity: (K, 3) body rates ``Omega``. rotation: (K, 3, 3) ``R``.
         attitude_rpy, reference_rpy, planned_rpy: (K, 3) roll, pitch, yaw (ZYX) of ``R``, ``R_r``
             and the planned ``R_d``.
         reference_roll: (K,) ``phi_r``. planned_roll: (K,) ``phi_d = atan2(R_d[2,1], R_d[2,2])``.
@@ -72,6 +74,8 @@ class SimResult:
         V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
         commands, actual: (K, n, 3) commanded and actual actuator values, columns
             ``eta_x, eta_y`` (rad), ``thrust`` (N). failed: (K, n) bool, true failure flags.
+        forces: (K, n, 3) body-frame forces of the actual outputs (N). rotor_speeds: (K, n)
+            normalized commanded rotor speeds.
         summary: dict, every field of tvmd-sim's ``RunSummary`` (``max_planned_roll``, ``max_e_f``,
             ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...),
             with ``metrics`` (settling time, steady-state, peak and integral errors, force and
@@ -136,7 +140,20 @@ class SimResult:
         """(K, 3) ``x`` (m)."""
     @property
     def velocity(self) -> _F64:
-        """(K, 3) ``x_dot`` (m/s)."""
+        """(K, 3) ``x_dot`` (m/s), world frame: ``velocity_world`` under its old name (kept for
+        compatibility; not a column of ``to_columns``)."""
+    @property
+    def velocity_world(self) -> _F64:
+        """(K, 3) ``x_dot`` (m/s), world frame."""
+    @property
+    def velocity_body(self) -> _F64:
+        """(K, 3) ``v = R^T x_dot`` (m/s), body frame (the frame of ``tvmd.State.velocity``)."""
+    @property
+    def angular_velocity(self) -> _F64:
+        """(K, 3) body rates ``Omega`` (rad/s), body frame."""
+    @property
+    def rotation(self) -> _F64:
+        """(K, 3, 3) attitude ``R`` (body to world)."""
     @property
     def reference_position(self) -> _F64:
         """(K, 3) ``x_r`` (m)."""
@@ -194,6 +211,14 @@ class SimResult:
     def actual(self) -> _F64:
         """(K, n, 3) actual actuator outputs, same columns."""
     @property
+    def forces(self) -> _F64:
+        """(K, n, 3) the agents' body-frame forces (N) of the actual outputs, with the plant's
+        actuation error (gimbal offsets, rotor efficiency): what the plant applied."""
+    @property
+    def rotor_speeds(self) -> _F64:
+        """(K, n) commanded rotor speeds, normalized (1 at the largest thrust ``sigma_Tf``):
+        ``sqrt(thrust / sigma_Tf)``."""
+    @property
     def failed(self) -> NDArray[np.bool_]:
         """(K, n) true failure flags."""
     @property
@@ -206,9 +231,318 @@ class SimResult:
     def scenario_toml(self) -> str:
         """The scenario that ran, as TOML."""
     def to_dict(self) -> dict[str, Any]:
-        """Every field as a dict."""
+        """Every field as a dict (arrays as they are: (K, ...))."""
+    def to_columns(self) -> dict[str, _F64]:
+        """Every time series as flat (K,) columns, in field order, for ``pandas.DataFrame``:
+        vectors as ``<name>_x/_y/_z`` (``attitude_rpy_roll/_pitch/_yaw``, ...), matrices as
+        ``rotation_<row><col>``, per-agent values as ``<name>_<i>`` and
+        ``commands_<i>_eta_x/_eta_y/_thrust``, ``forces_<i>_x/_y/_z``; ``velocity`` appears once,
+        as ``velocity_world``."""
+    def to_pandas(self) -> Any:
+        """``pandas.DataFrame(to_columns())``: one row per sample.
+
+        Raises:
+            ImportError: pandas is not installed.
+        """
     def __len__(self) -> int:
         """The number of samples ``K``."""
+
+@final
+class Observation:
+    """One controller tick as a controller sees it (read-only): what ``Simulation.reset``,
+    ``observe``, ``step`` and ``step_wrench`` return.
+
+    Attributes:
+        t: simulation time ``t_k`` (s).
+        state: the fed-back state (the scenario's state noise and feedback latency applied), a
+            ``tvmd.State``: position ``x``, attitude ``R``, body rates ``Omega`` and the
+            body-frame velocity ``v`` (``x_dot = R v``); what ``tvmd.Controller.step`` takes.
+        true_state: the true state, a ``tvmd.State``.
+        velocity_world: (3,) the fed-back world-frame velocity ``x_dot`` (m/s).
+        reference: the scenario's reference at ``t_k``, a ``tvmd.Reference``.
+        failed: (n,) bool, the failures the controller is told of.
+        done: the scenario's duration is reached (the last state; no step follows).
+    """
+
+    FIELDS: ClassVar[Tuple[str, ...]]
+    @property
+    def t(self) -> float:
+        """Simulation time ``t_k`` (s)."""
+    @property
+    def state(self) -> State:
+        """The fed-back state (noise and latency applied)."""
+    @property
+    def true_state(self) -> State:
+        """The true state."""
+    @property
+    def velocity_world(self) -> _F64:
+        """(3,) world-frame velocity ``x_dot`` of the fed-back state (m/s)."""
+    @property
+    def reference(self) -> Reference:
+        """The reference at ``t_k``."""
+    @property
+    def failed(self) -> NDArray[np.bool_]:
+        """(n,) the failures the controller is told of."""
+    @property
+    def done(self) -> bool:
+        """The scenario's duration is reached (no step follows)."""
+    def to_dict(self) -> dict[str, Any]:
+        """Every field as a dict (the states and the reference as dicts)."""
+
+@final
+class ControllerOutput:
+    """What ``ScenarioController.step`` returns for one tick: the commands and the diagnostics;
+    ``Simulation.step`` takes it as it is (the diagnostics then reach ``Simulation.result()``).
+    """
+
+    @property
+    def commands(self) -> _F64:
+        """(n, 3) commands ``eta_x``, ``eta_y`` (rad), ``thrust`` (N)."""
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """The controller's diagnostics of the tick (planner, law, allocation, Lyapunov values)."""
+
+@final
+class Simulation:
+    """The simulator stepped one controller period at a time, with your own controller.
+
+    The plant is ``run``'s (rapier3d rigid body at ``physics.dt``; the scenario's actuators,
+    failures, payloads, wind, gusts, external wrench, state noise and feedback latency apply), and
+    so is the loop: ``run`` is one client of these steps, so ``ScenarioController`` flown through
+    ``step`` reproduces ``run``'s flight exactly. Each step holds its commands for
+    ``controller_period`` (zero-order hold) and returns the next tick's ``Observation``.
+
+    Two action modes:
+
+    * ``step(commands)``: per-agent gimbal angles and thrusts (or normalized rotor speeds);
+    * ``step_wrench(wrench)``: a body wrench ``[u_tau; u_f]`` (N m, N; body frame, about the
+      centre of mass) that the scenario controller's planner-free allocation stage
+      (``tvmd_core::Controller::allocate``: its allocator, limits, rate limits; in f64) turns into
+      admissible commands, the failed agents the controller is told of idle.
+
+    Example::
+
+        sim = tvmd.sim.Simulation("hover")
+        obs = sim.reset()
+        while not obs.done:
+            s, r = obs.state, obs.reference
+            f = sim.mass * (9.81 * e3 - kp * (s.position - r.position) - kd * (obs.velocity_world - r.velocity))
+            obs = sim.step_wrench(np.r_[tau, s.attitude.T @ f])
+
+    Args:
+        scenario: a built-in name or a TOML scenario file, as ``run``'s; default ``"hover"``
+            (A4-Inc holding a hover at 1.5 m for 12 s; with ``team`` another team).
+        toml: inline TOML scenario text instead of ``scenario``.
+        team: a catalogue team (``"a6-inc"``, ...) or a ``tvmd.Team`` instead of the scenario's
+            (as ``run``'s ``team``).
+        relaxation, allocator, precision, null_space, law: ``run``'s overrides (the allocator and
+            the null-space stage are ``step_wrench``'s; ``precision`` and ``law`` concern
+            ``ScenarioController`` built with the same arguments).
+        max_samples: the samples ``result()`` keeps, as ``run``'s.
+
+    Raises:
+        ValueError: a scenario or override that cannot be used; a step with commands of the
+            wrong shape or with NaN or infinite values, a negative rotor speed, a wrench that is
+            not (6,) finite values, or a step after the duration (``done``: ``reset`` first).
+        RuntimeError: the state diverged.
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        toml: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+        max_samples: Optional[int] = None,
+    ) -> "Simulation": ...
+    def reset(
+        self,
+        seed: Optional[int] = None,
+        *,
+        position: Optional[ArrayLike] = None,
+        attitude_rpy: Optional[ArrayLike] = None,
+    ) -> Observation:
+        """Starts over (initial state, actuators at rest, no failure applied, time 0, nothing
+        recorded) and returns the first observation.
+
+        Args:
+            seed: 0 to 2**64 - 1, reseeds the state noise; without it the scenario's
+                ``disturbances.state_noise.seed`` is used, so every reset replays the same
+                noise. No effect without state noise.
+            position: (3,) another initial position of the centre of mass (m).
+            attitude_rpy: (3,) another initial attitude, roll, pitch, yaw (rad, ZYX).
+                ``position`` and ``attitude_rpy`` replace the scenario's initial pose (later
+                resets start there too); the team starts at rest.
+
+        Raises:
+            ValueError: a seed out of range, a pose that is not 3 finite values or that the
+                scenario's validation refuses (the simulation is then unchanged).
+        """
+    def observe(self) -> Observation:
+        """The current tick's observation (the noise is drawn once per tick: calling it again
+        returns the same values)."""
+    def step(self, commands: Union[ArrayLike, ControllerOutput], *, rotor_speeds: bool = False) -> Observation:
+        """Holds per-agent commands for one controller period; returns the next observation.
+
+        Args:
+            commands: (n, 3) rows ``eta_x, eta_y`` (rad), ``thrust`` (N); or (n, 4), the layout of
+                ``tvmd.Controller``'s commands (``eta_x, eta_y, thrust, omega``); or a
+                ``ControllerOutput`` (its diagnostics are recorded too). Failed agents' commands
+                are overridden as their failure dictates.
+            rotor_speeds: the last column is the normalized rotor speed ``omega`` (1 at
+                ``max_thrust``; thrust ``max_thrust * omega**2``) instead of the thrust.
+        """
+    def step_wrench(self, wrench: ArrayLike) -> Observation:
+        """Holds the admissible commands of the (6,) body wrench ``[u_tau; u_f]`` (N m, N; body
+        frame) for one controller period; returns the next observation. A wrench the
+        allocation cannot serve (zero thrust for a non-zero force) holds the previous commands."""
+    def result(self) -> SimResult:
+        """The flight so far as a ``SimResult`` (the samples copied; the simulation goes on)."""
+    @property
+    def state(self) -> State:
+        """The true state now."""
+    @property
+    def time(self) -> float:
+        """Simulation time (s)."""
+    @property
+    def done(self) -> bool:
+        """The scenario's duration is reached: ``reset`` before the next step."""
+    @property
+    def n_agents(self) -> int:
+        """Number of agents ``n``."""
+    @property
+    def mass(self) -> float:
+        """Team mass ``m_C`` (kg)."""
+    @property
+    def max_thrust(self) -> float:
+        """Largest thrust of one agent ``sigma_Tf`` (N)."""
+    @property
+    def agent_positions(self) -> _F64:
+        """(n, 3) the agents' positions ``p_i`` relative to the centre of mass (m, body frame)."""
+    @property
+    def gimbal_limits(self) -> Tuple[float, float]:
+        """``(sigma_x, sigma_y)``: the gimbal limits ``|eta_x| <= sigma_x``, ``|eta_y| <= sigma_y``
+        (rad)."""
+    @property
+    def controller_period(self) -> float:
+        """The time one step holds its commands (s)."""
+    @property
+    def duration(self) -> float:
+        """The scenario's duration (s)."""
+    @property
+    def scenario_toml(self) -> str:
+        """The scenario (overrides applied) as TOML."""
+
+@final
+class ScenarioController:
+    """The tvmd controller of a scenario exactly as ``run`` flies it (its precision, law,
+    allocator, failure handling, landing), to fly through ``Simulation.step``: with the same
+    arguments, ``sim.step(ctrl.step(obs))`` from ``sim.reset()`` to ``done`` reproduces
+    ``run``'s flight.
+
+    Args: as ``Simulation``'s (default scenario ``"hover"``).
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        toml: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+    ) -> "ScenarioController": ...
+    def step(self, observation: Observation) -> ControllerOutput:
+        """The commands and diagnostics for one tick's observation (advances the controller's
+        state: call it once per tick).
+
+        Raises:
+            RuntimeError: the controller failed.
+        """
+
+@final
+class SimulationBatch:
+    """Many teams of one scenario stepped together inside Rust: one call steps every team one
+    controller period on a worker pool (``jobs`` threads, the GIL released), each team with its
+    own action, and returns every team's observation as ``(B, ...)`` arrays. Each team is a
+    ``Simulation`` of its own (its noise, failures and errors); a team whose step fails (a
+    divergence) reports it in ``errors`` and NaN in the arrays, the others go on. The batch keeps
+    no samples.
+
+    Every call returns a dict of the teams' observations (the fed-back state):
+    ``t`` (B,), ``position``, ``velocity_world``, ``angular_velocity`` (B, 3), ``rotation``
+    (B, 3, 3), ``true_position`` (B, 3), ``reference_position``, ``reference_velocity`` (B, 3),
+    ``reference_rotation`` (B, 3, 3),
+    ``done`` (B,) bool (the duration is reached: reset that team) and ``errors`` (a list of
+    B messages or None).
+
+    Args:
+        scenario, toml, team, relaxation, allocator, precision, null_space, law: as
+            ``Simulation``'s (default scenario ``"hover"``).
+        count: the number of teams ``B`` (1 to 2**20).
+        jobs: worker threads (default: the available cores).
+    """
+
+    def __new__(
+        cls,
+        scenario: Optional[_ScenarioArg] = None,
+        *,
+        count: int,
+        jobs: Optional[int] = None,
+        toml: Optional[str] = None,
+        team: Optional[Union[str, Team]] = None,
+        relaxation: Optional[float] = None,
+        allocator: Optional[AllocatorName] = None,
+        precision: Optional[_Precision] = None,
+        null_space: Optional[str] = None,
+        law: Optional[_LawArg] = None,
+    ) -> "SimulationBatch": ...
+    def reset(
+        self,
+        indices: Optional[list[int]] = None,
+        *,
+        seeds: Optional[list[int]] = None,
+        positions: Optional[ArrayLike] = None,
+        attitudes_rpy: Optional[ArrayLike] = None,
+    ) -> dict[str, Any]:
+        """Resets the teams ``indices`` (default all) as ``Simulation.reset`` does, with one seed
+        and optional (m, 3) initial positions and attitudes per reset team; every team's
+        observation."""
+    def step_wrench(self, wrenches: ArrayLike, *, active: Optional[list[bool]] = None) -> dict[str, Any]:
+        """Holds each team's (B, 6) body wrench ``[u_tau; u_f]`` (N m, N) for one controller
+        period (only the ``active`` teams step, all by default); every team's observation.
+
+        Raises:
+            ValueError: not (B, 6) finite values, ``active`` not B flags.
+        """
+    def step(
+        self, commands: ArrayLike, *, active: Optional[list[bool]] = None, rotor_speeds: bool = False
+    ) -> dict[str, Any]:
+        """Holds each team's (B, n, 3) or (B, n, 4) per-agent commands (as ``Simulation.step``)
+        for one controller period; every team's observation."""
+    @property
+    def n_teams(self) -> int:
+        """The number of teams ``B``."""
+    @property
+    def n_agents(self) -> int:
+        """Number of agents ``n`` per team."""
+    @property
+    def mass(self) -> float:
+        """Team mass ``m_C`` (kg)."""
+    @property
+    def max_thrust(self) -> float:
+        """Largest thrust of one agent ``sigma_Tf`` (N)."""
+    @property
+    def controller_period(self) -> float:
+        """The time one step holds its commands (s)."""
 
 def builtin_scenarios() -> list[str]:
     """The names of the built-in scenarios (``"paper-tilt"`` is the paper's simulation, see
@@ -234,7 +568,7 @@ def run(
     pil: Optional[_PilTarget] = None,
     null_space: Optional[str] = None,
     max_samples: Optional[int] = None,
-    team: Optional[str] = None,
+    team: Optional[Union[str, Team]] = None,
     law: Optional[_LawArg] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
@@ -280,7 +614,12 @@ def run(
             ``"a3-con"`` ... ``"a10-inc"``, ``"a4-diamond-inc"``, ``"t10-con"``, ``"t10-inc"``);
             the scenario families (``"hover"``, ``"wind"``, ``"payload"``, ``"model-error"``,
             ``"reference-jump"``, ``"sine"``, ``"figure-eight"``, ``"initial-attitude-<rad>"``)
-            are built for any of them (docs/method.md "Scenario families").
+            are built for any of them (docs/method.md "Scenario families"). Or a ``tvmd.Team``
+            (a preset or one built in Python): its agents (positions, quarter turns, masses),
+            navigator, gimbal limits and largest thrust replace the scenario's ``[team]`` and
+            ``[limits]``; a team with agent inertias or a ``min_thrust`` raises ``ValueError``
+            (the simulator's agents are point masses that idle at zero thrust). In ``run_many``
+            dicts, a name only.
         law: override the scenario's control law (scenario field ``law``): ``"paper"`` (the
             paper's eq. 12), ``"offset-free"`` (natural gains, disturbance observer, planned
             rates), or a dict with the keys of the TOML ``[law]`` table (as
@@ -307,8 +646,23 @@ def run(
             found (the message says how to install or build it).
     """
 
+@overload
 def run_many(
-    runs: Iterable[_RunItem], *, jobs: Optional[int] = None, executor: Optional[Any] = None
+    runs: Iterable[_RunItem],
+    *,
+    jobs: Optional[int] = None,
+    executor: Optional[Any] = None,
+    errors: Literal["keep"],
+) -> list[Union[SimResult, Exception]]:
+    """``run_many`` with ``errors="keep"``: each failed run's exception in its place (see the
+    other overload for every argument)."""
+@overload
+def run_many(
+    runs: Iterable[_RunItem],
+    *,
+    jobs: Optional[int] = None,
+    executor: Optional[Any] = None,
+    errors: Literal["raise"] = "raise",
 ) -> list[SimResult]:
     """Runs many scenarios in parallel threads (GIL released) and returns their results in input
     order.
@@ -326,8 +680,16 @@ def run_many(
             run, each ``SimResult`` pickled back; logs are written where the task runs. The
             batch is checked here first (items, no two runs on one log); not with ``jobs``.
 
-    Every item is loaded and validated before any run starts. If runs fail, the first failure
-    in input order is raised, its message prefixed with ``runs[k]``.
+        errors: ``"raise"`` (default): if runs fail, the first failure in input order is
+            raised. ``"keep"``: every successful run's ``SimResult`` is returned, and each failed
+            run's exception (the one ``"raise"`` would raise: ``ValueError`` for a bad item or
+            log, ``RuntimeError`` for a failure while flying, ...) stands in its place, so
+            ``[r for r in out if isinstance(r, Exception)]`` lists the failures by index. What
+            concerns the whole batch still raises (``runs`` not a sequence, two runs on one log,
+            ``jobs``, an interrupt).
+
+    Every item is loaded and validated before any run starts. A failure's message is prefixed
+    with ``runs[k]``.
 
     Raises:
         ValueError, TypeError, OSError, KeyboardInterrupt, RuntimeError: as ``run``;
@@ -477,7 +839,12 @@ def monte_carlo_report(rows: list[str], *, out: Optional[_PathArg] = None) -> di
 
 
 __all__ = [
+    "ControllerOutput",
+    "Observation",
+    "ScenarioController",
     "SimResult",
+    "Simulation",
+    "SimulationBatch",
     "builtin_scenarios",
     "monte_carlo",
     "monte_carlo_flight",

@@ -43,9 +43,11 @@ pub mod engine;
 mod landing;
 pub mod pil;
 pub mod recording;
+pub mod wrench;
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
 pub use landing::{Landing, Touchdown, LANDED_HEIGHT};
+pub use wrench::WrenchAllocation;
 
 pub use config::{
     allocator, controller_settings, hover_roll_limit, law_settings, team_config, wire_config,

@@ -5,6 +5,18 @@ use tvmd_plant::actuators::{agent_force_body, ActuatorCommand};
 use tvmd_plant::physics::TeamBody;
 use tvmd_scenario::PlantError;
 
+/// The agents' body-frame forces (N) for their actuator outputs `outputs`, with the plant's
+/// actuation error (gimbal offsets, rotor efficiency): the forces the plant applies.
+pub fn agent_forces(
+    outputs: &[ActuatorCommand],
+    team: &TeamBody,
+    plant: &PlantError,
+) -> Vec<[f64; 3]> {
+    let mut out = Vec::with_capacity(outputs.len());
+    body_forces(outputs, team, plant, &mut out);
+    out.iter().map(|f| [f.x, f.y, f.z]).collect()
+}
+
 /// The agents' body-frame forces for their actuator outputs, written over `out`.
 pub(super) fn body_forces<'a>(
     outputs: impl IntoIterator<Item = &'a ActuatorCommand>,

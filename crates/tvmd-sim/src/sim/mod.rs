@@ -19,34 +19,44 @@
 //! over every tick's sample ([`summary`]); the run keeps all, a bounded subset or none of the
 //! samples ([`retention`]), so memory can stay flat however long the run. Two flights of one
 //! scenario are compared sample by sample with [`difference`].
+//!
+//! The loop is one client of the steppable entry ([`step`]): at each tick it takes the tick's
+//! [`Observation`], asks the controller and hands its output to [`Simulation::step_output`], which
+//! a caller with its own controller calls too ([`Simulation::step`] with commands,
+//! [`Simulation::step_wrench`] with a body wrench).
 
+pub mod batch;
 pub mod difference;
 mod forces;
 pub mod latency;
 pub mod retention;
 pub mod sample;
+pub mod step;
 pub mod summary;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use nalgebra::{Rotation3, Vector3};
-use rand::{Rng, SeedableRng};
+use nalgebra::Vector3;
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use serde::Serialize;
 
-use crate::flight::{FlightController, FlightInput};
+use crate::control::WrenchAllocation;
+use crate::flight::{FlightController, FlightOutput};
 use crate::sink::{LoggedTick, SceneRecord, Tick, TickSink};
 use crate::SimError;
 use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand};
-use tvmd_plant::physics::{ExtraWrench, MassError, PhysicsWorld, PlantState, TeamBody};
+use tvmd_plant::physics::{MassError, PhysicsWorld, PlantState, TeamBody};
 use tvmd_plant::PhysicsError;
 use tvmd_scenario::{Failure, Payload, Scenario, StateNoise};
 
+pub use batch::{BatchAction, SimulationBatch, TeamStep};
 pub use difference::FlightDifference;
+pub use forces::agent_forces;
 use forces::body_forces;
 pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
+pub use step::{Observation, Stepped};
 pub use summary::{
     EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics, NullSpaceSummary,
     PaperMetrics, RunSummary, RunTotals, SummaryFold, Verdict, VxRise,
@@ -118,9 +128,11 @@ impl Default for SimOptions {
     }
 }
 
-/// A simulation of one scenario.
+/// A simulation of one scenario: run to its end with a controller ([`Simulation::run`]) or
+/// stepped one controller period at a time ([`Simulation::step`], module [`step`]).
 pub struct Simulation {
     scenario: Scenario,
+    options: SimOptions,
     team: TeamBody,
     world: PhysicsWorld,
     actuators: ActuatorBank,
@@ -141,6 +153,16 @@ pub struct Simulation {
     controller_calls: usize,
     wall_time: f64,
     interrupted: bool,
+    /// The commands held until the next tick (zero-order hold).
+    held: Vec<ActuatorCommand>,
+    /// The agents' body-frame forces, reused every physics step.
+    forces: Vec<Vector3<f64>>,
+    /// The forces must be recomputed (new commands, a failure, or actuators with memory).
+    forces_stale: bool,
+    /// The current tick's observation, once taken and until its commands come.
+    observed: Option<Observation>,
+    /// The allocation stage of [`Simulation::step_wrench`], built on its first call.
+    allocation: Option<WrenchAllocation>,
 }
 
 impl Simulation {
@@ -176,6 +198,12 @@ impl Simulation {
             .samples
             .check(total_steps.div_ceil(steps_per_control))?;
         Ok(Self {
+            options,
+            held: vec![ActuatorCommand::default(); n],
+            forces: Vec::with_capacity(n),
+            forces_stale: true,
+            observed: None,
+            allocation: None,
             actuators: ActuatorBank::new(scenario.actuators, n),
             applied: vec![false; failures.len()],
             failures,
@@ -228,6 +256,17 @@ impl Simulation {
         self.samples.take()
     }
 
+    /// What has been simulated so far, copied (the simulation goes on): the kept samples, the
+    /// summary and the paper's metrics.
+    pub fn result(&self) -> RunResult {
+        RunResult {
+            summary: self.summary(),
+            paper: self.paper_metrics(),
+            sample_stride: self.samples.stride(),
+            samples: self.samples().to_vec(),
+        }
+    }
+
     /// What has been simulated so far: the kept samples (moved out), the summary and the
     /// paper's metrics.
     pub fn take_result(&mut self) -> RunResult {
@@ -237,46 +276,6 @@ impl Simulation {
             sample_stride: self.samples.stride(),
             samples: self.take_samples(),
         }
-    }
-
-    fn noisy(&mut self, s: &PlantState) -> PlantState {
-        let Some((n, rng)) = self.noise.as_mut() else {
-            return *s;
-        };
-        let mut g = |std: f64| -> Vector3<f64> {
-            Vector3::new(
-                rng.sample::<f64, _>(StandardNormal),
-                rng.sample::<f64, _>(StandardNormal),
-                rng.sample::<f64, _>(StandardNormal),
-            ) * std
-        };
-        let dp = g(n.position);
-        let dv = g(n.velocity);
-        let da = g(n.attitude);
-        let dw = g(n.angular_velocity);
-        PlantState {
-            position: s.position + dp,
-            rotation: s.rotation * Rotation3::new(da).into_inner(),
-            velocity: s.velocity + dv,
-            omega: s.omega + dw,
-        }
-    }
-
-    fn extra_wrench(&self, t: f64) -> ExtraWrench {
-        let d = &self.scenario.disturbances;
-        let mut w = ExtraWrench {
-            force_world: Vector3::from(d.wind),
-            ..Default::default()
-        };
-        if let Some(air) = &d.air {
-            let v = self.world.state().velocity;
-            w.force_world += Vector3::from(air.force(t, v.into(), self.team.len()));
-        }
-        if let Some(e) = d.external_wrench.as_ref().filter(|e| e.active(t)) {
-            w.force_world += Vector3::from(e.force);
-            w.torque_body += Vector3::from(e.torque);
-        }
-        w
     }
 
     /// Applies the failures whose time has come; true if any was applied now.
@@ -361,115 +360,93 @@ impl Simulation {
         mut sink: Option<&mut (dyn TickSink + '_)>,
         cancel: Option<&AtomicBool>,
     ) -> Result<(), SimError> {
-        let dt = self.scenario.physics.dt;
-        let period = self.scenario.controller_period;
-        let settings = self.scenario.log;
-        let scene_every = ((settings.scene_period / period).round() as usize).max(1);
-        let heavy_every = settings.decimation.max(1);
-        let mut held = vec![ActuatorCommand::default(); self.team.len()];
-        // Shared with the sink's jobs: one copy per run, not one per scene.
-        let team = sink
-            .as_deref()
-            .is_some_and(|s| s.wants_scenes())
-            .then(|| std::sync::Arc::new(self.team.clone()));
-        // Reused every physics step: the step allocates nothing of its own.
-        let mut forces = Vec::with_capacity(self.team.len());
-        // The agents' forces follow the actuator outputs, which actuators without servo or rotor
-        // lag change only at a controller tick or a failure: recomputed (two sines and two
-        // cosines per agent) only then.
-        let memoryless = self.scenario.actuators.is_memoryless();
-        let mut forces_stale = true;
-        while self.step_index < self.total_steps {
-            let k = self.step_index;
-            let t = k as f64 * dt;
-            if self.apply_failures(t) {
-                forces_stale = true;
+        let plan = SinkPlan::new(self, sink.as_deref());
+        while !self.is_finished() {
+            if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                self.interrupted = true;
+                break;
             }
-            self.attach_payloads(t)?;
-            if k % self.steps_per_control == 0 {
-                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                    self.interrupted = true;
-                    break;
-                }
-                let truth = self.world.state();
-                check_divergence(t, &truth)?;
-                let fed = self.noisy(&truth);
-                let fed = self.delay.delay(fed);
-                let reference = self.scenario.reference.at(t);
-                let out = controller
-                    .step(&FlightInput::new(t, &fed, &reference, &self.failed_told))
-                    .map_err(|source| SimError::Controller { t, source })?;
-                if out.commands.len() != self.team.len() {
-                    return Err(SimError::Physics(PhysicsError::InvalidCommand {
-                        t,
-                        reason: format!(
-                            "{} commands for {} agents",
-                            out.commands.len(),
-                            self.team.len()
-                        ),
-                    }));
-                }
-                if let Some(i) = out.commands.iter().position(|c| !c.is_finite()) {
-                    return Err(SimError::Physics(PhysicsError::InvalidCommand {
-                        t,
-                        reason: format!("non-finite command for agent {i}"),
-                    }));
-                }
-                held.clone_from(&out.commands);
-                forces_stale = true;
-                let tick = self.controller_calls;
-                self.controller_calls += 1;
-                let actual = self.actuators.actual();
-                let sample = Sample::record(
-                    t,
-                    &truth,
-                    &reference,
-                    &out,
-                    actual.clone(),
-                    self.failed_true.clone(),
-                );
-                self.fold.push(&sample);
-                self.samples.push(tick, || sample);
-                if let Some(sink) = sink.as_deref_mut() {
-                    // The scene shows the commanded forces: at a tick the actual ones still lag
-                    // by one period.
-                    let scene = team
-                        .clone()
-                        .filter(|_| tick % scene_every == 0)
-                        .map(|team| SceneRecord {
-                            team,
-                            forces_body: self.forces(&out.commands),
-                            max_thrust: self.max_thrust,
-                        });
-                    sink.tick(LoggedTick {
-                        tick: Tick {
-                            t,
-                            state: truth,
-                            reference,
-                            forces_body: self.forces(&actual),
-                            output: out,
-                            actual,
-                            failed: self.failed_true.clone(),
-                        },
-                        heavy: tick % heavy_every == 0,
-                        scene,
+            let observation = self.take_observation()?;
+            let out =
+                controller
+                    .step(&observation.input())
+                    .map_err(|source| SimError::Controller {
+                        t: observation.t,
+                        source,
                     })?;
-                    sink.pace(t);
-                }
-            }
-            self.actuators.step(&held, dt);
-            if forces_stale || !memoryless {
-                body_forces(
-                    self.actuators.outputs(),
-                    &self.team,
-                    &self.scenario.plant,
-                    &mut forces,
-                );
-                forces_stale = false;
-            }
-            let extra = self.extra_wrench(t);
-            self.world.step(&forces, &extra)?;
-            self.step_index += 1;
+            let sink = sink.as_deref_mut().map(|s| (s, &plan));
+            self.apply_output(observation, out, sink)?;
+        }
+        Ok(())
+    }
+
+    /// Records the tick of `observation` with the controller's `out` (sample, summary, sink)
+    /// and flies the control period with its commands held.
+    fn apply_output(
+        &mut self,
+        observation: Observation,
+        out: FlightOutput,
+        sink: Option<(&mut (dyn TickSink + '_), &SinkPlan)>,
+    ) -> Result<(), SimError> {
+        self.check_commands(observation.t, &out.commands)?;
+        self.held.clone_from(&out.commands);
+        self.forces_stale = true;
+        self.record(observation, out, sink)?;
+        self.advance_period()
+    }
+
+    /// The sample of a tick, into the summary and the kept samples, and the tick to the sink.
+    fn record(
+        &mut self,
+        observation: Observation,
+        out: FlightOutput,
+        sink: Option<(&mut (dyn TickSink + '_), &SinkPlan)>,
+    ) -> Result<(), SimError> {
+        let Observation {
+            t,
+            truth,
+            reference,
+            ..
+        } = observation;
+        let tick = self.controller_calls;
+        self.controller_calls += 1;
+        let actual = self.actuators.actual();
+        let sample = Sample::record(
+            t,
+            &truth,
+            &reference,
+            &out,
+            actual.clone(),
+            self.failed_true.clone(),
+        );
+        self.fold.push(&sample);
+        self.samples.push(tick, || sample);
+        if let Some((sink, plan)) = sink {
+            // The scene shows the commanded forces: at a tick the actual ones still lag by one
+            // period.
+            let scene = plan
+                .team
+                .clone()
+                .filter(|_| tick % plan.scene_every == 0)
+                .map(|team| SceneRecord {
+                    team,
+                    forces_body: self.forces(&out.commands),
+                    max_thrust: self.max_thrust,
+                });
+            sink.tick(LoggedTick {
+                tick: Tick {
+                    t,
+                    state: truth,
+                    reference,
+                    forces_body: self.forces(&actual),
+                    output: out,
+                    actual,
+                    failed: self.failed_true.clone(),
+                },
+                heavy: tick % plan.heavy_every == 0,
+                scene,
+            })?;
+            sink.pace(t);
         }
         Ok(())
     }
@@ -491,5 +468,27 @@ impl Simulation {
             interrupted: self.interrupted,
         };
         self.fold.summary(&self.scenario, &totals)
+    }
+}
+
+/// What the loop's sink needs beyond a tick: which ticks draw a scene or write the heavy
+/// topics, and the team to draw (one copy per run, shared with the sink's jobs).
+struct SinkPlan {
+    scene_every: usize,
+    heavy_every: usize,
+    team: Option<std::sync::Arc<TeamBody>>,
+}
+
+impl SinkPlan {
+    fn new(sim: &Simulation, sink: Option<&(dyn TickSink + '_)>) -> Self {
+        let settings = sim.scenario.log;
+        let period = sim.scenario.controller_period;
+        Self {
+            scene_every: ((settings.scene_period / period).round() as usize).max(1),
+            heavy_every: settings.decimation.max(1),
+            team: sink
+                .is_some_and(|s| s.wants_scenes())
+                .then(|| std::sync::Arc::new(sim.team.clone())),
+        }
     }
 }

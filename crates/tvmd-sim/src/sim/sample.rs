@@ -1,6 +1,6 @@
 //! What the loop records at each controller tick: [`Sample`].
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
@@ -17,8 +17,14 @@ pub struct Sample {
     pub t: f64,
     /// `x` (m).
     pub position: [f64; 3],
-    /// `x_dot` (m/s).
+    /// `x_dot` (m/s), world frame.
     pub velocity: [f64; 3],
+    /// Body rates `Omega` (rad/s), body frame.
+    #[serde(default)]
+    pub omega: [f64; 3],
+    /// The attitude `R` (body to world), by rows.
+    #[serde(default)]
+    pub rotation: [[f64; 3]; 3],
     /// `x_r` (m).
     pub reference_position: [f64; 3],
     /// Roll, pitch, yaw of `R` (rad).
@@ -70,6 +76,11 @@ pub(crate) fn arr(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
+/// The rows of a matrix.
+fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|i| [m[(i, 0)], m[(i, 1)], m[(i, 2)]])
+}
+
 fn sub3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -109,6 +120,8 @@ impl Sample {
             t,
             position: arr(&s.position),
             velocity: arr(&s.velocity),
+            omega: arr(&s.omega),
+            rotation: rows(&s.rotation),
             reference_position: arr(&r.position),
             roll_pitch_yaw: roll_pitch_yaw(&s.rotation),
             reference_roll_pitch_yaw: roll_pitch_yaw(&r.rotation),
@@ -142,6 +155,13 @@ impl Sample {
             actual,
             failed,
         }
+    }
+
+    /// The body-frame velocity `v = R^T x_dot` (m/s).
+    pub fn velocity_body(&self) -> [f64; 3] {
+        let r = &self.rotation;
+        let v = &self.velocity;
+        [0, 1, 2].map(|j| r[0][j] * v[0] + r[1][j] * v[1] + r[2][j] * v[2])
     }
 
     /// `||x - x_r||` (m).

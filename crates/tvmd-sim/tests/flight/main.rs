@@ -15,3 +15,4 @@ mod recording;
 mod sample_retention;
 mod scenario_families;
 mod sim_loop;
+mod stepping;

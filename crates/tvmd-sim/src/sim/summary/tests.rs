@@ -7,6 +7,8 @@ pub(crate) fn sample(t: f64, x: f64, e_f: Option<f64>) -> Sample {
         t,
         position: [x, 0.0, 1.0],
         velocity: [0.0; 3],
+        omega: [0.0; 3],
+        rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         reference_position: [0.0, 0.0, 1.0],
         roll_pitch_yaw: [0.0; 3],
         reference_roll_pitch_yaw: [0.0; 3],

@@ -1,0 +1,383 @@
+//! The simulator stepped from Python: `tvmd.sim.Simulation` (tvmd-sim's steppable
+//! `Simulation`: `reset`, `step` with per-agent commands, `step_wrench` with a body wrench),
+//! the `Observation` of a tick, and `ScenarioController`, the tvmd controller as `run` flies it,
+//! as one client of the same steps. Thin: the arguments are converted by [`crate::convert`],
+//! the scenario built by [`RunArgs`], the flight is tvmd-sim's.
+
+use std::sync::Mutex;
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyString;
+
+use tvmd_sim::control::{core_reference, core_state};
+use tvmd_sim::runner::RunSpec;
+use tvmd_sim::sim::{Observation, SimOptions, Simulation, Verdict};
+use tvmd_sim::{AnyTvmdController, FlightController, FlightOutput};
+
+use crate::convert::{commands_arg, law_arg, matrix, record_to_py, retention_arg, shaped};
+use crate::convert::{finite, wrench_arg, Int};
+use crate::errors::value_error;
+use crate::law::{PyReference, PyState};
+use crate::record::record;
+use crate::runs::{team_arg, RunArgs};
+use crate::sim_result::{PySimResult, SimData};
+
+/// The scenario of a `Simulation` or `ScenarioController`: `run`'s arguments, the built-in
+/// `"hover"` when neither `scenario` nor `toml` is given.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn spec(
+    py: Python<'_>,
+    scenario: Option<&Bound<'_, PyAny>>,
+    toml: Option<String>,
+    team: Option<&Bound<'_, PyAny>>,
+    relaxation: Option<f64>,
+    allocator: Option<String>,
+    precision: Option<String>,
+    null_space: Option<String>,
+    law: Option<&Bound<'_, PyAny>>,
+    max_samples: Option<&Int>,
+) -> PyResult<RunSpec> {
+    let (team, team_config) = team_arg(team)?;
+    let hover = PyString::new(py, "hover").into_any();
+    let scenario = scenario
+        .filter(|s| !s.is_none())
+        .or(toml.is_none().then_some(&hover));
+    RunArgs {
+        scenario,
+        toml,
+        team,
+        team_config,
+        relaxation,
+        allocator,
+        precision,
+        null_space,
+        law: law.map(|l| law_arg(l, "law")).transpose()?,
+        samples: retention_arg(max_samples, "max_samples")?,
+        ..RunArgs::default()
+    }
+    .spec("scenario")
+}
+
+/// An observation and whether the run is over.
+pub(crate) struct ObservationData {
+    observation: Observation,
+    done: bool,
+}
+
+record! {
+    /// One controller tick as a controller sees it: `t` (s), `state` (the fed-back
+    /// `tvmd.State`, noise and latency applied), `true_state`, `velocity_world` (3,),
+    /// `reference` (a `tvmd.Reference`), `failed` (n,) and `done`.
+    "Observation" in "tvmd.sim" => PyObservation(ObservationData) |py, o| {
+        /// Simulation time `t_k` (s).
+        t => o.observation.t,
+        /// The fed-back state (noise and latency applied) as a `tvmd.State`.
+        state => PyState { inner: core_state::<f64>(&o.observation.state) },
+        /// The true state as a `tvmd.State`.
+        true_state => PyState { inner: core_state::<f64>(&o.observation.truth) },
+        /// (3,) world-frame velocity `x_dot` of the fed-back state (m/s).
+        velocity_world => matrix(py, &o.observation.state.velocity)?,
+        /// The reference at `t_k` as a `tvmd.Reference`.
+        reference => PyReference { inner: core_reference::<f64>(&o.observation.reference) },
+        /// (n,) bool: the failures the controller is told of.
+        failed => shaped(py, o.observation.failed.clone(), &[o.observation.failed.len()])?,
+        /// The scenario's duration is reached (no step follows).
+        done => o.done,
+    }
+}
+
+/// A tvmd-sim error of a step as the Python exception.
+fn step_error(e: tvmd_sim::SimError) -> PyErr {
+    value_error(e)
+}
+
+/// The simulator stepped one controller period at a time with your own controller.
+///
+/// `Simulation(scenario="hover", *, toml, team, relaxation, allocator, precision, null_space,
+/// law, max_samples)`: the plant of `run` (actuators, failures, disturbances, noise). `reset()`
+/// returns the first `Observation`; `step(commands)` holds (n, 3) `eta_x, eta_y, thrust` (or
+/// (n, 4), or normalized rotor speeds with `rotor_speeds=True`, or a `ScenarioController`'s
+/// output) and `step_wrench(u)` the allocation of a (6,) body wrench `[u_tau; u_f]` for one
+/// controller period, each returning the next `Observation`; `result()` is the flight so far.
+/// Bad actions raise `ValueError` and change nothing.
+#[pyclass(module = "tvmd.sim", name = "Simulation")]
+pub(crate) struct PySimulation {
+    sim: Simulation,
+    spec: RunSpec,
+}
+
+impl PySimulation {
+    fn observation(&mut self) -> PyResult<PyObservation> {
+        let done = self.sim.is_finished();
+        let observation = self.sim.observe().map_err(step_error)?.clone();
+        Ok(PyObservation {
+            inner: ObservationData { observation, done },
+        })
+    }
+}
+
+#[pymethods]
+impl PySimulation {
+    #[new]
+    #[pyo3(signature = (scenario = None, *, toml = None, team = None, relaxation = None, allocator = None, precision = None, null_space = None, law = None, max_samples = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        scenario: Option<&Bound<'_, PyAny>>,
+        toml: Option<String>,
+        team: Option<&Bound<'_, PyAny>>,
+        relaxation: Option<f64>,
+        allocator: Option<String>,
+        precision: Option<String>,
+        null_space: Option<String>,
+        law: Option<&Bound<'_, PyAny>>,
+        max_samples: Option<Int>,
+    ) -> PyResult<Self> {
+        let spec = spec(
+            py,
+            scenario,
+            toml,
+            team,
+            relaxation,
+            allocator,
+            precision,
+            null_space,
+            law,
+            max_samples.as_ref(),
+        )?;
+        let options = SimOptions {
+            samples: spec.samples,
+        };
+        let sim = Simulation::with_options(&spec.scenario, options).map_err(value_error)?;
+        Ok(Self { sim, spec })
+    }
+
+    /// Starts over (optionally reseeding the state noise, from another initial pose); the
+    /// first observation. `seed` reseeds the state noise; `position` (3,) and `attitude_rpy`
+    /// (3,) replace the scenario's initial pose.
+    #[pyo3(signature = (seed = None, *, position = None, attitude_rpy = None))]
+    fn reset(
+        &mut self,
+        seed: Option<Int>,
+        position: Option<&Bound<'_, PyAny>>,
+        attitude_rpy: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyObservation> {
+        let seed = seed
+            .map(|s| s.to("seed", 0, i128::from(u64::MAX)))
+            .transpose()?;
+        let position = position
+            .map(|p| finite::<3, 1>(p, "position"))
+            .transpose()?;
+        let attitude = attitude_rpy
+            .map(|a| finite::<3, 1>(a, "attitude_rpy"))
+            .transpose()?;
+        self.sim
+            .reset_at(seed, position.map(Into::into), attitude.map(Into::into))
+            .map_err(step_error)?;
+        self.observation()
+    }
+
+    /// The current tick's observation (its noise is drawn once per tick).
+    fn observe(&mut self) -> PyResult<PyObservation> {
+        self.observation()
+    }
+
+    /// Holds per-agent commands (or a `ScenarioController`'s output) for one controller
+    /// period; the next observation. `commands`: (n, 3) rows `eta_x, eta_y` (rad), `thrust` (N);
+    /// (n, 4) in `tvmd.Controller`'s layout; with `rotor_speeds=True` the last column is the
+    /// normalized rotor speed (thrust `max_thrust * omega**2`).
+    #[pyo3(signature = (commands, *, rotor_speeds = false))]
+    fn step(&mut self, commands: &Bound<'_, PyAny>, rotor_speeds: bool) -> PyResult<PyObservation> {
+        if let Ok(out) = commands.cast::<PyControllerOutput>() {
+            let out = out.get().inner.clone();
+            self.sim.step_output(out).map_err(step_error)?;
+        } else {
+            let n = self.sim.agents();
+            let commands = commands_arg(commands, n, rotor_speeds, self.sim.max_thrust())?;
+            self.sim.step(&commands).map_err(step_error)?;
+        }
+        self.observation()
+    }
+
+    /// Holds the admissible commands of a body wrench for one controller period; the next
+    /// observation. `wrench`: (6,) `[u_tau; u_f]` (N m, N), body frame, about the centre of
+    /// mass; the scenario controller's allocation stage makes it admissible commands.
+    fn step_wrench(&mut self, wrench: &Bound<'_, PyAny>) -> PyResult<PyObservation> {
+        let wrench = wrench_arg(wrench)?;
+        self.sim.step_wrench(&wrench).map_err(step_error)?;
+        self.observation()
+    }
+
+    /// The flight so far as a `SimResult` (copied; the simulation goes on).
+    fn result(&self) -> PySimResult {
+        let mut result = self.sim.result();
+        result.summary.verdict = Verdict::judge(&result.summary, &self.spec.scenario.success);
+        PySimResult {
+            inner: SimData::new(self.spec.clone(), result),
+        }
+    }
+
+    /// The true state now, as a `tvmd.State`.
+    #[getter]
+    fn state(&self) -> PyState {
+        PyState {
+            inner: core_state::<f64>(&self.sim.state()),
+        }
+    }
+
+    /// Simulation time (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+
+    /// The scenario's duration is reached.
+    #[getter]
+    fn done(&self) -> bool {
+        self.sim.is_finished()
+    }
+
+    /// Number of agents `n`.
+    #[getter]
+    fn n_agents(&self) -> usize {
+        self.sim.agents()
+    }
+
+    /// Team mass `m_C` (kg).
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.sim.team().mass()
+    }
+
+    /// Largest thrust of one agent `sigma_Tf` (N).
+    #[getter]
+    fn max_thrust(&self) -> f64 {
+        self.sim.max_thrust()
+    }
+
+    /// (n, 3) the agents' positions `p_i` relative to the centre of mass (m, body frame).
+    #[getter]
+    fn agent_positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let agents = &self.sim.team().agents;
+        let values = agents.iter().flat_map(|a| a.position).collect();
+        shaped(py, values, &[agents.len(), 3])
+    }
+
+    /// `(sigma_x, sigma_y)`: the gimbal limits `|eta_x| <= sigma_x`, `|eta_y| <= sigma_y` (rad).
+    #[getter]
+    fn gimbal_limits(&self) -> (f64, f64) {
+        let limits = &self.sim.scenario().limits;
+        (limits.sigma_x, limits.sigma_y)
+    }
+
+    /// Controller period (s): the time one step holds its commands.
+    #[getter]
+    fn controller_period(&self) -> f64 {
+        self.sim.scenario().controller_period
+    }
+
+    /// The scenario's duration (s).
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.sim.scenario().duration
+    }
+
+    /// The scenario (overrides applied) as TOML.
+    #[getter]
+    fn scenario_toml(&self) -> PyResult<String> {
+        self.sim.scenario().to_toml_string().map_err(value_error)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Simulation(scenario_name='{}', n_agents={}, time={})",
+            self.sim.scenario().name,
+            self.sim.agents(),
+            self.sim.time()
+        )
+    }
+}
+
+/// A `ScenarioController`'s output for one tick: `commands` (n, 3) and `diagnostics` (dict);
+/// `Simulation.step` takes it as it is.
+#[pyclass(module = "tvmd.sim", name = "ControllerOutput", frozen)]
+pub(crate) struct PyControllerOutput {
+    inner: FlightOutput,
+}
+
+#[pymethods]
+impl PyControllerOutput {
+    /// (n, 3) commands `eta_x, eta_y, thrust` (rad, rad, N).
+    #[getter]
+    fn commands<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let c = &self.inner.commands;
+        let values = c
+            .iter()
+            .flat_map(|c| [c.eta_x, c.eta_y, c.thrust])
+            .collect();
+        shaped(py, values, &[c.len(), 3])
+    }
+
+    /// The controller's diagnostics of the tick (planner, law, allocation) as a dict.
+    #[getter]
+    fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        record_to_py(py, &self.inner.diagnostics)
+    }
+}
+
+/// The tvmd controller of a scenario exactly as `run` flies it (same arguments as
+/// `Simulation`): `sim.step(ctrl.step(obs))` from `reset()` to `done` reproduces `run`.
+#[pyclass(module = "tvmd.sim", name = "ScenarioController")]
+pub(crate) struct PyScenarioController {
+    /// In a mutex: a Python class must be `Sync`, the controller is `Send` only.
+    inner: Mutex<AnyTvmdController>,
+}
+
+#[pymethods]
+impl PyScenarioController {
+    #[new]
+    #[pyo3(signature = (scenario = None, *, toml = None, team = None, relaxation = None, allocator = None, precision = None, null_space = None, law = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        scenario: Option<&Bound<'_, PyAny>>,
+        toml: Option<String>,
+        team: Option<&Bound<'_, PyAny>>,
+        relaxation: Option<f64>,
+        allocator: Option<String>,
+        precision: Option<String>,
+        null_space: Option<String>,
+        law: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let spec = spec(
+            py, scenario, toml, team, relaxation, allocator, precision, null_space, law, None,
+        )?;
+        let inner = AnyTvmdController::from_scenario(&spec.scenario).map_err(value_error)?;
+        Ok(Self {
+            inner: Mutex::new(inner),
+        })
+    }
+
+    /// The commands and diagnostics for one tick's observation (call it once per tick).
+    fn step(&mut self, observation: &Bound<'_, PyObservation>) -> PyResult<PyControllerOutput> {
+        let o = &observation.get().inner.observation;
+        let mut controller = self
+            .inner
+            .lock()
+            .map_err(|_| PyRuntimeError::new_err("the controller failed in another thread"))?;
+        let inner = controller.step(&o.input()).map_err(|e| {
+            PyRuntimeError::new_err(format!("controller failed at t = {:.3} s: {e}", o.t))
+        })?;
+        Ok(PyControllerOutput { inner })
+    }
+}
+
+/// Registers `Simulation`, `Observation`, `ScenarioController` and `ControllerOutput` on the
+/// `sim` submodule.
+pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
+    sim.add_class::<PySimulation>()?;
+    sim.add_class::<PyObservation>()?;
+    sim.add_class::<PyScenarioController>()?;
+    sim.add_class::<PyControllerOutput>()
+}
