@@ -9,20 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! command -v arm-none-eabi-gcc >/dev/null 2>&1; then
-  echo "==> arm-none-eabi-gcc not found: installing gcc-arm-none-eabi with apt-get"
-  if [ "$(id -u)" -eq 0 ]; then
-    sudo_cmd=()
-  elif command -v sudo >/dev/null 2>&1; then
-    sudo_cmd=(sudo)
-  else
-    echo "error: arm-none-eabi-gcc is missing and neither root nor sudo can apt-get install gcc-arm-none-eabi" >&2
-    exit 1
-  fi
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
-    gcc-arm-none-eabi >/dev/null
-fi
+source scripts/lib/require.sh
+require arm-none-eabi-gcc gcc-arm-none-eabi
 arm-none-eabi-gcc --version | head -n 1
 
 rustup target add thumbv7em-none-eabihf

@@ -18,19 +18,9 @@ case "$target_dir" in /*) ;; *) target_dir="$PWD/$target_dir" ;; esac
 out="$target_dir/ffi"
 mkdir -p "$out"
 
-if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then
-  step "installing gcc and g++ (cc or c++ is missing)"
-  if [ "$(id -u)" -eq 0 ]; then
-    sudo_cmd=()
-  elif command -v sudo >/dev/null 2>&1; then
-    sudo_cmd=(sudo)
-  else
-    echo "error: cc/c++ missing and neither root nor sudo is available to apt-get install gcc g++" >&2
-    exit 1
-  fi
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq gcc g++ >/dev/null
-fi
+source scripts/lib/require.sh
+require cc gcc
+require c++ g++
 
 step "include/tvmd.h compiles as C99 and as C++11 (-Wall -Wextra -Werror -pedantic)"
 printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 3 ? 0 : 1; }\n' >"$out/header.c"

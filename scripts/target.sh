@@ -8,25 +8,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! command -v qemu-system-arm >/dev/null 2>&1; then
-  echo "==> qemu-system-arm not found: installing it with apt-get"
-  if [ "$(id -u)" -eq 0 ]; then
-    as_root() { "$@"; }
-  elif command -v sudo >/dev/null 2>&1; then
-    as_root() { sudo "$@"; }
-  else
-    echo "error: qemu-system-arm is missing and this user can neither install packages (not root) nor use sudo; install qemu-system-arm (Debian/Ubuntu package of that name) and rerun" >&2
-    exit 1
-  fi
-  if ! { as_root apt-get update -q && as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q qemu-system-arm; }; then
-    echo "error: apt-get could not install qemu-system-arm; install it by hand and rerun" >&2
-    exit 1
-  fi
-  command -v qemu-system-arm >/dev/null 2>&1 || {
-    echo "error: qemu-system-arm still not on PATH after apt-get install" >&2
-    exit 1
-  }
-fi
+source scripts/lib/require.sh
+require qemu-system-arm qemu-system-arm
 qemu-system-arm --version | head -n 1
 
 rustup target add thumbv7em-none-eabihf
