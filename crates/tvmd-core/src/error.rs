@@ -117,6 +117,9 @@ pub enum ConfigField {
     FaultThreshold,
     /// The persistence of [`crate::FaultDetector`].
     FaultPersistence,
+    /// Fault detection without the residual it reads (it needs the disturbance observer,
+    /// [`crate::OffsetFree::Observer`]).
+    FaultResidual,
 }
 
 impl ConfigField {
@@ -167,6 +170,7 @@ impl ConfigField {
             Self::FaultNoise => "fault.noise",
             Self::FaultThreshold => "fault.threshold",
             Self::FaultPersistence => "fault.persistence",
+            Self::FaultResidual => "fault.residual",
         }
     }
 }

@@ -241,18 +241,20 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Err(error) = checked {
             return Err(self.reject(error));
         }
-        let gains = &self.gains;
-        let mut u_fr = force_request(&self.plant, gains, state, reference);
+        let mut u_fr = force_request(&self.plant, &self.gains, state, reference);
         // Offset-free: the compensation joins the request before the projection and the
         // planner (skipped entirely when off, so the paper's cycle is bit for bit unchanged).
         let compensation = if self.offset_free.is_on() {
             self.offset_free.begin(&self.plant, state);
+            // The detector reads the estimate just measured (and may mask an agent now).
+            self.detect_faults(state);
             let c = self.offset_free.compensation();
             u_fr += state.attitude.transpose() * c.force;
             Some(c)
         } else {
             None
         };
+        let gains = &self.gains;
         let projection = project_force_in(&self.full_cone, &u_fr);
         let f_r = state.attitude * u_fr * projection.t_tf;
         // `reference.attitude` passed `reference.validate()` above.
