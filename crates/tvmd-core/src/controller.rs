@@ -13,7 +13,8 @@ mod reconfigure;
 mod settings;
 
 pub use crate::fault_detection::{
-    FaultDetection, FaultResponse, FAULT_MODEL_ERROR, FAULT_PERSISTENCE, FAULT_THRESHOLD,
+    FaultDetection, FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_MODEL_ERROR, FAULT_PERSISTENCE,
+    FAULT_THRESHOLD,
 };
 pub use cycle::{AllocationStage, LawStage};
 pub use detection::FaultMasking;

@@ -16,6 +16,11 @@ use crate::real::{lit, Real};
 pub const FAULT_MODEL_ERROR: f64 = 0.03;
 /// Threshold `k` (noise units) of [`FaultDetection::recommended`].
 pub const FAULT_THRESHOLD: f64 = 5.0;
+/// Bandwidth (rad/s) of the residual's slow baseline: the detector reads the residual's change
+/// from it, so the persistent part of the model error (a mass, inertia or centre-of-mass
+/// error, a steady wind) is not a fault, while a fault, which steps within a few periods, is
+/// read whole (the baseline is held while the statistic is above half the threshold).
+pub const FAULT_BASELINE_BANDWIDTH: f64 = 1.0;
 /// Persistence (periods) of [`FaultDetection::recommended`].
 pub const FAULT_PERSISTENCE: u32 = 5;
 

@@ -45,8 +45,8 @@ pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{
-    FlightDifference, PaperMetrics, RunResult, RunSummary, Sample, SampleRetention, SimOptions,
-    Simulation, Verdict,
+    FaultEvent, FaultSummary, FlightDifference, PaperMetrics, RunResult, RunSummary, Sample,
+    SampleRetention, SimOptions, Simulation, Verdict,
 };
 pub use sink::{LoggedTick, SceneRecord, Tick, TickSink};
 pub use tick_log::McapSink;

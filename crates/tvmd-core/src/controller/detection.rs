@@ -17,11 +17,11 @@ use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
 use crate::error::{ConfigError, ConfigField};
 use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
-use crate::fault_detection::FaultResponse;
+use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH};
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
 use crate::offset_free::OffsetFree;
-use crate::real::Real;
+use crate::real::{lit, Real};
 use crate::team::TeamConfig;
 
 /// A mask the controller set itself on a confirmed loss ([`FaultResponse::Mask`]).
@@ -30,9 +30,9 @@ pub struct FaultMasking<T: Real> {
     /// The agent masked.
     pub agent: usize,
     /// The hover-capability certificate of the mask in force
-    /// ([`Controller::hover_capability`]), or why the mask was refused (the old mask kept; not
-    /// tried again for this agent).
-    pub hover: Result<HoverCapability<T>, ConfigError>,
+    /// ([`Controller::hover_capability`]); `None` when the mask was refused (the remaining
+    /// team cannot produce every wrench: the old mask kept, not tried again for this agent).
+    pub hover: Option<HoverCapability<T>>,
     /// The count of law stages the detector had run when it masked (the period index).
     pub period: u32,
 }
@@ -40,9 +40,9 @@ pub struct FaultMasking<T: Real> {
 /// What the monitor keeps of a masking (the certificate is the controller's own).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Masked {
-    agent: usize,
+    agent: u32,
     period: u32,
-    refused: Option<ConfigError>,
+    refused: bool,
 }
 
 /// The detector's state inside a controller.
@@ -55,6 +55,11 @@ pub(super) struct FaultMonitor<T: Real> {
     gamma: (T, T),
     /// The filtered residual `[r_tau; r_f]` (`{C}`).
     residual: Vector6<T>,
+    /// Its slow baseline ([`FAULT_BASELINE_BANDWIDTH`]): the model error's persistent part,
+    /// held while the statistic is above half the threshold.
+    baseline: Vector6<T>,
+    /// `1 - e^(-L_b dt)` of the baseline.
+    slow: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
     periods: u32,
@@ -91,6 +96,8 @@ impl<T: Real> FaultMonitor<T> {
                 gamma(observer.force_bandwidth()),
             ),
             residual: Vector6::zeros(),
+            baseline: Vector6::zeros(),
+            slow: gamma(lit(FAULT_BASELINE_BANDWIDTH)),
             report: None,
             masked: None,
             periods: 0,
@@ -101,6 +108,7 @@ impl<T: Real> FaultMonitor<T> {
     pub(super) fn reset(&mut self) {
         self.state.reset();
         self.residual = Vector6::zeros();
+        self.baseline = Vector6::zeros();
         self.report = None;
     }
 
@@ -142,14 +150,20 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         for (f, c) in forces.iter_mut().zip(&self.previous) {
             *f = c.force();
         }
+        let change = monitor.residual - monitor.baseline;
         let report = monitor.state.update(
             &monitor.detector,
-            &monitor.residual,
+            &change,
             self.effectiveness.blocks(),
             &forces,
             &self.failures,
         );
         monitor.report = Some(report);
+        // The baseline follows the slow model error, not a fault: held above half the threshold.
+        if report.statistic <= report.threshold * lit(0.5) {
+            let slow = monitor.slow;
+            monitor.baseline += (monitor.residual - monitor.baseline) * slow;
+        }
         let FaultVerdict::Confirmed {
             agent,
             kind: FaultKind::Loss,
@@ -160,7 +174,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let refused_before = monitor
             .masked
             .as_ref()
-            .is_some_and(|m| m.agent == agent && m.refused.is_some());
+            .is_some_and(|m| m.agent as usize == agent && m.refused);
         if monitor.response != FaultResponse::Mask || refused_before {
             return;
         }
@@ -174,11 +188,13 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             monitor.state.reset();
             if hover.is_ok() {
                 monitor.residual = Vector6::zeros();
+                monitor.baseline = Vector6::zeros();
             }
             monitor.masked = Some(Masked {
-                agent,
+                // agent < N, a slot of the mask.
+                agent: u32::try_from(agent).unwrap_or(u32::MAX),
                 period,
-                refused: hover.err(),
+                refused: hover.is_err(),
             });
         }
     }
@@ -194,8 +210,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     pub fn fault_masking(&self) -> Option<FaultMasking<T>> {
         let m = self.fault.as_ref()?.masked?;
         Some(FaultMasking {
-            agent: m.agent,
-            hover: m.refused.map_or(Ok(self.hover), Err),
+            agent: m.agent as usize,
+            hover: (!m.refused).then_some(self.hover),
             period: m.period,
         })
     }

@@ -247,13 +247,14 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
                 *flag = true;
             }
             match &m.hover {
-                Ok(hover) => {
+                Some(hover) => {
                     out.masked = Some(m.agent);
                     self.accept_hover(t, state, hover);
                 }
-                Err(e) => {
+                None => {
                     self.failure_note = Some(format!(
-                        "detected loss of agent {} not masked: {e}",
+                        "detected loss of agent {} not masked: the remaining team cannot \
+                         produce every wrench",
                         m.agent
                     ));
                 }
