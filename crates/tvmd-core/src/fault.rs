@@ -71,6 +71,16 @@ impl<T: Real> FaultDetector<T> {
         })
     }
 
+    /// The stated force noise `sigma_f` (N).
+    pub fn force_noise(&self) -> T {
+        self.force_noise
+    }
+
+    /// The stated torque noise `sigma_tau` (N m).
+    pub fn torque_noise(&self) -> T {
+        self.torque_noise
+    }
+
     /// `k`, the threshold in units of the stated noise.
     pub fn threshold(&self) -> T {
         self.threshold

@@ -13,7 +13,7 @@ use crate::fault::FaultDetector;
 use crate::real::{lit, Real};
 
 /// Relative model error `epsilon` of [`FaultDetection::recommended`].
-pub const FAULT_MODEL_ERROR: f64 = 0.03;
+pub const FAULT_MODEL_ERROR: f64 = 0.015;
 /// Threshold `k` (noise units) of [`FaultDetection::recommended`].
 pub const FAULT_THRESHOLD: f64 = 5.0;
 /// Bandwidth (rad/s) of the residual's slow baseline: the detector reads the residual's change
@@ -21,6 +21,9 @@ pub const FAULT_THRESHOLD: f64 = 5.0;
 /// error, a steady wind) is not a fault, while a fault, which steps within a few periods, is
 /// read whole (the baseline is held while the statistic is above half the threshold).
 pub const FAULT_BASELINE_BANDWIDTH: f64 = 1.0;
+/// The share of the last jump of the commanded wrench added to the residual's stated noise:
+/// the part of a period the actuators (servo, rotor) may still deliver the old wrench.
+pub const FAULT_JUMP_SHARE: f64 = 0.5;
 /// Persistence (periods) of [`FaultDetection::recommended`].
 pub const FAULT_PERSISTENCE: u32 = 5;
 

@@ -3,7 +3,7 @@
 //!
 //! ```toml
 //! [fault_detection]          # every key optional; the core's recommended values by default
-//! model_error = 0.03         # the residual's noise, as a fraction of the weight (and weight x arm)
+//! model_error = 0.015        # the residual's noise, as a fraction of the weight (and weight x arm)
 //! threshold = 5.0            # k, in those units
 //! persistence = 5            # controller periods that confirm an agent
 //! response = "mask"          # or "report": the controller masks a confirmed lost agent itself

@@ -15,9 +15,10 @@ use nalgebra::{Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
+use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
 use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
-use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH};
+use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE};
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
 use crate::offset_free::OffsetFree;
@@ -60,6 +61,10 @@ pub(super) struct FaultMonitor<T: Real> {
     baseline: Vector6<T>,
     /// `1 - e^(-L_b dt)` of the baseline.
     slow: T,
+    /// `(||Delta u_tau||, ||Delta u_f||)`: how much the commanded wrench changed at the start of
+    /// the period the next residual measures. Actuators that lag (servos, rotors) deliver part
+    /// of the old wrench for part of that period, so the residual's noise grows by it.
+    jump: (T, T),
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
     periods: u32,
@@ -98,6 +103,7 @@ impl<T: Real> FaultMonitor<T> {
             residual: Vector6::zeros(),
             baseline: Vector6::zeros(),
             slow: gamma(lit(FAULT_BASELINE_BANDWIDTH)),
+            jump: (T::zero(), T::zero()),
             report: None,
             masked: None,
             periods: 0,
@@ -109,6 +115,7 @@ impl<T: Real> FaultMonitor<T> {
         self.state.reset();
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
+        self.jump = (T::zero(), T::zero());
         self.report = None;
     }
 
@@ -151,8 +158,19 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             *f = c.force();
         }
         let change = monitor.residual - monitor.baseline;
+        // The stated noise, grown by the last jump of the commanded wrench.
+        let d = &monitor.detector;
+        let half = lit::<T>(FAULT_JUMP_SHARE);
+        let (j_tau, j_f) = (monitor.jump.0 * half, monitor.jump.1 * half);
+        let detector = FaultDetector::new(
+            d.force_noise() + j_f,
+            d.torque_noise() + j_tau,
+            d.threshold(),
+            d.persistence(),
+        )
+        .unwrap_or(*d);
         let report = monitor.state.update(
-            &monitor.detector,
+            &detector,
             &change,
             self.effectiveness.blocks(),
             &forces,
@@ -197,6 +215,26 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                 refused: hover.is_err(),
             });
         }
+    }
+
+    /// Before `commands` replace the held ones: the jump of the commanded wrench they make,
+    /// for the next period's detection (nothing without detection).
+    pub(super) fn note_commands(&mut self, commands: &[AgentCommand<T>; N]) {
+        let Some(monitor) = self.fault.as_mut() else {
+            return;
+        };
+        let mut delta = [Vector3::zeros(); N];
+        for ((d, new), old) in delta.iter_mut().zip(commands).zip(&self.previous) {
+            *d = new.force() - old.force();
+        }
+        let w = self.effectiveness.wrench(&delta);
+        let (tau, f) = (w.fixed_rows::<3>(0).norm(), w.fixed_rows::<3>(3).norm());
+        // A non-finite jump (it cannot come from admissible commands) counts as none.
+        monitor.jump = if tau.is_finite() && f.is_finite() {
+            (tau, f)
+        } else {
+            (T::zero(), T::zero())
+        };
     }
 
     /// The detector's report of the last law stage: verdict, statistic, threshold, misfits
