@@ -133,3 +133,30 @@ fn without_detection_nothing_is_reported_and_detection_needs_the_observer() {
     paper.fault_detection = Some(FaultDetectionConfig::default());
     assert!(paper.validate().is_err());
 }
+
+#[test]
+fn the_fault_scenarios_load_and_a_team_override_flies_them() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/faults");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    names.sort();
+    // Three faults, two phases.
+    assert_eq!(names.len(), 6, "{names:?}");
+    for path in &names {
+        let s = Scenario::from_file(path).unwrap();
+        let d = s.fault_detection.expect("detection on");
+        assert_eq!(d.response, FaultResponseConfig::Mask, "{path:?}");
+        assert!(
+            s.failures.iter().all(|f| !f.controller_informed),
+            "{path:?}"
+        );
+    }
+    let mut s = Scenario::from_file(dir.join("loss-hover.toml")).unwrap();
+    s.team.preset = Some("a6-inc".into());
+    s.validate().unwrap();
+    let r = run_scenario(&s, None, None).unwrap();
+    let masked = r.summary.fault.and_then(|f| f.masked).expect("masked");
+    assert_eq!(masked.agent, 0);
+}
