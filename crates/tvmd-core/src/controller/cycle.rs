@@ -151,7 +151,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(field) = checked {
             return Err(self.reject(InputError::Overflow { field }));
         }
-        self.note_commands(&stage.commands);
+        self.note_wrench(&stage.allocation.wrench);
         self.previous = stage.commands;
         if let Some((state, pending)) = self.pending.take() {
             self.finish_offset_free(&state, pending, &stage.allocation);
@@ -220,7 +220,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(error) = error {
             return Err(self.reject(error));
         }
-        self.note_commands(&output.commands);
+        self.note_wrench(&output.allocation.wrench);
         self.previous = output.commands;
         if let Some(pending) = pending {
             self.finish_offset_free(state, pending, &output.allocation);

@@ -15,7 +15,6 @@ use nalgebra::{Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
-use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
 use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
 use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE};
@@ -34,15 +33,12 @@ pub struct FaultMasking<T: Real> {
     /// ([`Controller::hover_capability`]); `None` when the mask was refused (the remaining
     /// team cannot produce every wrench: the old mask kept, not tried again for this agent).
     pub hover: Option<HoverCapability<T>>,
-    /// The count of law stages the detector had run when it masked (the period index).
-    pub period: u32,
 }
 
 /// What the monitor keeps of a masking (the certificate is the controller's own).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Masked {
     agent: u32,
-    period: u32,
     refused: bool,
 }
 
@@ -59,15 +55,14 @@ pub(super) struct FaultMonitor<T: Real> {
     /// Its slow baseline ([`FAULT_BASELINE_BANDWIDTH`]): the model error's persistent part,
     /// held while the statistic is above half the threshold.
     baseline: Vector6<T>,
-    /// `1 - e^(-L_b dt)` of the baseline.
-    slow: T,
-    /// `(||Delta u_tau||, ||Delta u_f||)`: how much the commanded wrench changed at the start of
-    /// the period the next residual measures. Actuators that lag (servos, rotors) deliver part
-    /// of the old wrench for part of that period, so the residual's noise grows by it.
+    /// The wrench `M f` allocated for the coming period.
+    wrench: Vector6<T>,
+    /// `(||Delta u_tau||, ||Delta u_f||)`: how much the allocated wrench jumped at the start
+    /// of the period the next residual measures. Actuators that lag (servos, rotors) deliver
+    /// part of the old wrench for part of that period, so the residual's noise grows by it.
     jump: (T, T),
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
-    periods: u32,
 }
 
 impl<T: Real> FaultMonitor<T> {
@@ -102,11 +97,10 @@ impl<T: Real> FaultMonitor<T> {
             ),
             residual: Vector6::zeros(),
             baseline: Vector6::zeros(),
-            slow: gamma(lit(FAULT_BASELINE_BANDWIDTH)),
+            wrench: Vector6::zeros(),
             jump: (T::zero(), T::zero()),
             report: None,
             masked: None,
-            periods: 0,
         }))
     }
 
@@ -115,6 +109,7 @@ impl<T: Real> FaultMonitor<T> {
         self.state.reset();
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
+        self.wrench = Vector6::zeros();
         self.jump = (T::zero(), T::zero());
         self.report = None;
     }
@@ -139,11 +134,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// agent's wrench.
     pub(super) fn detect_faults(&mut self, state: &RigidState<T>) {
         let measurement = self.offset_free.observer_measurement();
+        let period = self.settings.period;
         let landed = self.offset_free.landed();
         let Some(monitor) = self.fault.as_mut() else {
             return;
         };
-        monitor.periods = monitor.periods.saturating_add(1);
         if landed {
             // On the ground: nothing to read, and nothing carried into the next flight.
             monitor.reset();
@@ -179,7 +174,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         monitor.report = Some(report);
         // The baseline follows the slow model error, not a fault: held above half the threshold.
         if report.statistic <= report.threshold * lit(0.5) {
-            let slow = monitor.slow;
+            // `L_b dt`, the baseline's gain (first order in `L_b dt`, which is small).
+            let slow = lit::<T>(FAULT_BASELINE_BANDWIDTH) * period;
             monitor.baseline += (monitor.residual - monitor.baseline) * slow;
         }
         let FaultVerdict::Confirmed {
@@ -196,7 +192,6 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if monitor.response != FaultResponse::Mask || refused_before {
             return;
         }
-        let period = monitor.periods;
         let mut mask = self.failures;
         let hover = mask.set(agent, true).and_then(|()| self.set_failures(mask));
         if hover.is_ok() {
@@ -211,30 +206,30 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             monitor.masked = Some(Masked {
                 // agent < N, a slot of the mask.
                 agent: u32::try_from(agent).unwrap_or(u32::MAX),
-                period,
                 refused: hover.is_err(),
             });
         }
     }
 
-    /// Before `commands` replace the held ones: the jump of the commanded wrench they make,
-    /// for the next period's detection (nothing without detection).
-    pub(super) fn note_commands(&mut self, commands: &[AgentCommand<T>; N]) {
-        let Some(monitor) = self.fault.as_mut() else {
-            return;
-        };
-        let mut delta = [Vector3::zeros(); N];
-        for ((d, new), old) in delta.iter_mut().zip(commands).zip(&self.previous) {
-            *d = new.force() - old.force();
+    /// The wrench `M f` allocated for the coming period, for the next period's detection
+    /// (nothing without detection).
+    pub(super) fn note_wrench(&mut self, wrench: &Vector6<T>) {
+        if let Some(monitor) = self.fault.as_mut() {
+            // A non-finite wrench (refused before it is sent) is not recorded.
+            if wrench.iter().all(|x| x.is_finite()) {
+                let jump = wrench - monitor.wrench;
+                let (tau, f) = (
+                    jump.fixed_rows::<3>(0).norm(),
+                    jump.fixed_rows::<3>(3).norm(),
+                );
+                monitor.jump = if tau.is_finite() && f.is_finite() {
+                    (tau, f)
+                } else {
+                    (T::zero(), T::zero())
+                };
+                monitor.wrench = *wrench;
+            }
         }
-        let w = self.effectiveness.wrench(&delta);
-        let (tau, f) = (w.fixed_rows::<3>(0).norm(), w.fixed_rows::<3>(3).norm());
-        // A non-finite jump (it cannot come from admissible commands) counts as none.
-        monitor.jump = if tau.is_finite() && f.is_finite() {
-            (tau, f)
-        } else {
-            (T::zero(), T::zero())
-        };
     }
 
     /// The detector's report of the last law stage: verdict, statistic, threshold, misfits
@@ -250,7 +245,6 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         Some(FaultMasking {
             agent: m.agent as usize,
             hover: (!m.refused).then_some(self.hover),
-            period: m.period,
         })
     }
 }

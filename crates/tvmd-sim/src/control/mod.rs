@@ -96,8 +96,8 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     /// The agents the core masked itself (`[fault_detection] response = "mask"`): kept in
     /// every mask passed on, so the scenario's flags do not unmask them.
     detected: Vec<bool>,
-    /// The period of the last self-masking seen ([`tvmd_core::FaultMasking::period`]).
-    masking_seen: Option<u32>,
+    /// The agent of the last self-masking seen ([`tvmd_core::FaultMasking::agent`]).
+    masking_seen: Option<usize>,
 }
 
 impl<T: CoreFloat> TvmdController<T> {
@@ -240,9 +240,9 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         let masking = self
             .inner
             .fault_masking()
-            .filter(|m| Some(m.period) != self.masking_seen);
+            .filter(|m| Some(m.agent) != self.masking_seen);
         if let Some(m) = masking {
-            self.masking_seen = Some(m.period);
+            self.masking_seen = Some(m.agent);
             if let Some(flag) = self.detected.get_mut(m.agent) {
                 *flag = true;
             }
