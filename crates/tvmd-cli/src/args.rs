@@ -66,6 +66,11 @@ pub enum Command {
         /// name no law) or paper (the paper's law as published; docs/method.md).
         #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(tvmd_scenario::LAW_NAMES))]
         law: Option<String>,
+        /// Detect agent faults from the wrench residual (`[fault_detection]` with the
+        /// recommended detector): report (verdicts only) or mask (the controller masks a
+        /// confirmed lost agent itself); needs the offset-free law (docs/method.md).
+        #[arg(long, value_parser = ["report", "mask"])]
+        detect: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]

@@ -7,11 +7,17 @@ use nalgebra::Vector3;
 pub use crate::rotation::roll;
 
 mod cycle;
+mod detection;
 mod guard;
 mod reconfigure;
 mod settings;
 
+pub use crate::fault_detection::{
+    FaultDetection, FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_MODEL_ERROR, FAULT_PERSISTENCE,
+    FAULT_THRESHOLD,
+};
 pub use cycle::{AllocationStage, LawStage};
+pub use detection::FaultMasking;
 
 pub use settings::{
     ControllerSettings, ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX,
@@ -94,6 +100,8 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     offset_free: OffsetFreeState<T>,
     /// The planned-rate filter (`None` when `settings.attitude_rate` is).
     attitude_rate: Option<AttitudeRateState<T>>,
+    /// The fault detector (`None` when `settings.fault_detection` is).
+    fault: Option<detection::FaultMonitor<T>>,
     /// What the offset-free state records once the law stage's wrench is allocated.
     pending: Option<(RigidState<T>, cycle::PendingRecord<T>)>,
     plant: Plant<T>,
@@ -144,7 +152,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         };
         let admissible = AdmissibleSet::from_limits(team.limits());
         let hover = hover_capability(&effectiveness, &admissible, plant.weight());
+        let fault = detection::FaultMonitor::new(&settings, &team, plant.weight())?;
         Ok(Self {
+            fault,
             input_limit,
             gains,
             offset_free,
@@ -216,13 +226,17 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
 
     /// Forgets the previous command (rate limits restart from a centred gimbal), whatever the
     /// allocator kept from earlier periods ([`Allocator::reset`]), the offset-free state (zero
-    /// estimate or integral) and the planned-rate filter (at rest). The landed flag
+    /// estimate or integral), the fault detector's candidate and report (a mask it set stays)
+    /// and the planned-rate filter (at rest). The landed flag
     /// ([`Self::set_landed`]) is the caller's input and is kept.
     pub fn reset(&mut self) {
         self.previous = [AgentCommand::idle(); N];
         self.allocator.reset();
         self.offset_free.reset();
         self.pending = None;
+        if let Some(fault) = &mut self.fault {
+            fault.reset();
+        }
         if let Some(rates) = &mut self.attitude_rate {
             rates.reset();
         }

@@ -93,6 +93,9 @@ pub struct ObserverState<T: Real> {
     momenta: Option<(Vector3<T>, Vector3<T>)>,
     /// The saturation of the last period, for the update that measures it.
     saturation: Saturation,
+    /// This period's raw measurement `(d_f,meas, d_tau,meas)`, before the filter and the
+    /// anti-windup (`None` before a measurement).
+    measured: Option<(Vector3<T>, Vector3<T>)>,
 }
 
 impl<T: Real> ObserverState<T> {
@@ -111,6 +114,7 @@ impl<T: Real> ObserverState<T> {
             last: None,
             momenta: None,
             saturation: Saturation::NONE,
+            measured: None,
         }
     }
 
@@ -125,6 +129,13 @@ impl<T: Real> ObserverState<T> {
         (self.force, self.torque)
     }
 
+    /// This period's raw measurement `(d_f,meas, d_tau,meas)` (`{I}`, `{C}`): the momentum
+    /// change against the model over the last period, unfiltered and not held by the
+    /// anti-windup. `None` when this period measured nothing (no sample yet, after a reset).
+    pub fn measurement(&self) -> Option<(Vector3<T>, Vector3<T>)> {
+        self.measured
+    }
+
     /// Zero estimates, no sample.
     pub fn reset(&mut self) {
         self.force = Vector3::zeros();
@@ -132,6 +143,7 @@ impl<T: Real> ObserverState<T> {
         self.last = None;
         self.momenta = None;
         self.saturation = Saturation::NONE;
+        self.measured = None;
     }
 
     /// The estimates and the last sample of `old` (another observer's, e.g. before a
@@ -141,6 +153,7 @@ impl<T: Real> ObserverState<T> {
         self.torque = guarded(&old.torque, &old.torque, false, self.observer.max_torque);
         self.last = old.last;
         self.momenta = None;
+        self.measured = None;
         self.saturation = old.saturation;
     }
 
@@ -155,12 +168,14 @@ impl<T: Real> ObserverState<T> {
     pub fn measure(&mut self, plant: &Plant<T>, state: &RigidState<T>, force_bound: T) {
         let (momentum, angular_momentum) = momenta(plant, state);
         self.momenta = Some((momentum, angular_momentum));
+        self.measured = None;
         let Some(last) = self.last else {
             return;
         };
         let dt = self.period;
         let d_f = (momentum - last.momentum) / dt - last.force;
         let d_tau = (angular_momentum - last.angular_momentum) / dt - last.torque;
+        self.measured = Some((d_f, d_tau));
         let (g_f, g_tau) = self.gamma;
         let force = self.force + (d_f - self.force) * g_f;
         let torque = self.torque + (d_tau - self.torque) * g_tau;

@@ -116,6 +116,9 @@ pub enum ConfigField {
     FaultThreshold,
     /// The persistence of [`crate::FaultDetector`].
     FaultPersistence,
+    /// Fault detection without the residual it reads (it needs the disturbance observer,
+    /// [`crate::OffsetFree::Observer`]).
+    FaultResidual,
 }
 
 impl ConfigField {
@@ -166,6 +169,7 @@ impl ConfigField {
             Self::FaultNoise => "fault.noise",
             Self::FaultThreshold => "fault.threshold",
             Self::FaultPersistence => "fault.persistence",
+            Self::FaultResidual => "fault.residual",
         }
     }
 }

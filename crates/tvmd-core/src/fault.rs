@@ -71,6 +71,16 @@ impl<T: Real> FaultDetector<T> {
         })
     }
 
+    /// The stated force noise `sigma_f` (N).
+    pub fn force_noise(&self) -> T {
+        self.force_noise
+    }
+
+    /// The stated torque noise `sigma_tau` (N m).
+    pub fn torque_noise(&self) -> T {
+        self.torque_noise
+    }
+
     /// `k`, the threshold in units of the stated noise.
     pub fn threshold(&self) -> T {
         self.threshold
@@ -147,7 +157,8 @@ pub struct FaultReport<T: Real> {
 /// The detector's state: the candidate and how long it has held.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FaultState {
-    candidate: Option<usize>,
+    /// The candidate agent (`u32`: a mask's slot; keeps the controller's state small).
+    candidate: Option<u32>,
     periods: u32,
 }
 
@@ -178,6 +189,21 @@ impl FaultState {
         residual: &Vector6<T>,
         blocks: &[Option<Matrix6x3<T>>; N],
         forces: &[Vector3<T>; N],
+        failures: &FailureMask<N>,
+    ) -> FaultReport<T> {
+        let force_of = |i: usize| forces.get(i).copied().unwrap_or_else(Vector3::zeros);
+        self.update_with(detector, residual, blocks, force_of, failures)
+    }
+
+    /// As [`Self::update`], with agent `i`'s force given by `force_of(i)`, called only for the
+    /// agent that explains the residual (at most once per period): a caller that holds
+    /// commands, not forces, pays their trigonometry only then.
+    pub fn update_with<T: Real, const N: usize>(
+        &mut self,
+        detector: &FaultDetector<T>,
+        residual: &Vector6<T>,
+        blocks: &[Option<Matrix6x3<T>>; N],
+        force_of: impl FnOnce(usize) -> Vector3<T>,
         failures: &FailureMask<N>,
     ) -> FaultReport<T> {
         let w = detector.weights();
@@ -223,16 +249,14 @@ impl FaultState {
             report.verdict = FaultVerdict::Unexplained;
             return report;
         };
-        let kind = kind_of(
-            &b.delta_f,
-            forces.get(agent).copied().unwrap_or_else(Vector3::zeros),
-        );
-        self.periods = if self.candidate == Some(agent) {
+        let kind = kind_of(&b.delta_f, force_of(agent));
+        let slot = u32::try_from(agent).ok();
+        self.periods = if self.candidate.is_some() && self.candidate == slot {
             self.periods.saturating_add(1)
         } else {
             1
         };
-        self.candidate = Some(agent);
+        self.candidate = slot;
         report.verdict = if self.periods >= detector.persistence {
             FaultVerdict::Confirmed { agent, kind }
         } else {

@@ -64,6 +64,7 @@ pub mod effectiveness;
 pub mod error;
 pub mod failure;
 pub mod fault;
+pub mod fault_detection;
 pub mod gain_schedule;
 pub mod gimbal;
 pub mod hover;
@@ -94,6 +95,7 @@ pub use command::AgentCommand;
 pub use controller::{
     AllocationStage, ControlOutput, Controller, ControllerSettings, CycleError, LawStage,
 };
+pub use controller::{FaultDetection, FaultMasking, FaultResponse};
 pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};

@@ -88,6 +88,17 @@ impl<T: Real> OffsetFreeState<T> {
         Compensation { force, torque }
     }
 
+    /// The disturbance observer's raw measurement of this period (`(d_f,meas, d_tau,meas)`,
+    /// `{I}`, `{C}`; [`ObserverState::measurement`]): the wrench the team did not deliver as
+    /// commanded, which the fault detector filters into its residual. `None` without an
+    /// observer, when landed, or when this period measured nothing.
+    pub fn observer_measurement(&self) -> Option<(Vector3<T>, Vector3<T>)> {
+        match &self.kind {
+            Kind::Observer(o) if !self.landed => o.measurement(),
+            _ => None,
+        }
+    }
+
     /// Clears the state (zero estimate or integral, no observer sample); the landed flag,
     /// which is the caller's input, is kept.
     pub fn reset(&mut self) {

@@ -9,8 +9,9 @@ use flight::{fly, settling_time, worst_after, Body, Sample, Truth};
 use tvmd_core::nalgebra::Vector3;
 use tvmd_core::team::presets;
 use tvmd_core::{
-    Controller, ControllerSettings, DisturbanceObserver, GainSchedule, IntegralAction,
-    NaturalGains, OffsetFree, RedistributedPseudoInverse, Reference, TeamConfig,
+    ConfigError, ConfigField, Controller, ControllerSettings, DisturbanceObserver, FailureMask,
+    FaultDetection, FaultResponse, GainSchedule, IntegralAction, NaturalGains, OffsetFree,
+    RedistributedPseudoInverse, Reference, TeamConfig,
 };
 
 const HOVER: [f64; 3] = [0.0, 0.0, 1.5];
@@ -335,4 +336,99 @@ fn the_planned_rates_reduce_the_attitude_lag_behind_a_moving_planned_attitude() 
     let with = lag(Some(tvmd_core::AttitudeRateFilter::new(20.0, 5.0).unwrap()));
     println!("largest |e_R| against R_d over 4.5-11 s: reference rates {without:.2e}, planned rates {with:.2e}");
     assert!(with < 0.7 * without, "{without} {with}");
+}
+
+/// The offset-free law with fault detection masking a confirmed loss.
+fn detecting(team: TeamConfig<f64, 4>) -> Controller<f64, 4, RedistributedPseudoInverse> {
+    let settings = ControllerSettings {
+        fault_detection: Some(FaultDetection::recommended(FaultResponse::Mask)),
+        ..ControllerSettings::offset_free_law()
+    };
+    Controller::new(team, settings, RedistributedPseudoInverse).unwrap()
+}
+
+/// Hovers A4-Inc under the disturbed truth and cuts agent `lost`'s thrust at `cut` s: the
+/// plant gets `M f - M_lost f_lost`. Returns the time the controller masked an agent, which
+/// agent, and the largest statistic before the cut.
+fn lose_agent(lost: usize, cut: f64) -> (Option<(f64, usize)>, f64, FailureMask<4>) {
+    let team = presets::a4_inc::<f64, 4>().unwrap();
+    let truth = disturbed_truth(&team);
+    let blocks = *team.effectiveness(&FailureMask::none()).blocks();
+    let mut c = detecting(team);
+    let mut body = Body::at(hover());
+    let dt = c.settings().period;
+    let mut masked = None;
+    let mut before = 0.0f64;
+    for k in 0..((cut + 1.0) / dt).round() as usize {
+        let t = k as f64 * dt;
+        let out = c.step(&body.state(), &Reference::hover(hover())).unwrap();
+        let report = c.fault_report().copied();
+        if t < cut {
+            before = before.max(report.map_or(0.0, |r| r.statistic));
+        }
+        if let (None, Some(m)) = (masked, c.fault_masking()) {
+            masked = Some((t, m.agent));
+        }
+        let mut u = out.allocation.wrench;
+        if t >= cut {
+            u -= blocks[lost].unwrap() * out.allocation.forces[lost];
+        }
+        for _ in 0..10 {
+            body = flight::rk4(&body, &truth, &u, dt / 10.0);
+        }
+    }
+    (masked, before, *c.failures())
+}
+
+#[test]
+fn a_lost_agent_is_detected_isolated_and_masked_by_the_controller() {
+    let threshold = FaultDetection::<f64>::recommended(FaultResponse::Mask).threshold();
+    for lost in 0..4 {
+        let (masked, before, mask) = lose_agent(lost, 2.0);
+        // No alarm before the cut under model error and a constant disturbance.
+        assert!(
+            before < threshold,
+            "agent {lost}: statistic {before} before the cut"
+        );
+        let (t, agent) = masked.unwrap_or_else(|| panic!("agent {lost} never masked"));
+        println!("agent {lost}: masked {agent} after {:.2} s", t - 2.0);
+        assert_eq!(agent, lost);
+        // The observer's bandwidth (10 rad/s) and the persistence bound the delay.
+        assert!(t >= 2.0 && t - 2.0 <= 0.5, "agent {lost}: masked at {t}");
+        assert!(mask.is_failed(lost) && (0..4).filter(|i| mask.is_failed(*i)).count() == 1);
+    }
+}
+
+#[test]
+fn fault_detection_needs_the_observer_and_reports_nothing_when_off() {
+    let team = presets::a4_inc::<f64, 4>().unwrap();
+    let without_observer = ControllerSettings {
+        fault_detection: Some(FaultDetection::recommended(FaultResponse::Report)),
+        ..ControllerSettings::paper()
+    };
+    assert_eq!(
+        Controller::new(team, without_observer, RedistributedPseudoInverse).unwrap_err(),
+        ConfigError::Parameter {
+            field: ConfigField::FaultResidual
+        }
+    );
+    assert!(ControllerSettings::<f64>::paper().fault_detection.is_none());
+    assert_eq!(
+        FaultDetection::new(0.0f64, 5.0, 3, FaultResponse::Mask),
+        Err(ConfigError::Parameter {
+            field: ConfigField::FaultNoise
+        })
+    );
+    let mut c = Controller::new(
+        team,
+        ControllerSettings::offset_free_law(),
+        RedistributedPseudoInverse,
+    )
+    .unwrap();
+    c.step(
+        &tvmd_core::RigidState::at_rest(hover()),
+        &Reference::hover(hover()),
+    )
+    .unwrap();
+    assert!(c.fault_report().is_none() && c.fault_masking().is_none());
 }

@@ -176,6 +176,7 @@ pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> 
         gain_schedule: law.gain_schedule,
         offset_free: law.offset_free,
         attitude_rate: law.attitude_rate,
+        fault_detection: None,
     };
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,

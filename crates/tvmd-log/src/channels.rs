@@ -21,6 +21,7 @@ pub(crate) struct Channels {
     actuators: Channel<proto::Actuators>,
     lyapunov: Channel<proto::Lyapunov>,
     hover: Channel<proto::Hover>,
+    fault: Channel<proto::Fault>,
     tf: Channel<FrameTransform>,
     scene: Channel<SceneUpdate>,
 }
@@ -39,6 +40,7 @@ impl Channels {
             actuators: build(ctx, LogKind::Actuators),
             lyapunov: build(ctx, LogKind::Lyapunov),
             hover: build(ctx, LogKind::Hover),
+            fault: build(ctx, LogKind::Fault),
             tf: build(ctx, LogKind::FrameTransform),
             scene: build(ctx, LogKind::Scene),
         }
@@ -78,6 +80,7 @@ log_message!(proto::Allocation, Allocation, allocation);
 log_message!(proto::Actuators, Actuators, actuators);
 log_message!(proto::Lyapunov, Lyapunov, lyapunov);
 log_message!(proto::Hover, Hover, hover);
+log_message!(proto::Fault, Fault, fault);
 log_message!(FrameTransform, FrameTransform, tf);
 log_message!(SceneUpdate, Scene, scene);
 

@@ -21,6 +21,8 @@ pub enum LogKind {
     Lyapunov,
     /// Hover classification ([`proto::Hover`]).
     Hover,
+    /// Fault detector report ([`proto::Fault`]).
+    Fault,
     /// The team's pose (`foxglove.FrameTransform`).
     FrameTransform,
     /// The 3D scene (`foxglove.SceneUpdate`).
@@ -29,7 +31,7 @@ pub enum LogKind {
 
 impl LogKind {
     /// All kinds, in channel order.
-    pub const ALL: [LogKind; 10] = [
+    pub const ALL: [LogKind; 11] = [
         LogKind::State,
         LogKind::Reference,
         LogKind::Planner,
@@ -38,6 +40,7 @@ impl LogKind {
         LogKind::Actuators,
         LogKind::Lyapunov,
         LogKind::Hover,
+        LogKind::Fault,
         LogKind::FrameTransform,
         LogKind::Scene,
     ];
@@ -53,6 +56,7 @@ impl LogKind {
             Self::Actuators => "/actuators",
             Self::Lyapunov => "/lyapunov",
             Self::Hover => "/hover",
+            Self::Fault => "/fault",
             Self::FrameTransform => "/tf",
             Self::Scene => "/scene",
         }
@@ -70,6 +74,7 @@ impl LogKind {
             Self::Actuators => proto::Actuators::NAME,
             Self::Lyapunov => proto::Lyapunov::NAME,
             Self::Hover => proto::Hover::NAME,
+            Self::Fault => proto::Fault::NAME,
             Self::FrameTransform => "foxglove.FrameTransform",
             Self::Scene => "foxglove.SceneUpdate",
         }

@@ -12,6 +12,7 @@
 //! | `/actuators` | `tvmd.Actuators` | commanded and actual agent commands, failures |
 //! | `/lyapunov` | `tvmd.Lyapunov` | `V_x`, `V_R` |
 //! | `/hover` | `tvmd.Hover` | hover classification when the failure mask changes |
+//! | `/fault` | `tvmd.Fault` | fault detector: statistic, threshold, verdict, isolated agent |
 //! | `/tf` | `foxglove.FrameTransform` | pose of frame `team` in frame `world` |
 //! | `/scene` | `foxglove.SceneUpdate` | one entity per agent (cube at `p_i`, thrust arrow) |
 //!

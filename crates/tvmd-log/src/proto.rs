@@ -85,6 +85,9 @@ macro_rules! proto_field {
     ($name:ident, $ty:ty, (double, tag = $n:literal)) => {
         proto_field!(@ $name, $n, Optional, Double, None, false)
     };
+    ($name:ident, $ty:ty, (double, optional, tag = $n:literal)) => {
+        proto_field!(@ $name, $n, Optional, Double, None, true)
+    };
     ($name:ident, $ty:ty, (double, repeated, tag = $n:literal)) => {
         proto_field!(@ $name, $n, Repeated, Double, None, false)
     };
@@ -377,6 +380,26 @@ proto_messages! {
         /// Whether the controller lands.
         landing: bool => (bool, tag = 6);
     }
+
+    /// `/fault`: the fault detector's report, every period it runs.
+    Fault {
+        /// Time (s).
+        t: f64 => (double, tag = 1);
+        /// The residual in noise units.
+        statistic: f64 => (double, tag = 2);
+        /// The threshold it is compared with.
+        threshold: f64 => (double, tag = 3);
+        /// `nominal`, `unexplained`, `suspected` or `confirmed`.
+        verdict: String => (string, tag = 4);
+        /// The isolated agent, if any.
+        agent: Option<u32> => (uint32, optional, tag = 5);
+        /// `loss`, `partial-loss`, `stuck-gimbal`, or empty.
+        kind: String => (string, tag = 6);
+        /// The fraction delivered, for a partial loss.
+        efficiency: Option<f64> => (double, optional, tag = 7);
+        /// The agent the controller masked itself this period, if any.
+        masked: Option<u32> => (uint32, optional, tag = 8);
+    }
 }
 
 /// The serialized `FileDescriptorSet` of `tvmd/log.proto` (built once).
@@ -406,79 +429,5 @@ impl Vec3 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_descriptor_set_names_every_message_and_field_once() {
-        let set = FileDescriptorSet::decode(file_descriptor_set()).unwrap();
-        assert_eq!(set.file.len(), 1);
-        let file = &set.file[0];
-        assert_eq!(file.package(), PACKAGE);
-        let names: Vec<&str> = file.message_type.iter().map(|m| m.name()).collect();
-        for n in [
-            "State",
-            "Reference",
-            "Allocation",
-            "Actuators",
-            "Hover",
-            "Vec3",
-        ] {
-            assert!(names.contains(&n), "{n} missing from {names:?}");
-        }
-        for m in &file.message_type {
-            let mut numbers: Vec<i32> = m.field.iter().map(|f| f.number()).collect();
-            numbers.sort_unstable();
-            numbers.dedup();
-            assert_eq!(
-                numbers.len(),
-                m.field.len(),
-                "{}: duplicate field number",
-                m.name()
-            );
-            for f in &m.field {
-                if f.r#type() == Type::Message {
-                    let target = f.type_name().trim_start_matches(".tvmd.");
-                    assert!(names.contains(&target), "{}.{}", m.name(), f.name());
-                }
-            }
-        }
-        let hover = file
-            .message_type
-            .iter()
-            .find(|m| m.name() == "Hover")
-            .unwrap();
-        let limiting = hover
-            .field
-            .iter()
-            .find(|f| f.name() == "limiting_agent")
-            .unwrap();
-        assert!(limiting.proto3_optional());
-        assert_eq!(hover.oneof_decl[0].name(), "_limiting_agent");
-    }
-
-    #[test]
-    fn messages_round_trip_and_keep_explicit_presence() {
-        let h = Hover {
-            t: 1.5,
-            capable: true,
-            margin: 0.25,
-            limiting_agent: Some(0),
-            limit: "thrust".into(),
-            landing: false,
-        };
-        let back = Hover::decode(h.encode_to_vec().as_slice()).unwrap();
-        assert_eq!(back, h);
-        assert_eq!(back.limiting_agent, Some(0));
-        let none = Hover {
-            limiting_agent: None,
-            ..h
-        };
-        assert_eq!(
-            Hover::decode(none.encode_to_vec().as_slice())
-                .unwrap()
-                .limiting_agent,
-            None
-        );
-    }
-}
+#[path = "proto_tests.rs"]
+mod tests;

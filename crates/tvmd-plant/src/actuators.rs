@@ -111,12 +111,20 @@ pub enum FailureKind {
     StuckGimbal,
     /// Both.
     NoThrustStuckGimbal,
+    /// The rotor delivers half of its commanded thrust from the failure time on (a partial
+    /// loss: a damaged propeller, a browning-out ESC).
+    HalfThrust,
 }
 
 impl FailureKind {
     /// True if the thrust is lost.
     pub fn loses_thrust(self) -> bool {
         matches!(self, Self::NoThrust | Self::NoThrustStuckGimbal)
+    }
+
+    /// True if the thrust is halved.
+    pub fn halves_thrust(self) -> bool {
+        matches!(self, Self::HalfThrust)
     }
 
     /// True if the gimbal sticks.
@@ -136,6 +144,8 @@ pub struct AgentActuator {
     pub thrust_failed: bool,
     /// The gimbal is stuck at `actual`'s angles.
     pub gimbal_stuck: bool,
+    /// The rotor delivers half its commanded thrust ([`FailureKind::HalfThrust`]).
+    pub thrust_halved: bool,
 }
 
 fn servo_axis(angle: &mut f64, rate: &mut f64, cmd: f64, m: &ServoModel, dt: f64) {
@@ -176,12 +186,17 @@ impl AgentActuator {
         if self.thrust_failed {
             self.actual.thrust = 0.0;
         } else {
+            let wanted = if self.thrust_halved {
+                0.5 * c.thrust
+            } else {
+                c.thrust
+            };
             match &model.rotor_lag {
-                None => self.actual.thrust = c.thrust,
+                None => self.actual.thrust = wanted,
                 Some(l) => {
                     // Exact discretisation of the first-order lag over dt.
                     let a = (-dt / l.time_constant).exp();
-                    self.actual.thrust = a * self.actual.thrust + (1.0 - a) * c.thrust;
+                    self.actual.thrust = a * self.actual.thrust + (1.0 - a) * wanted;
                 }
             }
         }
@@ -198,11 +213,15 @@ impl AgentActuator {
             self.gimbal_stuck = true;
             self.rates = [0.0; 2];
         }
+        if kind.halves_thrust() {
+            self.thrust_halved = true;
+            self.actual.thrust *= 0.5;
+        }
     }
 
     /// True if any failure is active.
     pub fn failed(&self) -> bool {
-        self.thrust_failed || self.gimbal_stuck
+        self.thrust_failed || self.gimbal_stuck || self.thrust_halved
     }
 }
 
@@ -368,6 +387,18 @@ mod tests {
                 thrust: 4.0
             }
         );
+        // A halved rotor delivers half of every later command, its gimbal still moving.
+        let mut half = ActuatorBank::new(model, 1);
+        half.fail(0, FailureKind::HalfThrust);
+        half.step(&cmd[..1], 1e-3);
+        assert_eq!(
+            half.actual()[0],
+            ActuatorCommand {
+                thrust: 1.5,
+                ..cmd[0]
+            }
+        );
+        assert!(half.agents[0].failed());
     }
 
     #[test]

@@ -93,6 +93,7 @@ impl PyController {
             gain_schedule,
             offset_free,
             attitude_rate,
+            fault_detection: None,
         };
         let allocator = make_allocator(allocator, weights, regularization, team.len())?;
         let mask = failure_mask(&team, failed)?;

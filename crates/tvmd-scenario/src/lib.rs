@@ -84,6 +84,7 @@ mod error;
 mod experiment;
 mod failures;
 mod families;
+mod fault_detection;
 mod law;
 mod log_settings;
 mod null_space;
@@ -101,6 +102,10 @@ pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise, MAX_FEEDBAC
 pub use error::ScenarioError;
 pub use failures::{Failure, FailureResponse, OnHoverLoss};
 pub use families::{FAMILY_NAMES, HOVER_HEIGHT, RELEASE_HEIGHT};
+pub use fault_detection::{
+    FaultDetectionConfig, FaultResponseConfig, FAULT_MODEL_ERROR, FAULT_PERSISTENCE,
+    FAULT_THRESHOLD,
+};
 pub use law::{
     AttitudeRateConfig, GainScheduleConfig, LawConfig, NaturalGainsConfig, OffsetFreeConfig,
     LAW_NAMES,

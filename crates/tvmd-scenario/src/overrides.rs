@@ -2,7 +2,7 @@
 //! `--precision` / `--team` / `--law`, the Python keywords `relaxation=` / `allocator=` /
 //! `precision=` / `law=`), applied with validation.
 
-use super::{LawConfig, NullSpaceConfig, Precision, Scenario};
+use super::{FaultDetectionConfig, LawConfig, NullSpaceConfig, Precision, Scenario};
 use crate::ScenarioError;
 
 /// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
@@ -21,6 +21,9 @@ pub struct Overrides {
     /// The control law (`[law]`), e.g. [`LawConfig::paper`] to fly a family with the paper's
     /// law.
     pub law: Option<LawConfig>,
+    /// Agent fault detection (`[fault_detection]`), e.g. the recommended detector with the
+    /// `"mask"` response.
+    pub fault_detection: Option<FaultDetectionConfig>,
 }
 
 impl Overrides {
@@ -32,6 +35,7 @@ impl Overrides {
             && self.null_space.is_none()
             && self.team.is_none()
             && self.law.is_none()
+            && self.fault_detection.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -50,6 +54,9 @@ impl Overrides {
         }
         if let Some(law) = self.law {
             scenario.law = law;
+        }
+        if let Some(detection) = self.fault_detection {
+            scenario.fault_detection = Some(detection);
         }
         if let Some(team) = &self.team {
             scenario.team.preset = Some(team.clone());
@@ -80,6 +87,7 @@ mod tests {
             null_space: Some("margin".parse().unwrap()),
             team: Some("a6-inc".into()),
             law: Some(LawConfig::paper()),
+            fault_detection: None,
         };
         assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();

@@ -8,8 +8,9 @@ use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
 use crate::error::invalid;
 use crate::{
-    Disturbances, Failure, FailureResponse, GainsConfig, LawConfig, LimitsConfig, LogSettings,
-    NullSpaceConfig, Payload, PlantError, Precision, ScenarioError, SuccessBounds, TeamSpec,
+    Disturbances, Failure, FailureResponse, FaultDetectionConfig, GainsConfig, LawConfig,
+    LimitsConfig, LogSettings, NullSpaceConfig, Payload, PlantError, Precision, ScenarioError,
+    SuccessBounds, TeamSpec,
 };
 
 /// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
@@ -74,6 +75,10 @@ pub struct Scenario {
     pub failures: Vec<Failure>,
     /// What to do when a failure leaves a team that cannot hold hover.
     pub failure_response: FailureResponse,
+    /// Agent fault detection in the controller (`[fault_detection]`,
+    /// [`FaultDetectionConfig`]); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fault_detection: Option<FaultDetectionConfig>,
     /// Disturbances.
     pub disturbances: Disturbances,
     /// Model error: how the flown team differs from the controller's model of it.
@@ -113,6 +118,7 @@ impl Default for Scenario {
             actuators: ActuatorModel::default(),
             failures: Vec::new(),
             failure_response: FailureResponse::default(),
+            fault_detection: None,
             disturbances: Disturbances::default(),
             plant: PlantError::nominal(),
             payloads: Vec::new(),

@@ -114,6 +114,43 @@ state_noise = { position = 0.01, seed = 7 }
 }
 
 #[test]
+fn fault_detection_parses_defaults_and_needs_the_observer() {
+    assert_eq!(Scenario::default().fault_detection, None);
+    let s = Scenario::from_toml_str(
+        "[fault_detection]\nresponse = \"mask\"\n[[failures]]\nagent = 0\ntime = 1.0\n\
+         kind = \"half-thrust\"\ncontroller_informed = false\n",
+    )
+    .unwrap();
+    let d = s.fault_detection.unwrap();
+    assert_eq!(d.response, crate::FaultResponseConfig::Mask);
+    assert_eq!(
+        (d.threshold, d.persistence),
+        (crate::FAULT_THRESHOLD, crate::FAULT_PERSISTENCE)
+    );
+    assert_eq!(s.failures[0].kind, FailureKind::HalfThrust);
+    // Round trip through TOML keeps it.
+    let back = Scenario::from_toml_str(&toml::to_string(&s).unwrap()).unwrap();
+    assert_eq!(back.fault_detection, s.fault_detection);
+    for (text, field) in [
+        (
+            "[fault_detection]\nthreshold = 0.0\n",
+            "fault_detection.threshold",
+        ),
+        (
+            "[fault_detection]\npersistence = 0\n",
+            "fault_detection.persistence",
+        ),
+        ("law = \"paper\"\n[fault_detection]\n", "fault_detection"),
+    ] {
+        let e = Scenario::from_toml_str(text).unwrap_err();
+        assert!(
+            matches!(&e, ScenarioError::InvalidScenario { field: f, .. } if f == field),
+            "{text}: {e}"
+        );
+    }
+}
+
+#[test]
 fn load_takes_a_builtin_name_or_a_file() {
     assert_eq!(
         Scenario::load("a4-con").unwrap(),

@@ -293,6 +293,9 @@ impl Scenario {
             ));
         }
         self.law.validate()?;
+        if let Some(detection) = &self.fault_detection {
+            detection.validate(&self.law.offset_free)?;
+        }
         Ok(())
     }
 }

@@ -1,5 +1,6 @@
 //! The diagnostics schema: what a controller may report at each tick, recorded in the samples
-//! and logged on `/planner`, `/control`, `/allocation` and `/lyapunov` (see the module `log`).
+//! and logged on `/planner`, `/control`, `/allocation`, `/lyapunov` and `/fault` (see the module
+//! `log`).
 //! The field names are the MCAP messages' and stay stable.
 
 use serde::{Deserialize, Serialize};
@@ -132,6 +133,60 @@ pub struct HoverDiagnostics {
     pub refused: Option<String>,
 }
 
+/// The fault detector's verdict of one period (`tvmd_core::FaultVerdict`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FaultVerdictName {
+    /// The residual is within the noise.
+    #[default]
+    Nominal,
+    /// Above the threshold, no single agent explains it.
+    Unexplained,
+    /// One agent explains it, for fewer periods than the persistence.
+    Suspected,
+    /// One agent explained it for the persistence's periods.
+    Confirmed,
+}
+
+/// What an isolated agent's residual looks like (`tvmd_core::FaultKind`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FaultKindName {
+    /// It delivers (almost) nothing.
+    Loss,
+    /// It delivers a fraction (`efficiency`).
+    PartialLoss,
+    /// Its force turned away from the command.
+    StuckGimbal,
+}
+
+/// The fault detector's report of one period (logged on `/fault`), when the controller runs
+/// one (`[fault_detection]`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FaultDiagnostics {
+    /// The residual in noise units, `||r||_Sigma`.
+    pub statistic: f64,
+    /// The threshold `k` it is compared with.
+    pub threshold: f64,
+    /// The verdict.
+    pub verdict: FaultVerdictName,
+    /// The isolated agent (suspected or confirmed).
+    #[serde(default)]
+    pub agent: Option<usize>,
+    /// What its residual looks like.
+    #[serde(default)]
+    pub kind: Option<FaultKindName>,
+    /// The fraction delivered, for a partial loss.
+    #[serde(default)]
+    pub efficiency: Option<f64>,
+    /// Consecutive periods the agent has been the candidate (suspected).
+    #[serde(default)]
+    pub periods: u32,
+    /// The agent the controller masked itself this period (`response = "mask"`).
+    #[serde(default)]
+    pub masked: Option<usize>,
+}
+
 /// Optional diagnostics returned by a controller; every present part is logged and recorded.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Diagnostics {
@@ -153,4 +208,7 @@ pub struct Diagnostics {
     /// The hover classification, at the tick a new failure mask was accepted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hover: Option<HoverDiagnostics>,
+    /// The fault detector's report, when the controller runs one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault: Option<FaultDiagnostics>,
 }

@@ -48,8 +48,8 @@ pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{
-    FlightDifference, Observation, PaperMetrics, RunResult, RunSummary, Sample, SampleRetention,
-    SimOptions, Simulation, Stepped, Verdict,
+    FaultEvent, FaultSummary, FlightDifference, Observation, PaperMetrics, RunResult, RunSummary,
+    Sample, SampleRetention, SimOptions, Simulation, Stepped, Verdict,
 };
 pub use sink::{LoggedTick, SceneRecord, Tick, TickSink};
 pub use tick_log::McapSink;

@@ -7,7 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use tvmd_scenario::{LawConfig, NullSpaceConfig, Overrides, Precision, Scenario};
+use tvmd_scenario::{
+    FaultDetectionConfig, FaultResponseConfig, LawConfig, NullSpaceConfig, Overrides, Precision,
+    Scenario,
+};
 
 use crate::control::pil::PilTarget;
 use crate::runner::RunSpec;
@@ -70,6 +73,8 @@ pub struct RunRequest {
     pub team: Option<String>,
     /// Override of the control law (`[law]`).
     pub law: Option<LawConfig>,
+    /// Override of the fault detection (`[fault_detection]`).
+    pub fault_detection: Option<FaultDetectionConfig>,
     /// Override of the controller precision.
     pub precision: Option<Precision>,
     /// The processor-in-the-loop target, or `None` for the host.
@@ -92,6 +97,22 @@ impl RunRequest {
     /// The option `law` (`paper`, `offset-free`); the error names `law`.
     pub fn parse_law(text: &str) -> Result<LawConfig, SimError> {
         text.parse::<LawConfig>().map_err(|e| invalid("law", e))
+    }
+
+    /// The option `detect` (`report`, `mask`): the recommended fault detector with that
+    /// response; the error names `fault_detection`.
+    pub fn parse_fault_detection(text: &str) -> Result<FaultDetectionConfig, SimError> {
+        let response = match text {
+            "report" => FaultResponseConfig::Report,
+            "mask" => FaultResponseConfig::Mask,
+            other => {
+                return Err(invalid(
+                    "fault_detection",
+                    format!("unknown response `{other}` (known: report, mask)"),
+                ))
+            }
+        };
+        Ok(FaultDetectionConfig::with_response(response))
     }
 
     /// The option `pil` (`cortex-m4`, `cortex-m7`); the error names `pil`.
@@ -137,6 +158,7 @@ impl RunRequest {
             null_space: self.null_space,
             team: self.team.clone(),
             law: self.law,
+            fault_detection: self.fault_detection,
         }
     }
 

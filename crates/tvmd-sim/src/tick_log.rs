@@ -8,7 +8,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::diagnostics::{
-    AllocationDiagnostics, ControlDiagnostics, HoverDiagnostics, PlannerDiagnostics,
+    AllocationDiagnostics, ControlDiagnostics, FaultDiagnostics, HoverDiagnostics,
+    PlannerDiagnostics,
 };
 use crate::sink::{LoggedTick, Tick, TickSink};
 use crate::SimError;
@@ -202,6 +203,27 @@ fn hover(t: f64, h: &HoverDiagnostics) -> proto::Hover {
     }
 }
 
+fn fault(t: f64, f: &FaultDiagnostics) -> proto::Fault {
+    proto::Fault {
+        t,
+        statistic: f.statistic,
+        threshold: f.threshold,
+        verdict: kebab(&f.verdict),
+        agent: f.agent.and_then(|i| u32::try_from(i).ok()),
+        kind: f.kind.as_ref().map(kebab).unwrap_or_default(),
+        efficiency: f.efficiency,
+        masked: f.masked.and_then(|i| u32::try_from(i).ok()),
+    }
+}
+
+/// The kebab-case name serde gives a unit variant (`"partial-loss"`).
+fn kebab<V: serde::Serialize>(v: &V) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        _ => String::new(),
+    }
+}
+
 /// Writes the message `build` makes unless its kind is thinned on this tick: a heavy kind
 /// ([`tvmd_log::LogKind::is_heavy`], the one list of them) is written only on `heavy` ticks, and is not
 /// even built otherwise.
@@ -296,6 +318,9 @@ impl Tick {
         }
         if let Some(h) = &d.hover {
             log.write(t, &hover(t, h));
+        }
+        if let Some(f) = &d.fault {
+            log.write(t, &fault(t, f));
         }
         log.write(t, &frame_transform(t, &s.position, &s.rotation));
     }

@@ -139,6 +139,7 @@ impl CoreConfig {
             gain_schedule: tvmd_core::GainSchedule::AsGiven,
             offset_free: None,
             attitude_rate: None,
+            fault_detection: None,
         };
         self.law.apply(&mut settings)?;
         let alloc = AnyAllocator::from_name(self.allocator_name(), &Default::default())?;

@@ -43,6 +43,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             null_space,
             team,
             law,
+            detect,
             precision,
             pil,
             live,
@@ -61,6 +62,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             null_space,
             team,
             law,
+            detect,
             precision,
             pil,
             live: live.then_some(LiveOptions {

@@ -29,6 +29,7 @@ pub struct RunArgs {
     pub(crate) null_space: Option<tvmd_scenario::NullSpaceConfig>,
     pub(crate) team: Option<String>,
     pub(crate) law: Option<String>,
+    pub(crate) detect: Option<String>,
     pub(crate) precision: Option<String>,
     pub(crate) pil: Option<String>,
     pub(crate) live: Option<LiveOptions>,
@@ -44,6 +45,11 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         null_space: a.null_space,
         team: a.team,
         law: a.law.as_deref().map(RunRequest::parse_law).transpose()?,
+        fault_detection: a
+            .detect
+            .as_deref()
+            .map(RunRequest::parse_fault_detection)
+            .transpose()?,
         samples: plot_retention(a.plots.is_some()),
         ..RunRequest::default()
     }

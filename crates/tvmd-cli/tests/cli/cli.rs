@@ -297,3 +297,51 @@ fn null_space_option_reports_its_margins_and_rejects_bad_objectives() {
         assert!(stderr.contains(needle), "{spec}: {stderr}");
     }
 }
+
+#[test]
+fn detect_option_reports_the_fault_and_needs_the_observer() {
+    let dir = tmp_dir("detect");
+    // A6-Inc loses agent 0 at 0.5 s in a hover the controller is not told of.
+    let path = dir.join("loss.toml");
+    std::fs::write(
+        &path,
+        "name = \"loss\"\nduration = 1.2\ninitial_position = [0.0, 0.0, 1.5]\n\
+         [team]\npreset = \"a6-inc\"\n[reference]\nkind = \"hover\"\nposition = [0.0, 0.0, 1.5]\n\
+         [[failures]]\nagent = 0\ntime = 0.5\nkind = \"no-thrust\"\ncontroller_informed = false\n",
+    )
+    .unwrap();
+    let summary = dir.join("summary.json");
+    ok(bin()
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--no-log",
+            "--detect",
+            "mask",
+        ])
+        .args(["--summary", summary.to_str().unwrap()])
+        .output()
+        .unwrap());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let fault = &json["summary"]["fault"];
+    assert_eq!(fault["masked"]["agent"], 0, "{fault}");
+    // Without the option the summary has no detector.
+    ok(bin()
+        .args(["run", path.to_str().unwrap(), "--no-log"])
+        .args(["--summary", summary.to_str().unwrap()])
+        .output()
+        .unwrap());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert!(json["summary"].get("fault").is_none(), "{json}");
+    // The paper's law has no observer: refused, naming the field.
+    let out = bin()
+        .args(["run", path.to_str().unwrap(), "--no-log", "--law", "paper"])
+        .args(["--detect", "report"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("fault_detection"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

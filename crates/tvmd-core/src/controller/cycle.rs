@@ -151,6 +151,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(field) = checked {
             return Err(self.reject(InputError::Overflow { field }));
         }
+        self.note_wrench(&stage.allocation.wrench);
         self.previous = stage.commands;
         if let Some((state, pending)) = self.pending.take() {
             self.finish_offset_free(&state, pending, &stage.allocation);
@@ -219,6 +220,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(error) = error {
             return Err(self.reject(error));
         }
+        self.note_wrench(&output.allocation.wrench);
         self.previous = output.commands;
         if let Some(pending) = pending {
             self.finish_offset_free(state, pending, &output.allocation);
@@ -241,18 +243,20 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Err(error) = checked {
             return Err(self.reject(error));
         }
-        let gains = &self.gains;
-        let mut u_fr = force_request(&self.plant, gains, state, reference);
+        let mut u_fr = force_request(&self.plant, &self.gains, state, reference);
         // Offset-free: the compensation joins the request before the projection and the
         // planner (skipped entirely when off, so the paper's cycle is bit for bit unchanged).
         let compensation = if self.offset_free.is_on() {
             self.offset_free.begin(&self.plant, state);
+            // The detector reads the estimate just measured (and may mask an agent now).
+            self.detect_faults(state);
             let c = self.offset_free.compensation();
             u_fr += state.attitude.transpose() * c.force;
             Some(c)
         } else {
             None
         };
+        let gains = &self.gains;
         let projection = project_force_in(&self.full_cone, &u_fr);
         let f_r = state.attitude * u_fr * projection.t_tf;
         // `reference.attitude` passed `reference.validate()` above.

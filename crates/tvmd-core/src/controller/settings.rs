@@ -6,6 +6,7 @@ use crate::allocation::NullSpaceStage;
 use crate::attitude_rate::AttitudeRateFilter;
 use crate::disturbance::DisturbanceObserver;
 use crate::error::{ConfigError, ConfigField};
+use crate::fault_detection::FaultDetection;
 use crate::gain_schedule::GainSchedule;
 use crate::law::Gains;
 use crate::limits::RateLimits;
@@ -63,6 +64,11 @@ pub struct ControllerSettings<T: Real> {
     /// law's `Omega_d`, `Omega_d_dot` are those of the planner's `R_d` in place of the
     /// reference's; `None`: the reference's (the paper).
     pub attitude_rate: Option<AttitudeRateFilter<T>>,
+    /// Optional agent fault detection ([`FaultDetection`]; needs the disturbance observer,
+    /// [`OffsetFree::Observer`], whose estimate is its residual): a verdict each period
+    /// ([`crate::Controller::fault_report`]) and, with [`crate::FaultResponse::Mask`], the
+    /// controller masks a confirmed lost agent itself. `None`: no detection (the paper).
+    pub fault_detection: Option<FaultDetection<T>>,
 }
 
 impl<T: Real> Default for ControllerSettings<T> {
@@ -88,6 +94,7 @@ impl<T: Real> ControllerSettings<T> {
             gain_schedule: GainSchedule::AsGiven,
             offset_free: None,
             attitude_rate: None,
+            fault_detection: None,
         }
     }
 

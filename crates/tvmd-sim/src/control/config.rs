@@ -5,8 +5,8 @@
 use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, AttitudeRateFilter, ControllerSettings,
-    DisturbanceObserver, FailureMask, GainSchedule, Gains, IntegralAction, NaturalGains, Navigator,
-    OffsetFree, RateLimits, Relaxation, TeamConfig,
+    DisturbanceObserver, FailureMask, FaultDetection, FaultResponse, GainSchedule, Gains,
+    IntegralAction, NaturalGains, Navigator, OffsetFree, RateLimits, Relaxation, TeamConfig,
 };
 
 use super::convert::{matrix_to_core, to_core, vector_to_core, CoreFloat};
@@ -14,7 +14,8 @@ use super::MAX_AGENTS;
 use crate::SimError;
 use tvmd_plant::math::from_rows;
 use tvmd_scenario::{
-    AttitudeRateConfig, GainScheduleConfig, LawConfig, OffsetFreeConfig, Scenario,
+    AttitudeRateConfig, FaultDetectionConfig, FaultResponseConfig, GainScheduleConfig, LawConfig,
+    OffsetFreeConfig, Scenario,
 };
 
 pub(super) fn invalid(field: &str, reason: impl Into<String>) -> SimError {
@@ -54,6 +55,10 @@ fn config_field(e: &ConfigError) -> &'static str {
         Some(ConfigField::OffsetFreeTorqueBound) => "law.offset_free.max_torque",
         Some(ConfigField::AttitudeRateBandwidth) => "law.attitude_rate.bandwidth",
         Some(ConfigField::AttitudeRateLimit) => "law.attitude_rate.max_rate",
+        Some(ConfigField::FaultNoise) => "fault_detection.model_error",
+        Some(ConfigField::FaultThreshold) => "fault_detection.threshold",
+        Some(ConfigField::FaultPersistence) => "fault_detection.persistence",
+        Some(ConfigField::FaultResidual) => "fault_detection",
         Some(ConfigField::RateLimits) => "controller_rate_limits",
         Some(ConfigField::Period) => "controller_period",
         Some(ConfigField::Gravity) => "physics.gravity",
@@ -144,7 +149,29 @@ pub fn controller_settings<T: CoreFloat>(
         gain_schedule,
         offset_free,
         attitude_rate,
+        fault_detection: scenario
+            .fault_detection
+            .as_ref()
+            .map(fault_detection)
+            .transpose()?,
     })
+}
+
+/// The core's fault detection of a scenario's `[fault_detection]` in `T`.
+pub fn fault_detection<T: CoreFloat>(
+    config: &FaultDetectionConfig,
+) -> Result<FaultDetection<T>, SimError> {
+    let response = match config.response {
+        FaultResponseConfig::Report => FaultResponse::Report,
+        FaultResponseConfig::Mask => FaultResponse::Mask,
+    };
+    FaultDetection::new(
+        to_core(config.model_error),
+        to_core(config.threshold),
+        config.persistence,
+        response,
+    )
+    .map_err(config_error)
 }
 
 /// The core's settings of the scenario's `[law]` in `T`: the gain schedule, the offset-free

@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 use super::convert::{array_to_sim, matrix_to_sim, to_sim, vector_to_sim, CoreFloat};
 use super::CoreOutput;
 use crate::diagnostics::{
-    AllocationDiagnostics, ControlDiagnostics, Diagnostics, LyapunovDiagnostics,
-    NullSpaceDiagnostics, PlannerDiagnostics,
+    AllocationDiagnostics, ControlDiagnostics, Diagnostics, FaultDiagnostics, FaultKindName,
+    FaultVerdictName, LyapunovDiagnostics, NullSpaceDiagnostics, PlannerDiagnostics,
 };
-use tvmd_core::PlannerStatus;
+use tvmd_core::{FaultKind, FaultReport, FaultVerdict, PlannerStatus};
 use tvmd_plant::math::{planned_roll, to_rows};
 
 /// The diagnostics of `out` for a team of `n` agents, with the controller's failure note.
@@ -77,5 +77,45 @@ pub(super) fn cycle_diagnostics<T: CoreFloat>(
         cycle_error: None,
         failure_note,
         hover: None,
+        fault: None,
+    }
+}
+
+/// The detector's report in f64 (no agent masked: the caller fills `masked`).
+pub(super) fn fault_diagnostics<T: CoreFloat>(report: &FaultReport<T>) -> FaultDiagnostics {
+    let (verdict, agent, kind, periods) = match report.verdict {
+        FaultVerdict::Nominal => (FaultVerdictName::Nominal, None, None, 0),
+        FaultVerdict::Unexplained => (FaultVerdictName::Unexplained, None, None, 0),
+        FaultVerdict::Suspected {
+            agent,
+            kind,
+            periods,
+        } => (
+            FaultVerdictName::Suspected,
+            Some(agent),
+            Some(kind),
+            periods,
+        ),
+        FaultVerdict::Confirmed { agent, kind } => {
+            (FaultVerdictName::Confirmed, Some(agent), Some(kind), 0)
+        }
+    };
+    let (kind, efficiency) = match kind {
+        None => (None, None),
+        Some(FaultKind::Loss) => (Some(FaultKindName::Loss), None),
+        Some(FaultKind::PartialLoss { efficiency }) => {
+            (Some(FaultKindName::PartialLoss), Some(to_sim(efficiency)))
+        }
+        Some(FaultKind::StuckGimbal) => (Some(FaultKindName::StuckGimbal), None),
+    };
+    FaultDiagnostics {
+        statistic: to_sim(report.statistic),
+        threshold: to_sim(report.threshold),
+        verdict,
+        agent,
+        kind,
+        efficiency,
+        periods,
+        masked: None,
     }
 }

@@ -2,7 +2,9 @@
 //! [`CoreController`] and by the processor-in-the-loop link (module `pil`), and wrapped by the
 //! cycle recorder (module `recording`). [`super::TvmdController`] drives any of them alike.
 
-use tvmd_core::{AgentCommand, FailureMask, HoverCapability, Reference, RigidState};
+use tvmd_core::{
+    AgentCommand, FailureMask, FaultMasking, FaultReport, HoverCapability, Reference, RigidState,
+};
 
 use super::convert::CoreFloat;
 use super::{CoreController, CoreOutput, MAX_AGENTS};
@@ -47,6 +49,17 @@ pub trait CoreEngine<T: CoreFloat> {
         state: &RigidState<T>,
         reference: &Reference<T>,
     ) -> Result<CycleAnswer<T>, BoxedError>;
+
+    /// [`tvmd_core::Controller::fault_report`] of the last cycle (`None` by default: an
+    /// engine without the detector, e.g. the processor-in-the-loop firmware).
+    fn fault_report(&self) -> Option<FaultReport<T>> {
+        None
+    }
+
+    /// [`tvmd_core::Controller::fault_masking`]: the last mask the core set itself.
+    fn fault_masking(&self) -> Option<FaultMasking<T>> {
+        None
+    }
 }
 
 impl<T: CoreFloat> CoreEngine<T> for CoreController<T> {
@@ -77,5 +90,13 @@ impl<T: CoreFloat> CoreEngine<T> for CoreController<T> {
                 commands: e.commands,
             }),
         )
+    }
+
+    fn fault_report(&self) -> Option<FaultReport<T>> {
+        tvmd_core::Controller::fault_report(self).copied()
+    }
+
+    fn fault_masking(&self) -> Option<FaultMasking<T>> {
+        tvmd_core::Controller::fault_masking(self)
     }
 }

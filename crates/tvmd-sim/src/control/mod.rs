@@ -29,7 +29,7 @@
 
 use tvmd_core::{AnyAllocator, FailureMask};
 
-use crate::diagnostics::{Diagnostics, HoverDiagnostics};
+use crate::diagnostics::{Diagnostics, FaultDiagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightInput, FlightOutput};
 use crate::SimError;
@@ -95,6 +95,11 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     touchdown: Touchdown,
     /// What the core was last told by `set_landed`.
     landed: bool,
+    /// The agents the core masked itself (`[fault_detection] response = "mask"`): kept in
+    /// every mask passed on, so the scenario's flags do not unmask them.
+    detected: Vec<bool>,
+    /// The agent of the last self-masking seen ([`tvmd_core::FaultMasking::agent`]).
+    masking_seen: Option<usize>,
 }
 
 impl<T: CoreFloat> TvmdController<T> {
@@ -139,6 +144,8 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             landing: None,
             touchdown: Touchdown::default(),
             landed: false,
+            detected: vec![false; n],
+            masking_seen: None,
         }
     }
 
@@ -159,7 +166,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         failed: &[bool],
     ) -> Result<(), BoxedError> {
         let wanted: Vec<bool> = (0..self.n)
-            .map(|i| failed.get(i).copied().unwrap_or(false))
+            .map(|i| failed.get(i).copied().unwrap_or(false) || self.detected[i])
             .collect();
         if wanted == self.mask || self.refused.as_ref() == Some(&wanted) {
             return Ok(());
@@ -173,24 +180,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             Ok(hover) => {
                 self.failure_note = None;
                 self.refused = None;
-                let land = !hover.capable
-                    && self.response.on_hover_loss == OnHoverLoss::Land
-                    && self.landing.is_none();
-                if land {
-                    self.landing = Some(Landing::start(
-                        t,
-                        &state.position,
-                        self.response.landing_acceleration,
-                    ));
-                }
-                self.hover = Some(HoverDiagnostics {
-                    capable: hover.capable,
-                    margin: convert::to_sim(hover.margin),
-                    limiting_agent: hover.limiting_agent,
-                    limit: hover.limit.as_str().to_string(),
-                    landing: land,
-                    refused: None,
-                });
+                self.accept_hover(t, state, &hover);
             }
             Err(e) => {
                 let note = format!(
@@ -216,6 +206,64 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             self.failure_note = Some(format!("failure mask {wanted:?} not applied"));
         }
         Ok(())
+    }
+}
+
+impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
+    /// An accepted mask's classification: reported, and with `on_hover_loss = "land"` a team
+    /// not hover-capable starts its landing.
+    fn accept_hover(&mut self, t: f64, state: &PlantState, hover: &tvmd_core::HoverCapability<T>) {
+        let land = !hover.capable
+            && self.response.on_hover_loss == OnHoverLoss::Land
+            && self.landing.is_none();
+        if land {
+            self.landing = Some(Landing::start(
+                t,
+                &state.position,
+                self.response.landing_acceleration,
+            ));
+        }
+        self.hover = Some(HoverDiagnostics {
+            capable: hover.capable,
+            margin: convert::to_sim(hover.margin),
+            limiting_agent: hover.limiting_agent,
+            limit: hover.limit.as_str().to_string(),
+            landing: land,
+            refused: None,
+        });
+    }
+
+    /// The detector's report of the cycle just run, and a mask the core set itself in it:
+    /// taken as the simulator's own (kept in later masks, classified, landing on a
+    /// hover-capability loss as for an informed failure).
+    fn fault_diagnostics(&mut self, t: f64, state: &PlantState) -> Option<FaultDiagnostics> {
+        let report = self.inner.fault_report()?;
+        let mut out = diagnostics::fault_diagnostics(&report);
+        let masking = self
+            .inner
+            .fault_masking()
+            .filter(|m| Some(m.agent) != self.masking_seen);
+        if let Some(m) = masking {
+            self.masking_seen = Some(m.agent);
+            if let Some(flag) = self.detected.get_mut(m.agent) {
+                *flag = true;
+            }
+            match &m.hover {
+                Some(hover) => {
+                    out.masked = Some(m.agent);
+                    self.accept_hover(t, state, hover);
+                }
+                None => {
+                    self.failure_note = Some(format!(
+                        "detected loss of agent {} not masked: the remaining team cannot \
+                         produce every wrench",
+                        m.agent
+                    ));
+                }
+            }
+            self.mask = self.inner.failures().as_array()[..self.n].to_vec();
+        }
+        Some(out)
     }
 }
 
@@ -252,14 +300,19 @@ impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
             });
         }
         let hover = self.hover.take();
-        match self.inner.step(
+        let answer = self.inner.step(
             &convert::core_state(state),
             &convert::core_reference(reference),
-        )? {
+        )?;
+        let fault = self.fault_diagnostics(t, state);
+        // A mask the core set itself this cycle is classified now; reported with this tick.
+        let hover = self.hover.take().or(hover);
+        match answer {
             Ok(out) => {
                 let mut diagnostics =
                     diagnostics::cycle_diagnostics(&out, n, self.failure_note.clone());
                 diagnostics.hover = hover;
+                diagnostics.fault = fault;
                 let commands = out.commands[..n].iter().map(sim_command).collect();
                 self.last = Some(out);
                 Ok(FlightOutput {

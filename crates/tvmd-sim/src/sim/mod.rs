@@ -58,8 +58,8 @@ pub use retention::{SampleRetention, SampleStore, MAX_KEPT_SAMPLES};
 pub use sample::Sample;
 pub use step::{Observation, Stepped};
 pub use summary::{
-    EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics, NullSpaceSummary,
-    PaperMetrics, RunSummary, RunTotals, SummaryFold, Verdict, VxRise,
+    EfficiencyMetrics, ErrorMetrics, FaultEvent, FaultSummary, FlightMetrics, MagnitudeMetrics,
+    NullSpaceSummary, PaperMetrics, RunSummary, RunTotals, SummaryFold, Verdict, VxRise,
 };
 
 /// The valid range of the physics: beyond it a run ends with `PhysicsError::Diverged` rather than

@@ -3,7 +3,7 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::diagnostics::{AllocationDiagnostics, HoverDiagnostics};
+use crate::diagnostics::{AllocationDiagnostics, FaultDiagnostics, HoverDiagnostics};
 use crate::flight::FlightOutput;
 use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::math::{from_rows, planned_roll, roll_pitch_yaw, rotation_distance};
@@ -63,6 +63,9 @@ pub struct Sample {
     pub cycle_error: bool,
     /// The hover classification, at the tick a new failure mask was accepted.
     pub hover: Option<HoverDiagnostics>,
+    /// The fault detector's report, when the controller runs one.
+    #[serde(default)]
+    pub fault: Option<FaultDiagnostics>,
     /// Commands returned at this tick.
     pub commands: Vec<ActuatorCommand>,
     /// Actual actuator outputs at this tick (before the new commands act).
@@ -151,6 +154,7 @@ impl Sample {
             v_r: d.lyapunov.map(|l| l.v_r),
             cycle_error: d.cycle_error.is_some(),
             hover: d.hover.clone(),
+            fault: d.fault,
             commands: out.commands.clone(),
             actual,
             failed,

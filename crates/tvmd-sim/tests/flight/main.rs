@@ -6,6 +6,7 @@ mod common;
 
 mod closed_loop;
 mod coarse_step;
+mod fault_detection;
 mod flight_metrics;
 mod hover_failure;
 mod null_space;

@@ -5,8 +5,8 @@
 use super::metrics::MetricsFold;
 use super::rules::{ArgMax, Max, MaxRise, Min, Nearest, Settling, Spacing};
 use super::{
-    e_f_visible, HoverClassification, NullSpaceSummary, PaperMetrics, RunSummary, RunTotals,
-    ATTITUDE_SETTLED, SETTLING_TIME,
+    e_f_visible, FaultSummary, HoverClassification, NullSpaceSummary, PaperMetrics, RunSummary,
+    RunTotals, ATTITUDE_SETTLED, SETTLING_TIME,
 };
 use tvmd_plant::math::roll_pitch_yaw;
 use tvmd_plant::reference::ReferenceConfig;
@@ -94,6 +94,7 @@ pub struct SummaryFold {
     cycle_errors: usize,
     margins: Margins,
     hover: Vec<HoverClassification>,
+    fault: Option<FaultSummary>,
     stage_b_settling: Option<Settling>,
     stage_b_max_attitude_error: Max,
     max_v_x_after_4s: Max,
@@ -135,6 +136,7 @@ impl SummaryFold {
             cycle_errors: 0,
             margins: Margins::default(),
             hover: Vec::new(),
+            fault: None,
             stage_b_settling: tilt
                 .map(|[b0, b1]| Settling::new(b0, b0 + 0.75 * (b1 - b0), ATTITUDE_SETTLED)),
             stage_b_max_attitude_error: Max::default(),
@@ -206,6 +208,11 @@ impl SummaryFold {
                 refused: h.refused.clone(),
             });
         }
+        if let Some(f) = &x.fault {
+            self.fault
+                .get_or_insert_with(FaultSummary::default)
+                .push(t, f);
+        }
         if let Some([b0, b1]) = self.tilt {
             if t >= b0 && t <= b1 {
                 self.stage_b_max_attitude_error.push_some(x.attitude_error);
@@ -274,6 +281,7 @@ impl SummaryFold {
             cycle_errors: self.cycle_errors,
             null_space: self.margins.get(),
             hover_classifications: self.hover.clone(),
+            fault: self.fault,
             controller_calls: totals.controller_calls,
             physics_steps: totals.physics_steps,
             wall_time: totals.wall_time,

@@ -7,6 +7,7 @@
 //! One rule picks the sample "at" a time: [`sample_at`], the nearest sample if it lies within
 //! half a sample spacing ([`rules::Nearest`]).
 
+mod fault;
 mod fold;
 pub mod metrics;
 pub mod rules;
@@ -20,6 +21,7 @@ use crate::sim::sample::Sample;
 use tvmd_plant::physics::PlantState;
 use tvmd_scenario::{Precision, Scenario};
 
+pub use fault::{FaultEvent, FaultSummary};
 pub use fold::SummaryFold;
 pub use metrics::{EfficiencyMetrics, ErrorMetrics, FlightMetrics, MagnitudeMetrics};
 pub use rules::Rise as VxRise;
@@ -166,6 +168,9 @@ pub struct RunSummary {
     pub null_space: Option<NullSpaceSummary>,
     /// The hover classifications, one per accepted change of the failure mask.
     pub hover_classifications: Vec<HoverClassification>,
+    /// What the fault detector reported, when the controller runs one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault: Option<FaultSummary>,
     /// Number of controller calls.
     pub controller_calls: usize,
     /// Number of physics steps.

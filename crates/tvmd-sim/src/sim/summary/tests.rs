@@ -27,6 +27,7 @@ pub(crate) fn sample(t: f64, x: f64, e_f: Option<f64>) -> Sample {
         v_r: None,
         cycle_error: false,
         hover: None,
+        fault: None,
         commands: Vec::new(),
         actual: Vec::new(),
         failed: Vec::new(),

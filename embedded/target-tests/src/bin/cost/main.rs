@@ -26,7 +26,8 @@ use tvmd_core::controller::roll;
 use tvmd_core::nalgebra::{convert, ComplexField, Vector3};
 use tvmd_core::team::presets;
 use tvmd_core::{
-    Allocator, Controller, ControllerSettings, ExactBoundaryRedistribution, PlannerStatus,
+    Allocator, Controller, ControllerSettings, ExactBoundaryRedistribution, FaultDetection,
+    FaultResponse, PlannerStatus,
     PseudoInverse, RedistributedPseudoInverse, Reference, RigidState, TeamConfig,
 };
 
@@ -153,9 +154,16 @@ fn report<const N: usize>(per_tick: u32) -> bool {
     for searching in [false, true] {
         let name = if searching { "searching" } else { "hover" };
         let mut paper_instructions = None;
+        let mut offset_free_instructions = None;
+        // The offset-free law with the fault detector reporting (issue 47).
+        let detecting = ControllerSettings {
+            fault_detection: Some(FaultDetection::recommended(FaultResponse::Report)),
+            ..ControllerSettings::offset_free_law()
+        };
         for (law, settings) in [
             ("paper", ControllerSettings::paper()),
             ("offset-free", ControllerSettings::offset_free_law()),
+            ("detecting", detecting),
         ] {
             let Some(m) =
                 measure::<N, _>(searching, settings, RedistributedPseudoInverse, per_tick)
@@ -183,6 +191,19 @@ fn report<const N: usize>(per_tick: u32) -> bool {
                 m.iterations,
                 if as_intended { "" } else { "  FAIL: not the intended planner case" }
             );
+            if law == "detecting" {
+                let extra = m.instructions.saturating_sub(offset_free_instructions.unwrap_or(0));
+                hprintln!(
+                    "cost: n = {:2} {:9} cycle: the fault detector costs {} instructions more than the offset-free law",
+                    N,
+                    name,
+                    extra
+                );
+                continue;
+            }
+            if law == "offset-free" {
+                offset_free_instructions = Some(m.instructions);
+            }
             match paper_instructions {
                 None => paper_instructions = Some(m.instructions),
                 Some(paper) => {

@@ -1,0 +1,250 @@
+//! Agent fault detection inside the controller ([`ControllerSettings::fault_detection`]): each
+//! period the disturbance observer's raw measurement of the last period, rotated into the body
+//! frame and low-passed at the observer's bandwidths (the same first-order filter, but not
+//! held by the anti-windup, which freezes the observer's estimate exactly when a lost agent
+//! saturates the others), is the residual that [`crate::fault`] reads against the working
+//! agents' blocks and the forces allocated for the period it measures. On a confirmed loss the controller either reports it
+//! ([`FaultResponse::Report`]: the caller decides) or masks the agent itself
+//! ([`FaultResponse::Mask`]: [`Controller::set_failures`], whose hover-capability certificate
+//! [`Controller::fault_masking`] reports). `docs/method.md`, "Beyond the paper: agent faults".
+//!
+//! The settings ([`crate::FaultDetection`]) and how their noise is resolved for the team are in
+//! [`crate::fault_detection`].
+
+use nalgebra::{Vector3, Vector6};
+
+use super::{Controller, ControllerSettings};
+use crate::allocation::Allocator;
+use crate::error::{ConfigError, ConfigField};
+use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
+use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE};
+use crate::hover::HoverCapability;
+use crate::law::RigidState;
+use crate::offset_free::OffsetFree;
+use crate::real::{lit, Real};
+use crate::team::TeamConfig;
+
+/// A mask the controller set itself on a confirmed loss ([`FaultResponse::Mask`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultMasking<T: Real> {
+    /// The agent masked.
+    pub agent: usize,
+    /// The hover-capability certificate of the mask in force
+    /// ([`Controller::hover_capability`]); `None` when the mask was refused (the remaining
+    /// team cannot produce every wrench: the old mask kept, not tried again for this agent).
+    pub hover: Option<HoverCapability<T>>,
+}
+
+/// What the monitor keeps of a masking (the certificate is the controller's own).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Masked {
+    agent: u32,
+    refused: bool,
+}
+
+/// The detector's state inside a controller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct FaultMonitor<T: Real> {
+    response: FaultResponse,
+    detector: FaultDetector<T>,
+    state: FaultState,
+    /// `1 - e^(-L dt)` of the observer's torque and force bandwidths.
+    gamma: (T, T),
+    /// The filtered residual `[r_tau; r_f]` (`{C}`).
+    residual: Vector6<T>,
+    /// Its slow baseline ([`FAULT_BASELINE_BANDWIDTH`]): the model error's persistent part,
+    /// held while the statistic is above half the threshold.
+    baseline: Vector6<T>,
+    /// The wrench `M f` allocated for the coming period.
+    wrench: Vector6<T>,
+    /// `(||Delta u_tau||, ||Delta u_f||)`: how much the allocated wrench jumped at the start
+    /// of the period the next residual measures. Actuators that lag (servos, rotors) deliver
+    /// part of the old wrench for part of that period, so the residual's noise grows by it.
+    jump: (T, T),
+    report: Option<FaultReport<T>>,
+    masked: Option<Masked>,
+}
+
+impl<T: Real> FaultMonitor<T> {
+    /// The monitor of `settings` for `team` (`None` when detection is off). Errors when
+    /// detection is on without the disturbance observer ([`ConfigField::FaultResidual`]) or
+    /// the team's noise cannot be resolved.
+    pub(super) fn new<const N: usize>(
+        settings: &ControllerSettings<T>,
+        team: &TeamConfig<T, N>,
+        weight: T,
+    ) -> Result<Option<Self>, ConfigError> {
+        let Some(detection) = settings.fault_detection else {
+            return Ok(None);
+        };
+        let Some(OffsetFree::Observer(observer)) = settings.offset_free else {
+            return Err(ConfigError::Parameter {
+                field: ConfigField::FaultResidual,
+            });
+        };
+        let gamma = |l: T| T::one() - (-(l * settings.period)).exp();
+        let arm = team
+            .agents()
+            .iter()
+            .fold(T::zero(), |a, s| a.max(s.position.norm()));
+        Ok(Some(Self {
+            response: detection.response(),
+            detector: detection.detector(weight, arm)?,
+            state: FaultState::new(),
+            gamma: (
+                gamma(observer.torque_bandwidth()),
+                gamma(observer.force_bandwidth()),
+            ),
+            residual: Vector6::zeros(),
+            baseline: Vector6::zeros(),
+            wrench: Vector6::zeros(),
+            jump: (T::zero(), T::zero()),
+            report: None,
+            masked: None,
+        }))
+    }
+
+    /// Forgets the candidate, the residual and the report (a controller reset).
+    pub(super) fn reset(&mut self) {
+        self.state.reset();
+        self.residual = Vector6::zeros();
+        self.baseline = Vector6::zeros();
+        self.wrench = Vector6::zeros();
+        self.jump = (T::zero(), T::zero());
+        self.report = None;
+    }
+
+    /// Filters this period's measurement (`{I}` force, `{C}` torque) into the residual.
+    fn filter(&mut self, attitude_t: &nalgebra::Matrix3<T>, d_f: &Vector3<T>, d_tau: &Vector3<T>) {
+        let f = attitude_t * d_f;
+        let measured = Vector6::new(d_tau.x, d_tau.y, d_tau.z, f.x, f.y, f.z);
+        let (g_tau, g_f) = self.gamma;
+        for (k, (r, m)) in self.residual.iter_mut().zip(measured.iter()).enumerate() {
+            let g = if k < 3 { g_tau } else { g_f };
+            *r += (*m - *r) * g;
+        }
+    }
+}
+
+impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
+    /// This period's detection, after the observer measured the last period: the filtered
+    /// residual `[r_tau; r_f]` against the working agents; with [`FaultResponse::Mask`], a
+    /// confirmed loss masks the agent now (this period's projection and allocation already
+    /// fly without it) and clears the observer's estimate and the residual, which held that
+    /// agent's wrench.
+    pub(super) fn detect_faults(&mut self, state: &RigidState<T>) {
+        let measurement = self.offset_free.observer_measurement();
+        let period = self.settings.period;
+        let landed = self.offset_free.landed();
+        let Some(monitor) = self.fault.as_mut() else {
+            return;
+        };
+        if landed {
+            // On the ground: nothing to read, and nothing carried into the next flight.
+            monitor.reset();
+            return;
+        }
+        if let Some((d_f, d_tau)) = measurement {
+            monitor.filter(&state.attitude.transpose(), &d_f, &d_tau);
+        }
+        // The forces of the commands held over the period the residual measures.
+        let mut forces = [Vector3::zeros(); N];
+        for (f, c) in forces.iter_mut().zip(&self.previous) {
+            *f = c.force();
+        }
+        let change = monitor.residual - monitor.baseline;
+        // The stated noise, grown by the last jump of the commanded wrench.
+        let d = &monitor.detector;
+        let half = lit::<T>(FAULT_JUMP_SHARE);
+        let (j_tau, j_f) = (monitor.jump.0 * half, monitor.jump.1 * half);
+        let detector = FaultDetector::new(
+            d.force_noise() + j_f,
+            d.torque_noise() + j_tau,
+            d.threshold(),
+            d.persistence(),
+        )
+        .unwrap_or(*d);
+        let report = monitor.state.update(
+            &detector,
+            &change,
+            self.effectiveness.blocks(),
+            &forces,
+            &self.failures,
+        );
+        monitor.report = Some(report);
+        // The baseline follows the slow model error, not a fault: held above half the threshold.
+        if report.statistic <= report.threshold * lit(0.5) {
+            // `L_b dt`, the baseline's gain (first order in `L_b dt`, which is small).
+            let slow = lit::<T>(FAULT_BASELINE_BANDWIDTH) * period;
+            monitor.baseline += (monitor.residual - monitor.baseline) * slow;
+        }
+        let FaultVerdict::Confirmed {
+            agent,
+            kind: FaultKind::Loss,
+        } = report.verdict
+        else {
+            return;
+        };
+        let refused_before = monitor
+            .masked
+            .as_ref()
+            .is_some_and(|m| m.agent as usize == agent && m.refused);
+        if monitor.response != FaultResponse::Mask || refused_before {
+            return;
+        }
+        let mut mask = self.failures;
+        let hover = mask.set(agent, true).and_then(|()| self.set_failures(mask));
+        if hover.is_ok() {
+            self.offset_free.reset();
+        }
+        if let Some(monitor) = self.fault.as_mut() {
+            monitor.state.reset();
+            if hover.is_ok() {
+                monitor.residual = Vector6::zeros();
+                monitor.baseline = Vector6::zeros();
+            }
+            monitor.masked = Some(Masked {
+                // agent < N, a slot of the mask.
+                agent: u32::try_from(agent).unwrap_or(u32::MAX),
+                refused: hover.is_err(),
+            });
+        }
+    }
+
+    /// The wrench `M f` allocated for the coming period, for the next period's detection
+    /// (nothing without detection).
+    pub(super) fn note_wrench(&mut self, wrench: &Vector6<T>) {
+        if let Some(monitor) = self.fault.as_mut() {
+            // A non-finite wrench (refused before it is sent) is not recorded.
+            if wrench.iter().all(|x| x.is_finite()) {
+                let jump = wrench - monitor.wrench;
+                let (tau, f) = (
+                    jump.fixed_rows::<3>(0).norm(),
+                    jump.fixed_rows::<3>(3).norm(),
+                );
+                monitor.jump = if tau.is_finite() && f.is_finite() {
+                    (tau, f)
+                } else {
+                    (T::zero(), T::zero())
+                };
+                monitor.wrench = *wrench;
+            }
+        }
+    }
+
+    /// The detector's report of the last law stage: verdict, statistic, threshold, misfits
+    /// (`None` when detection is off, before the first period, or while landed).
+    pub fn fault_report(&self) -> Option<&FaultReport<T>> {
+        self.fault.as_ref().and_then(|m| m.report.as_ref())
+    }
+
+    /// The last mask the controller set itself on a confirmed loss (`None` if it never did),
+    /// with the hover certificate of the mask in force.
+    pub fn fault_masking(&self) -> Option<FaultMasking<T>> {
+        let m = self.fault.as_ref()?.masked?;
+        Some(FaultMasking {
+            agent: m.agent as usize,
+            hover: (!m.refused).then_some(self.hover),
+        })
+    }
+}

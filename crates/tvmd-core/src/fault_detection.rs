@@ -1,0 +1,119 @@
+//! The controller's fault detection settings ([`FaultDetection`], [`FaultResponse`]): the stated
+//! relative model error, the threshold in its units, the persistence and what to do on a
+//! confirmed loss (`docs/method.md`, "Beyond the paper: agent faults"). The detector runs inside
+//! [`crate::Controller`] when [`crate::ControllerSettings::fault_detection`] is set.
+//!
+//! The noise is stated as a relative model error `epsilon` and resolved for the team at
+//! [`crate::Controller::new`]: `sigma_f = epsilon m_C g`, `sigma_tau = epsilon m_C g l` with `l`
+//! the largest agent distance `||p_i||`, so one setting fits every team (a loss of one of `n`
+//! agents at hover is about `1 / (n epsilon)` noise units in force alone).
+
+use crate::error::ConfigError;
+use crate::fault::FaultDetector;
+use crate::real::{lit, Real};
+
+/// Relative model error `epsilon` of [`FaultDetection::recommended`].
+pub const FAULT_MODEL_ERROR: f64 = 0.015;
+/// Threshold `k` (noise units) of [`FaultDetection::recommended`].
+pub const FAULT_THRESHOLD: f64 = 5.0;
+/// Bandwidth (rad/s) of the residual's slow baseline: the detector reads the residual's change
+/// from it, so the persistent part of the model error (a mass, inertia or centre-of-mass
+/// error, a steady wind) is not a fault, while a fault, which steps within a few periods, is
+/// read whole (the baseline is held while the statistic is above half the threshold).
+pub const FAULT_BASELINE_BANDWIDTH: f64 = 1.0;
+/// The share of the last jump of the commanded wrench added to the residual's stated noise:
+/// the part of a period the actuators (servo, rotor) may still deliver the old wrench.
+pub const FAULT_JUMP_SHARE: f64 = 0.5;
+/// Persistence (periods) of [`FaultDetection::recommended`].
+pub const FAULT_PERSISTENCE: u32 = 5;
+
+/// What the controller does when the detector confirms an agent's loss.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FaultResponse {
+    /// Report only ([`crate::Controller::fault_report`]): the caller keeps the decision.
+    #[default]
+    Report,
+    /// Mask the agent ([`crate::Controller::set_failures`]) and report it with the hover-capability
+    /// certificate ([`crate::Controller::fault_masking`]). Partial losses and stuck gimbals are
+    /// reported only.
+    Mask,
+}
+
+/// The controller's fault detection: the stated relative model error, the threshold in its
+/// units, the persistence and the response. Validated: each finite and positive
+/// (`persistence >= 1`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultDetection<T: Real> {
+    model_error: T,
+    threshold: T,
+    persistence: u32,
+    response: FaultResponse,
+}
+
+impl<T: Real> FaultDetection<T> {
+    /// `model_error` `epsilon`: one standard deviation of the residual without a fault, as a
+    /// fraction of the team's weight (force) and of its weight times the largest arm
+    /// (torque); `threshold` `k` in those units; `persistence` in periods.
+    ///
+    /// Errors: as [`FaultDetector::new`] ([`crate::ConfigField::FaultNoise`],
+    /// [`crate::ConfigField::FaultThreshold`], [`crate::ConfigField::FaultPersistence`]).
+    pub fn new(
+        model_error: T,
+        threshold: T,
+        persistence: u32,
+        response: FaultResponse,
+    ) -> Result<Self, ConfigError> {
+        FaultDetector::new(model_error, model_error, threshold, persistence)?;
+        Ok(Self {
+            model_error,
+            threshold,
+            persistence,
+            response,
+        })
+    }
+
+    /// [`FAULT_MODEL_ERROR`], [`FAULT_THRESHOLD`], [`FAULT_PERSISTENCE`] with `response`.
+    pub fn recommended(response: FaultResponse) -> Self {
+        Self {
+            model_error: lit(FAULT_MODEL_ERROR),
+            threshold: lit(FAULT_THRESHOLD),
+            persistence: FAULT_PERSISTENCE,
+            response,
+        }
+    }
+
+    /// `epsilon`.
+    pub fn model_error(&self) -> T {
+        self.model_error
+    }
+
+    /// `k`.
+    pub fn threshold(&self) -> T {
+        self.threshold
+    }
+
+    /// Periods that confirm a candidate.
+    pub fn persistence(&self) -> u32 {
+        self.persistence
+    }
+
+    /// The response to a confirmed loss.
+    pub fn response(&self) -> FaultResponse {
+        self.response
+    }
+
+    /// The same detection with another response.
+    pub fn with_response(self, response: FaultResponse) -> Self {
+        Self { response, ..self }
+    }
+
+    /// The detector for a team of weight `m_C g` (N) whose farthest agent is `arm` (m) from
+    /// the centre: `sigma_f = epsilon m_C g`, `sigma_tau = epsilon m_C g arm`.
+    ///
+    /// Errors: [`crate::ConfigField::FaultNoise`] when a noise is not finite and positive (e.g. a
+    /// single agent at the centre).
+    pub fn detector(&self, weight: T, arm: T) -> Result<FaultDetector<T>, ConfigError> {
+        let force = self.model_error * weight;
+        FaultDetector::new(force, force * arm, self.threshold, self.persistence)
+    }
+}

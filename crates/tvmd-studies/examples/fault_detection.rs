@@ -1,0 +1,332 @@
+//! The agent fault detector in flight (`docs/fault-detection.md`): detection and isolation
+//! delays per team, fault kind and flight phase; false alarms over nominal Monte Carlo flights;
+//! and the flight outcome with the controller not informed against the informed baseline.
+//!
+//! ```text
+//! cargo run --profile ci -p tvmd-studies --example fault_detection -- [FLIGHTS] [JOBS] [EPSILON]
+//! ```
+//!
+//! `FLIGHTS` nominal flights (default 1000) spread over A4-Inc, A6-Inc, A8-Inc and the hover,
+//! wind and tilt flights, each with a Monte Carlo draw of the default model-error distributions
+//! and the default conditions (servo dynamics, state noise, one period of feedback latency).
+//! The fault flights use the same draws and conditions: every agent of each team loses its
+//! thrust, half its thrust, or sticks its gimbal, at hover (t = 4 s) and in the tilt (t = 7 s),
+//! the controller not informed, detection on with the recommended settings and `response =
+//! "mask"`. Prints Markdown tables.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use tvmd_plant::actuators::FailureKind;
+use tvmd_scenario::{
+    Failure, FaultDetectionConfig, FaultResponseConfig, LawConfig, OnHoverLoss, Scenario,
+};
+use tvmd_sim::{run_scenario, FaultSummary, RunResult};
+use tvmd_studies::montecarlo::{Conditions, Distributions, Draw};
+
+const TEAMS: [&str; 3] = ["a4-inc", "a6-inc", "a8-inc"];
+const SEED: u64 = 47;
+
+/// The detector of every flight: the recommended one with `"mask"`, or another stated model
+/// error (the third argument).
+fn detection() -> FaultDetectionConfig {
+    let mut d = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
+    if let Some(e) = std::env::args().nth(3).and_then(|a| a.parse().ok()) {
+        d.model_error = e;
+    }
+    d
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    Hover,
+    Wind,
+    Tilt,
+}
+
+impl Phase {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Hover => "hover",
+            Self::Wind => "wind",
+            Self::Tilt => "tilt",
+        }
+    }
+
+    /// When a fault strikes in this phase.
+    fn fault_time(self) -> f64 {
+        match self {
+            Self::Hover | Self::Wind => 4.0,
+            // Mid-tilt: the reference rolls over 4-10 s.
+            Self::Tilt => 7.0,
+        }
+    }
+}
+
+/// The flight of `team` in `phase` with the offset-free law and detection (`"mask"`), a Monte
+/// Carlo draw `index` and the default conditions.
+fn flight(team: &str, phase: Phase, index: u64) -> Result<Scenario, Box<dyn std::error::Error>> {
+    let mut s = match phase {
+        Phase::Hover => Scenario::builtin("hover")?,
+        Phase::Wind => Scenario::builtin("wind")?,
+        Phase::Tilt => Scenario::default(),
+    };
+    s.team.preset = Some(team.into());
+    s.team.agents = None;
+    s.law = LawConfig::default();
+    s.fault_detection = Some(detection());
+    let n = s.team_body()?.len();
+    let mut s = Draw::new(&Distributions::default(), SEED, index, n).apply(&s)?;
+    Conditions::default().apply(&mut s, SEED, index);
+    s.validate()?;
+    Ok(s)
+}
+
+fn kind_name(k: FailureKind) -> &'static str {
+    match k {
+        FailureKind::NoThrust => "loss",
+        FailureKind::HalfThrust => "50% thrust",
+        FailureKind::StuckGimbal => "stuck gimbal",
+        FailureKind::NoThrustStuckGimbal => "loss + stuck",
+    }
+}
+
+/// One fault flight's result.
+struct FaultRun {
+    team: &'static str,
+    kind: FailureKind,
+    phase: Phase,
+    agent: usize,
+    fault: FaultSummary,
+    t_f: f64,
+}
+
+impl FaultRun {
+    /// Delay of an event to the fault when it names the right agent; `Err(())` for a wrong
+    /// agent or an event before the fault; `Ok(None)` when none.
+    fn delay(&self, event: Option<tvmd_sim::FaultEvent>) -> Result<Option<f64>, ()> {
+        match event {
+            None => Ok(None),
+            Some(e) if e.agent == self.agent && e.time >= self.t_f => Ok(Some(e.time - self.t_f)),
+            Some(_) => Err(()),
+        }
+    }
+}
+
+fn fault_runs(jobs: usize) -> Vec<FaultRun> {
+    let mut specs = Vec::new();
+    for (k, team) in TEAMS.iter().enumerate() {
+        let n = 4 + 2 * k;
+        for kind in [
+            FailureKind::NoThrust,
+            FailureKind::HalfThrust,
+            FailureKind::StuckGimbal,
+        ] {
+            for phase in [Phase::Hover, Phase::Tilt] {
+                for agent in 0..n {
+                    specs.push((*team, kind, phase, agent));
+                }
+            }
+        }
+    }
+    map(&specs, jobs, |k, &(team, kind, phase, agent)| {
+        let mut s = flight(team, phase, 10_000 + k as u64).ok()?;
+        let t_f = phase.fault_time();
+        s.duration = t_f + 3.0;
+        s.failures = vec![Failure {
+            agent,
+            time: t_f,
+            kind,
+            controller_informed: false,
+        }];
+        let r = run_scenario(&s, None, None).ok()?;
+        Some(FaultRun {
+            team,
+            kind,
+            phase,
+            agent,
+            fault: r.summary.fault.unwrap_or_default(),
+            t_f,
+        })
+    })
+}
+
+fn quantiles(mut v: Vec<f64>) -> String {
+    if v.is_empty() {
+        return "-".into();
+    }
+    v.sort_by(f64::total_cmp);
+    let median = v[v.len() / 2];
+    format!("{:.2} / {:.2}", median, v[v.len() - 1])
+}
+
+fn fault_table(runs: &[FaultRun]) {
+    println!("| team | fault | phase | flights | suspected (right agent) | delay median / worst (s) | confirmed (right agent) | delay median / worst (s) | loss confirmed, masked | delay median / worst (s) | wrong agent |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for team in TEAMS {
+        for kind in [
+            FailureKind::NoThrust,
+            FailureKind::HalfThrust,
+            FailureKind::StuckGimbal,
+        ] {
+            for phase in [Phase::Hover, Phase::Tilt] {
+                let group: Vec<&FaultRun> = runs
+                    .iter()
+                    .filter(|r| r.team == team && r.kind == kind && r.phase == phase)
+                    .collect();
+                let mut wrong = 0;
+                let mut column = |pick: &dyn Fn(&FaultRun) -> Option<tvmd_sim::FaultEvent>| {
+                    let mut delays = Vec::new();
+                    for r in &group {
+                        match r.delay(pick(r)) {
+                            Ok(Some(d)) => delays.push(d),
+                            Ok(None) => {}
+                            Err(()) => wrong += 1,
+                        }
+                    }
+                    (delays.len(), quantiles(delays))
+                };
+                let (ns, ds) = column(&|r| r.fault.first_suspected);
+                let (nc, dc) = column(&|r| r.fault.first_confirmed);
+                let (nm, dm) = column(&|r| r.fault.masked);
+                println!(
+                    "| {team} | {} | {} | {} | {ns} | {ds} | {nc} | {dc} | {nm} | {dm} | {wrong} |",
+                    kind_name(kind),
+                    phase.name(),
+                    group.len()
+                );
+            }
+        }
+    }
+}
+
+fn false_alarms(flights: usize, jobs: usize) {
+    let phases = [Phase::Hover, Phase::Wind, Phase::Tilt];
+    let specs: Vec<(usize, &str, Phase)> = (0..flights)
+        .map(|k| (k, TEAMS[k % 3], phases[(k / 3) % 3]))
+        .collect();
+    let done = AtomicUsize::new(0);
+    let rows = map(&specs, jobs, |_, &(k, team, phase)| {
+        let s = flight(team, phase, k as u64).ok()?;
+        let r = run_scenario(&s, None, None).ok()?;
+        let f = r.summary.fault.unwrap_or_default();
+        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+        if d % 100 == 0 {
+            eprintln!("{d} nominal flights");
+        }
+        Some((team, phase, f, r.summary.verdict.success))
+    });
+    println!("| team | flight | flights | over threshold | suspected | confirmed (false alarm) | masked | largest statistic / k | verdict ok |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for team in TEAMS {
+        for phase in phases {
+            let g: Vec<_> = rows
+                .iter()
+                .filter(|r| r.0 == team && r.1 == phase)
+                .collect();
+            let count = |p: &dyn Fn(&FaultSummary) -> bool| g.iter().filter(|r| p(&r.2)).count();
+            let worst = g
+                .iter()
+                .map(|r| r.2.max_statistic / r.2.threshold.max(1e-9))
+                .fold(0.0, f64::max);
+            println!(
+                "| {team} | {} | {} | {} | {} | {} | {} | {worst:.2} | {} |",
+                phase.name(),
+                g.len(),
+                count(&|f| f.first_alarm.is_some()),
+                count(&|f| f.first_suspected.is_some()),
+                count(&|f| f.first_confirmed.is_some()),
+                count(&|f| f.masked.is_some()),
+                g.iter().filter(|r| r.3).count(),
+            );
+        }
+    }
+}
+
+/// The largest position error and tilt (rad) from `from` on.
+fn after(r: &RunResult, from: f64) -> (f64, f64) {
+    r.samples
+        .iter()
+        .filter(|s| s.t >= from)
+        .fold((0.0f64, 0.0f64), |(e, tilt), s| {
+            let d = [0, 1, 2].map(|i| s.position[i] - s.reference_position[i]);
+            let err = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let [roll, pitch, _] = s.roll_pitch_yaw;
+            let c = roll.cos() * pitch.cos();
+            (e.max(err), tilt.max(c.clamp(-1.0, 1.0).acos()))
+        })
+}
+
+fn outcomes() -> Result<(), Box<dyn std::error::Error>> {
+    println!("| flight | controller | masked at (s) | peak position error after the fault (m) | max tilt after the fault (rad) | landed |");
+    println!("|---|---|---|---|---|---|");
+    for (name, land) in [("a6-agent-failure", false), ("agent-failure", true)] {
+        for (label, law, informed, detect) in [
+            ("paper law, informed", LawConfig::paper(), true, false),
+            ("offset-free, informed", LawConfig::default(), true, false),
+            (
+                "offset-free, not informed, detection",
+                LawConfig::default(),
+                false,
+                true,
+            ),
+            (
+                "offset-free, not informed, no detection",
+                LawConfig::default(),
+                false,
+                false,
+            ),
+        ] {
+            let mut s = Scenario::builtin(name)?;
+            s.law = law;
+            for f in &mut s.failures {
+                f.controller_informed = informed;
+            }
+            if land {
+                s.failure_response.on_hover_loss = OnHoverLoss::Land;
+            }
+            if detect {
+                s.fault_detection = Some(detection());
+            }
+            let t_f = s.failures[0].time;
+            let r = run_scenario(&s, None, None)?;
+            let (peak, tilt) = after(&r, t_f);
+            let masked = r
+                .summary
+                .fault
+                .and_then(|f| f.masked)
+                .map_or("-".into(), |m| format!("{:.2} (agent {})", m.time, m.agent));
+            let landed = r.summary.final_position[2] < 0.05;
+            println!(
+                "| {name}{} | {label} | {masked} | {peak:.3} | {tilt:.3} | {landed} |",
+                if land { " (land)" } else { "" }
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `f(k, item)` on `jobs` threads, the results in order (failed flights dropped).
+fn map<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    f: impl Fn(usize, &T) -> Option<R> + Sync,
+) -> Vec<R> {
+    tvmd_sim::pool::map_in_order(items, jobs, f)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .collect()
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let flights: usize = args.next().map_or(Ok(1000), |a| a.parse())?;
+    let jobs: usize = args.next().map_or(Ok(2), |a| a.parse())?;
+    println!("## Flight outcome, controller informed or not\n");
+    outcomes()?;
+    println!("\n## Detection and isolation delays (fault at t_f, not informed)\n");
+    fault_table(&fault_runs(jobs));
+    println!("\n## False alarms over {flights} nominal flights\n");
+    false_alarms(flights, jobs);
+    Ok(())
+}
