@@ -1,4 +1,4 @@
-//! Team presets: the authors' catalogue ([`Preset`]: A3 to A10 and T10, Con and Inc, with the
+//! Team presets: the authors' catalogue ([`Preset`](crate::team::presets::Preset): A3 to A10 and T10, Con and Inc, with the
 //! paper's A4 square), the paper's A4 teams, grid layouts and ring layouts for tests and the
 //! simulator.
 
