@@ -59,6 +59,67 @@
 #define TVMD_SERVO_CHANNELS 8
 
 /*
+ `fault.mode`: no detection (the paper's and the default configurations).
+ */
+#define TVMD_FAULT_OFF 0
+
+/*
+ `fault.mode`: detect and report (`tvmd_fault_report`); the caller keeps the decision.
+ */
+#define TVMD_FAULT_REPORT 1
+
+/*
+ `fault.mode`: detect, report, and mask an agent whose loss is confirmed.
+ */
+#define TVMD_FAULT_MASK 2
+
+/*
+ `TvmdFaultReport.verdict`: no report (detection off, or no period stepped yet).
+ */
+#define TVMD_FAULT_VERDICT_NONE 0
+
+/*
+ `TvmdFaultReport.verdict`: the residual is within the noise.
+ */
+#define TVMD_FAULT_VERDICT_NOMINAL 1
+
+/*
+ `TvmdFaultReport.verdict`: above the threshold, but no single agent explains it (a gust, a
+ payload, model error).
+ */
+#define TVMD_FAULT_VERDICT_UNEXPLAINED 2
+
+/*
+ `TvmdFaultReport.verdict`: `agent` explains it, for fewer periods than the persistence.
+ */
+#define TVMD_FAULT_VERDICT_SUSPECTED 3
+
+/*
+ `TvmdFaultReport.verdict`: `agent` explained it for the persistence's periods.
+ */
+#define TVMD_FAULT_VERDICT_CONFIRMED 4
+
+/*
+ `TvmdFaultReport.kind`: no agent named.
+ */
+#define TVMD_FAULT_KIND_NONE 0
+
+/*
+ `TvmdFaultReport.kind`: the agent delivers (almost) nothing of its command.
+ */
+#define TVMD_FAULT_KIND_LOSS 1
+
+/*
+ `TvmdFaultReport.kind`: the agent delivers the fraction `efficiency` of its command.
+ */
+#define TVMD_FAULT_KIND_PARTIAL_LOSS 2
+
+/*
+ `TvmdFaultReport.kind`: the agent's force turned away from its command (a stuck gimbal).
+ */
+#define TVMD_FAULT_KIND_STUCK_GIMBAL 3
+
+/*
  Bytes of a [`TvmdController`]: at least the controller's size on every supported target
  (checked at compile time), with room for the core to grow within one ABI version.
  */
@@ -371,6 +432,31 @@ typedef struct TvmdGains {
 } TvmdGains;
 
 /*
+ Fault detection settings. `tvmd_config_default` and `tvmd_config_paper` set the mode off and
+ the recommended numbers, so switching the mode on uses them.
+ */
+typedef struct TvmdFaultDetection {
+  /*
+   One of `TVMD_FAULT_*` (`OFF`, `REPORT`, `MASK`).
+   */
+  uint32_t mode;
+  /*
+   The stated relative model error `epsilon`: one standard deviation of the residual
+   without a fault, as a fraction of the team's weight (force) and of its weight times its
+   largest arm (torque); finite and positive (recommended 0.015).
+   */
+  float model_error;
+  /*
+   The threshold `k` in those noise units; finite and positive (recommended 5).
+   */
+  float threshold;
+  /*
+   Periods a verdict must hold to be confirmed, `>= 1` (recommended 5).
+   */
+  uint32_t persistence;
+} TvmdFaultDetection;
+
+/*
  The law beyond the paper: how the gains are formed, the offset-free action and the filter of
  the planned attitude's rates. All numbers SI. A mode reads only its own fields; the fields
  a mode does not use are ignored (any value, even NaN). Every number a mode uses must be
@@ -516,11 +602,62 @@ typedef struct TvmdConfig {
    */
   uint32_t allocator_max_rounds;
   /*
+   Agent fault detection (all zeros: off), see `TvmdFaultDetection`.
+   */
+  struct TvmdFaultDetection fault;
+  /*
    The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
    zeros: the paper's law).
    */
   struct TvmdLaw law;
 } TvmdConfig;
+
+/*
+ The detector's latest report and the controller's own mask.
+ */
+typedef struct TvmdFaultReport {
+  /*
+   `sizeof(TvmdFaultReport)`, set by the caller.
+   */
+  uint32_t size;
+  /*
+   One of `TVMD_FAULT_VERDICT_*`.
+   */
+  uint32_t verdict;
+  /*
+   The agent suspected or confirmed; -1 when none.
+   */
+  int32_t agent;
+  /*
+   One of `TVMD_FAULT_KIND_*` for that agent.
+   */
+  uint32_t kind;
+  /*
+   The delivered fraction with `TVMD_FAULT_KIND_PARTIAL_LOSS`, NaN otherwise.
+   */
+  float efficiency;
+  /*
+   Consecutive periods of a suspicion (0 otherwise).
+   */
+  uint32_t periods;
+  /*
+   The test statistic `||r||_Sigma` (noise units); NaN without a report.
+   */
+  float statistic;
+  /*
+   The threshold it was compared with; NaN without a report.
+   */
+  float threshold;
+  /*
+   The agent the controller masked itself (`TVMD_FAULT_MASK`); -1 when it has not.
+   */
+  int32_t masked_agent;
+  /*
+   Non-zero when that mask was accepted and the remaining team can hold hover (the
+   classification `tvmd_set_failures` returns); zero otherwise.
+   */
+  uint32_t masked_hover_capable;
+} TvmdFaultReport;
 
 /*
  The measured state: pose and body-frame twist.
@@ -1129,6 +1266,17 @@ TvmdStatus tvmd_config_default(struct TvmdConfig *config);
  `config` is null or points to a writable `TvmdConfig`.
  */
 TvmdStatus tvmd_config_paper(struct TvmdConfig *config);
+
+/*
+ Fills `report` (whose `size` the caller sets) with the detector's latest report: after a
+ `tvmd_step` (or `tvmd_law`) with detection on, the period's verdict; `verdict =
+ TVMD_FAULT_VERDICT_NONE` with detection off or before the first period.
+
+ # Safety
+ `handle` is null or points to a `TvmdController`; `report` is null or points to a
+ `TvmdFaultReport`.
+ */
+TvmdStatus tvmd_fault_report(const struct TvmdController *handle, struct TvmdFaultReport *report);
 
 /*
  The bytes of caller memory a controller needs (`sizeof(TvmdController)`).

@@ -5,6 +5,7 @@ use tvmd_core::team::presets;
 use tvmd_core::ControllerSettings;
 
 use crate::handle::checked_size;
+use crate::fault::TvmdFaultDetection;
 use crate::law::TvmdLaw;
 use crate::status::*;
 use crate::types::*;
@@ -62,6 +63,7 @@ unsafe fn fill(
         allocator: TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
         agent_weights: [1.0; TVMD_MAX_AGENTS],
         allocator_max_rounds: 0,
+        fault: TvmdFaultDetection::recommended_off(),
         law,
     };
     TVMD_OK

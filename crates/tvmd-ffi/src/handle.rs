@@ -176,7 +176,7 @@ pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> 
         gain_schedule: law.gain_schedule,
         offset_free: law.offset_free,
         attitude_rate: law.attitude_rate,
-        fault_detection: None,
+        fault_detection: config.fault.to_core()?,
     };
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,

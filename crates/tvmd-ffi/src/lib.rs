@@ -39,6 +39,7 @@ extern crate std;
 
 pub mod actuator;
 pub mod config;
+pub mod fault;
 pub mod handle;
 pub mod law;
 pub mod reconfigure;

@@ -11,6 +11,7 @@ use tvmd_core::{
     PlannerStatus, Reference, RigidState,
 };
 
+use crate::fault::TvmdFaultDetection;
 use crate::law::TvmdLaw;
 use crate::status::{ConvertError, TvmdStatus};
 use crate::TVMD_MAX_AGENTS;
@@ -126,6 +127,8 @@ pub struct TvmdConfig {
     /// zero: no cap (the walk's own `2 n + 4`). With another allocator a non-zero value is
     /// refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`).
     pub allocator_max_rounds: u32,
+    /// Agent fault detection (all zeros: off), see `TvmdFaultDetection`.
+    pub fault: TvmdFaultDetection,
     /// The law beyond the paper: gain schedule, offset-free action, planned-rate filter (all
     /// zeros: the paper's law).
     pub law: TvmdLaw,

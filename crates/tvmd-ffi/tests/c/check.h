@@ -47,4 +47,7 @@ void test_law(void);
 /* stages_test.c */
 void test_stages(void);
 
+/* fault_test.c */
+void test_fault(void);
+
 #endif

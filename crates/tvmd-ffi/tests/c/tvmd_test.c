@@ -517,6 +517,7 @@ int main(int argc, char **argv) {
   CHECK_STATUS(step(c, &s, &r, &o), TVMD_OK);
   test_law();
   test_stages();
+  test_fault();
 
   fclose(record);
   printf("tvmd C test: %d checks, %d failed\n", checks, failed);

@@ -39,7 +39,7 @@ const BOUNDS: [(&str, usize); 10] = [
     ("tvmd_validate_config", 24_576),
     ("tvmd_reconfigure", 28_672),
     ("tvmd_step", 12_800),
-    ("tvmd_law", 2_304),
+    ("tvmd_law", 2_560),
     ("tvmd_allocate", 12_288),
     ("tvmd_plan", 1_024),
     ("tvmd_set_failures", 6_144),
