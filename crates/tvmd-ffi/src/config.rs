@@ -4,8 +4,8 @@
 use tvmd_core::team::presets;
 use tvmd_core::ControllerSettings;
 
-use crate::handle::checked_size;
 use crate::fault::TvmdFaultDetection;
+use crate::handle::checked_size;
 use crate::law::TvmdLaw;
 use crate::status::*;
 use crate::types::*;
