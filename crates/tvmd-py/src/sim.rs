@@ -16,7 +16,9 @@ use crate::errors::value_error;
 use crate::runs::{batch_label, run_items, run_items_keeping, run_specs};
 use crate::runs::{sweep_label, sweep_run_specs};
 use crate::runs::{team_arg, RunArgs};
-use crate::sim_result::PySimResult;
+use crate::sim_result::{PySimResult, SimData};
+use tvmd_sim::runner::RunSpec;
+use tvmd_sim::SampleRetention;
 
 /// The names of the built-in scenarios.
 #[pyfunction]
@@ -131,6 +133,33 @@ fn relaxation_sweep(
     run_specs(py, specs, jobs, |_, s| sweep_label(s))
 }
 
+/// A run read back from the MCAP log it wrote (``run(..., mcap=path)``), as the ``SimResult``
+/// that run returned: one sample per controller tick (``sample_stride`` 1), every array equal to
+/// the in-memory result of a run that kept all its samples (the log stores every value as a
+/// float64, so the arrays are the same bits), the summary and paper metrics the run computed,
+/// and ``mcap_path`` the path given. On ticks a scenario's ``[log] decimation > 1`` thinned,
+/// the heavy topics are absent: the commands, actual outputs, forces, planner and allocation
+/// values of those samples are NaN.
+///
+/// Raises ``ValueError`` naming ``path`` if the file is missing, unreadable, not MCAP, or not a
+/// tvmd-sim run's log.
+#[pyfunction]
+#[pyo3(signature = (path))]
+fn load(py: Python<'_>, path: PathBuf) -> PyResult<PySimResult> {
+    let loaded = py
+        .detach(|| tvmd_sim::load_run(&path))
+        .map_err(|e| PyValueError::new_err(format!("cannot load the run log: {e}")))?;
+    let spec = RunSpec {
+        scenario: loaded.scenario,
+        log: Some(path),
+        pil: None,
+        samples: SampleRetention::All,
+    };
+    Ok(PySimResult {
+        inner: SimData::new(spec, loaded.result),
+    })
+}
+
 /// Adds the documentation and the run functions to the `sim` submodule.
 pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.setattr(
@@ -143,5 +172,6 @@ pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(run, sim)?)?;
     sim.add_function(wrap_pyfunction!(run_many, sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep, sim)?)?;
+    sim.add_function(wrap_pyfunction!(load, sim)?)?;
     Ok(())
 }

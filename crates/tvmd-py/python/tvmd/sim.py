@@ -12,6 +12,7 @@ ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``
   is the tvmd controller as :func:`run` flies it, for the same steps.
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
+* :func:`load` -- a run read back from its MCAP log, as the :class:`SimResult` it returned.
 * :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads, or one task per
   run on any ``concurrent.futures.Executor`` (``executor=``; results pickle back).
 * :func:`monte_carlo` -- a Monte Carlo study (model errors and initial conditions drawn per
@@ -91,6 +92,7 @@ ScenarioController = _sim.ScenarioController
 ControllerOutput = _sim.ControllerOutput
 builtin_scenarios = _sim.builtin_scenarios
 run = _sim.run
+load = _sim.load
 scenario_toml = _sim.scenario_toml
 # `SimResult.__reduce__` names it here: an executor's worker sends its result back pickled.
 _sim_result_from_state = _sim._sim_result_from_state
@@ -229,6 +231,7 @@ __all__ = [
     "Simulation",
     "SimulationBatch",
     "builtin_scenarios",
+    "load",
     "monte_carlo",
     "monte_carlo_flight",
     "monte_carlo_fly",

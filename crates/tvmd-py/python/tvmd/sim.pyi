@@ -646,6 +646,28 @@ def run(
             found (the message says how to install or build it).
     """
 
+def load(path: _PathArg) -> SimResult:
+    """A run read back from the MCAP log it wrote (``run(..., mcap=path)``), as the
+    :class:`SimResult` that run returned.
+
+    The log stores every value as a float64 (protobuf ``double``), so the arrays equal the
+    in-memory result's exactly (NaN where it has NaN) for a run that kept every tick
+    (``max_samples=None``): one sample per controller tick (``sample_stride`` 1). ``summary``
+    and ``paper_metrics`` are the ones the run computed (stored in the log's ``tvmd.result``
+    metadata); ``scenario_toml`` is the scenario that ran (``tvmd.scenario`` metadata);
+    ``mcap_path`` is ``path``. On ticks a scenario's ``[log] decimation > 1`` thinned, the
+    heavy topics are absent: those samples' commands, actual outputs, forces, rotor speeds,
+    planner and allocation values are NaN.
+
+    Args:
+        path: the ``.mcap`` file (a str or ``os.PathLike``).
+
+    Raises:
+        ValueError: the file is missing or unreadable, not MCAP, truncated, or not a tvmd-sim
+            run's log (no ``/state`` messages or no scenario metadata); the message names
+            ``path``.
+    """
+
 @overload
 def run_many(
     runs: Iterable[_RunItem],
