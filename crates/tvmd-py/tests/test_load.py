@@ -1,7 +1,8 @@
 """``tvmd.sim.load``: a run read back from its MCAP log equals the ``SimResult`` the run returned.
 
 The log stores every value as a protobuf ``double`` (float64), so the comparison is exact
-(NaN where the result has NaN): every array field, the summary, the paper metrics and the
+(NaN where the result has NaN; ``-0.0 == 0.0``, as protobuf does not keep the sign of a zero
+scalar): every array field, the summary, the paper metrics and the
 scalars. A missing, corrupt or foreign file is a ``ValueError`` naming the path.
 """
 

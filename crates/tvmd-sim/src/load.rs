@@ -2,7 +2,8 @@
 //! [`Sample`] per logged tick, and the summary of [`METADATA_RESULT`].
 //!
 //! Each tick's state, reference and controller output are rebuilt from its messages (every
-//! numeric field a protobuf `double`, so the loop's values exactly) and recorded with
+//! numeric field a protobuf `double`, so the loop's values exactly, except that a `-0.0` in a
+//! non-repeated field reads back as `0.0`: protobuf omits a field equal to zero) and recorded with
 //! [`Sample::record`], the function the loop records with: the samples equal the in-memory
 //! ones of a run that kept every tick. On the ticks a `[log] decimation > 1` thinned, the
 //! heavy topics are absent: those samples have no commands, actual outputs, planner or
