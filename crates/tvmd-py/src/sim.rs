@@ -26,7 +26,7 @@ fn builtin_scenarios() -> Vec<&'static str> {
     BUILTIN_NAMES.to_vec()
 }
 
-/// A built-in scenario as TOML text (every field). See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.scenario_toml.txt")]
 #[pyfunction]
 fn scenario_toml(name: &str) -> PyResult<String> {
     let scenario = Scenario::builtin(name);
@@ -35,7 +35,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
         .map_err(value_error)
 }
 
-/// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
+#[doc = include_str!("../docstrings/tvmd.sim.run.txt")]
 #[pyfunction]
 #[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None, law = None))]
 #[allow(clippy::too_many_arguments)]
@@ -76,8 +76,7 @@ fn run(
         .ok_or_else(|| PyRuntimeError::new_err("tvmd-sim returned no result"))
 }
 
-/// Runs many scenarios in parallel threads; results in input order (with `errors="keep"`, a
-/// failed run's exception in its place). See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.run_many.txt")]
 #[pyfunction]
 #[pyo3(signature = (runs, *, jobs = None, errors = "raise"))]
 fn run_many(
@@ -103,7 +102,7 @@ fn run_many(
     }
 }
 
-/// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.relaxation_sweep.txt")]
 #[pyfunction]
 #[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None, pil = None, max_samples = None))]
 #[allow(clippy::too_many_arguments)]
@@ -133,16 +132,7 @@ fn relaxation_sweep(
     run_specs(py, specs, jobs, |_, s| sweep_label(s))
 }
 
-/// A run read back from the MCAP log it wrote (``run(..., mcap=path)``), as the ``SimResult``
-/// that run returned: one sample per controller tick (``sample_stride`` 1), every array equal to
-/// the in-memory result of a run that kept all its samples (the log stores every value as a
-/// float64, so the arrays are the same bits), the summary and paper metrics the run computed,
-/// and ``mcap_path`` the path given. On ticks a scenario's ``[log] decimation > 1`` thinned,
-/// the heavy topics are absent: the commands, actual outputs, forces, planner and allocation
-/// values of those samples are NaN.
-///
-/// Raises ``ValueError`` naming ``path`` if the file is missing, unreadable, not MCAP, or not a
-/// tvmd-sim run's log.
+#[doc = include_str!("../docstrings/tvmd.sim.load.txt")]
 #[pyfunction]
 #[pyo3(signature = (path))]
 fn load(py: Python<'_>, path: PathBuf) -> PyResult<PySimResult> {

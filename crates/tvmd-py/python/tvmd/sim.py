@@ -50,7 +50,7 @@ def monte_carlo(
     jobs=None,
     executor=None,
 ):
-    """A Monte Carlo study; see the stub (``sim.pyi``) for the arguments and the result."""
+    """A Monte Carlo study of ``runs`` flights (the full docstring is the stub's, below)."""
     specs = _sim.monte_carlo_specs(
         scenario,
         toml=toml,
@@ -184,7 +184,7 @@ def _run_one_keeping(item, index):
 
 
 def run_many(runs, *, jobs=None, executor=None, errors="raise"):
-    """Many runs, results in input order; see the stub (``sim.pyi``)."""
+    """Many runs in parallel, results in input order (the full docstring is the stub's, below)."""
     if errors not in ("raise", "keep"):
         raise ValueError(f'`errors` must be "raise" or "keep", got {errors!r}')
     if executor is None:
@@ -209,7 +209,7 @@ def relaxation_sweep(
     max_samples=None,
     executor=None,
 ):
-    """The relaxation study; see the stub (``sim.pyi``)."""
+    """The paper's relaxation study (the full docstring is the stub's, below)."""
     kw = dict(
         toml=toml,
         allocator=allocator,
@@ -222,6 +222,29 @@ def relaxation_sweep(
         return _sim.relaxation_sweep(relaxations, scenario, jobs=jobs, **kw)
     items = _sim._relaxation_sweep_runs(relaxations, scenario, **kw)
     return _on_executor(items, jobs, executor, _run_swept)
+
+def _docs_from_stub(*functions):
+    # One source: these Python functions show the docstrings of ``sim.pyi`` (shipped beside this
+    # file) in ``help()``, as the Rust callables do (scripts/stub_docs.py). The longest
+    # overload's docstring is the full one.
+    import ast
+    from pathlib import Path
+
+    try:
+        tree = ast.parse(Path(__file__).with_name("sim.pyi").read_text())
+    except OSError:
+        return
+    docs = {}
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            doc = ast.get_docstring(node) or ""
+            if len(doc) > len(docs.get(node.name, "")):
+                docs[node.name] = doc
+    for f in functions:
+        f.__doc__ = docs.get(f.__name__) or f.__doc__
+
+
+_docs_from_stub(monte_carlo, run_many, relaxation_sweep)
 
 __all__ = [
     "ControllerOutput",

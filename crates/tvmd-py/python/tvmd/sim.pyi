@@ -619,7 +619,8 @@ def run(
             navigator, gimbal limits and largest thrust replace the scenario's ``[team]`` and
             ``[limits]``; a team with agent inertias or a ``min_thrust`` raises ``ValueError``
             (the simulator's agents are point masses that idle at zero thrust). In ``run_many``
-            dicts, a name only.
+            dicts too (on a process pool's ``executor``, a name only: a ``tvmd.Team`` does not
+            pickle).
         law: override the scenario's control law (scenario field ``law``): ``"paper"`` (the
             paper's eq. 12), ``"offset-free"`` (natural gains, disturbance observer, planned
             rates), or a dict with the keys of the TOML ``[law]`` table (as
@@ -651,7 +652,8 @@ def load(path: _PathArg) -> SimResult:
     :class:`SimResult` that run returned.
 
     The log stores every value as a float64 (protobuf ``double``), so the arrays equal the
-    in-memory result's exactly (NaN where it has NaN) for a run that kept every tick
+    in-memory result's exactly (NaN where it has NaN; a ``-0.0`` may read back as ``0.0``,
+    which compares equal) for a run that kept every tick
     (``max_samples=None``): one sample per controller tick (``sample_stride`` 1). ``summary``
     and ``paper_metrics`` are the ones the run computed (stored in the log's ``tvmd.result``
     metadata); ``scenario_toml`` is the scenario that ran (``tvmd.scenario`` metadata);
