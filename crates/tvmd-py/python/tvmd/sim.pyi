@@ -870,6 +870,7 @@ __all__ = [
     "Simulation",
     "SimulationBatch",
     "builtin_scenarios",
+    "load",
     "monte_carlo",
     "monte_carlo_flight",
     "monte_carlo_fly",
