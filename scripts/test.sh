@@ -52,6 +52,9 @@ step "architecture: crate table, import cycles, file sizes"
 # docs/architecture.md).
 python3 scripts/architecture.py --check
 
+step "Python docstrings: the Rust callables' docstring files are the stubs' (scripts/stub_docs.py)"
+python3 scripts/stub_docs.py --check
+
 step "cargo clippy -D warnings (default features, then with clarabel)"
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy -p tvmd-core -p tvmd -p tvmd-sim -p tvmd-studies -p tvmd-cli -p tvmd-py --all-targets \

@@ -18,7 +18,8 @@
 //!
 //! The `tvmd.*` messages are declared in [`proto`]; the `foxglove.*` ones are the SDK's.
 //! The scenario's `[log]` table (`tvmd_scenario::LogSettings`) thins the heavy topics. A metadata record
-//! [`METADATA_SCENARIO`] may hold the scenario of the run.
+//! [`METADATA_SCENARIO`] may hold the scenario of the run, [`METADATA_RESULT`] its summary; [`read`]
+//! reads a log back.
 //!
 //! Every message carries the simulation time `t` (s) as its MCAP log and publish time (ns).
 //! Each [`RunLog`] logs through its own `foxglove::Context`, so runs in parallel never share a
@@ -38,6 +39,7 @@ mod kind;
 pub mod live;
 pub mod paths;
 pub mod proto;
+pub mod read;
 mod run_log;
 pub mod scene;
 pub mod writer;
@@ -47,9 +49,15 @@ pub use convert::{fg_quaternion, fg_vector, frame_transform, nanos, timestamp};
 pub use error::LogError;
 pub use kind::LogKind;
 pub use live::{LiveOptions, LiveServer};
+pub use read::{read_run, read_run_bytes, LoggedRun, TickMessages};
 pub use run_log::RunLog;
 pub use writer::{LogJob, QUEUE_JOBS};
 
 /// Name of the metadata record holding the scenario of a run: keys `name`, `relaxation`,
 /// `allocator`, `controller_precision` and `toml` (the whole scenario as TOML).
 pub const METADATA_SCENARIO: &str = "tvmd.scenario";
+
+/// Name of the metadata record holding the outcome of a run, written when the flight ends:
+/// keys `summary` and `paper_metrics` (tvmd-sim's `RunSummary` and `PaperMetrics` as JSON).
+/// [`read_run`] gives it back with the ticks.
+pub const METADATA_RESULT: &str = "tvmd.result";

@@ -399,6 +399,8 @@ proto_messages! {
         efficiency: Option<f64> => (double, optional, tag = 7);
         /// The agent the controller masked itself this period, if any.
         masked: Option<u32> => (uint32, optional, tag = 8);
+        /// Consecutive periods the agent has been the candidate (suspected).
+        periods: u32 => (uint32, tag = 9);
     }
 }
 

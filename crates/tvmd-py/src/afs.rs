@@ -47,7 +47,7 @@ fn afs_repr(a: &AfsData) -> String {
 }
 
 record! {
-    /// The elliptic-cone AFS approximation (eqs. 7-8). See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.AttainableForceSpace.txt")]
     "AttainableForceSpace" in "tvmd" => PyAfs(AfsData) repr afs_repr |_py, o| {
         /// Working agents.
         n => o.afs.n(),
@@ -79,7 +79,7 @@ record! {
             Ok(Self { inner })
         }
 
-        /// The semi-axes `(c_x, c_y)` of eq. (8) at height(s) `z`. See the stub.
+        #[doc = include_str!("../docstrings/tvmd.AttainableForceSpace.semi_axes.txt")]
         #[pyo3(signature = (z, relaxation = None, *, s = None))]
         fn semi_axes<'py>(
             &self,
@@ -126,7 +126,7 @@ record! {
             scalar_or_array(py, inside, &leading)
         }
 
-        /// `(K_f u, t_Tf, t_eta)` of eqs. (12)-(13). See the stub.
+        #[doc = include_str!("../docstrings/tvmd.AttainableForceSpace.project.txt")]
         fn project<'py>(
             &self,
             py: Python<'py>,
@@ -224,7 +224,7 @@ pub(crate) fn thrust_direction<'py>(
     vectors_out(py, a.collect(), &shape)
 }
 
-/// `(eta_x, eta_y, thrust)` of agent-frame force(s). See the stub.
+#[doc = include_str!("../docstrings/tvmd.gimbal_inverse.txt")]
 #[pyfunction]
 pub(crate) fn gimbal_inverse<'py>(
     py: Python<'py>,

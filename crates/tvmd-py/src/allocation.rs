@@ -123,7 +123,7 @@ pub(crate) fn rate_limits_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option
     }
 }
 
-/// Allocates a desired wrench `u_d` over the working agents (eqs. 4 and 6). See the stub.
+#[doc = include_str!("../docstrings/tvmd.allocate.txt")]
 #[pyfunction]
 #[pyo3(signature = (team, wrench, method = "exact-boundary-redistribution", weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None))]
 #[allow(clippy::too_many_arguments)]

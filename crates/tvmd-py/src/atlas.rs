@@ -17,7 +17,7 @@ const DIRECTIONS: (i128, i128) = (4, 3600);
 /// Heights of the certification grid: tvmd-sim's bounds (`HeightRange::heights`).
 const CERTIFY_HEIGHTS: (i128, i128) = (2, 200);
 
-/// The atlas row of one catalogue team and failure mask. See the stub.
+#[doc = include_str!("../docstrings/tvmd.afs_atlas.txt")]
 #[pyfunction]
 #[pyo3(
     signature = (team, *, failed = None, heights = None, directions = Int::of(36), relaxation = 1.0, certify_heights = Int::of(9), torque = None, plots = None),

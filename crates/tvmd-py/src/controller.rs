@@ -36,7 +36,7 @@ fn busy() -> PyErr {
     )
 }
 
-/// The full-pose controller: one `step` per control period. See the stub for arguments.
+#[doc = include_str!("../docstrings/tvmd.Controller.txt")]
 #[pyclass(module = "tvmd", name = "Controller")]
 pub struct PyController {
     inner: Controller<f64, CAPACITY, AnyAllocator<f64, CAPACITY>>,
@@ -112,8 +112,7 @@ impl PyController {
         })
     }
 
-    /// Marks agents failed (None or [] for none); returns the `HoverCapability` of the
-    /// working agents. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Controller.set_failures.txt")]
     #[pyo3(signature = (failed = None))]
     fn set_failures(
         slf: &Bound<'_, Self>,
@@ -141,8 +140,7 @@ impl PyController {
         self.inner.reset();
     }
 
-    /// Whether the team stands on the ground: while landed the offset-free state is cleared
-    /// and held at zero. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Controller.set_landed.txt")]
     fn set_landed(&mut self, landed: bool) {
         self.inner.set_landed(landed);
     }
@@ -183,7 +181,7 @@ impl PyController {
         self.law.name()
     }
 
-    /// One control period. See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.Controller.step.txt")]
     fn step(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
@@ -208,7 +206,7 @@ impl PyController {
         }
     }
 
-    /// The law stage of one period (state and reference in, the body wrench out). See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Controller.law_stage.txt")]
     fn law_stage(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
@@ -228,7 +226,7 @@ impl PyController {
         }
     }
 
-    /// The allocation stage: a (6,) body wrench `[u_tau; u_f]` to commands. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Controller.allocate.txt")]
     fn allocate(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
@@ -253,7 +251,7 @@ impl PyController {
         }
     }
 
-    /// The planner alone for a reference attitude and an inertial force. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Controller.plan.txt")]
     fn plan(
         &self,
         reference_attitude: &Bound<'_, PyAny>,

@@ -16,7 +16,7 @@ pyo3::create_exception!(
     tvmd,
     ConfigError,
     PyValueError,
-    "A team, limit, gain, setting or failure mask that cannot be used. See the stub."
+    include_str!("../docstrings/tvmd.ConfigError.txt")
 );
 
 pyo3::create_exception!(

@@ -64,7 +64,7 @@ fn k_xi(g: &Gains<f64>) -> Matrix6<f64> {
 }
 
 record! {
-    /// Gains `K_x`, `K_R`, `K_xi = blockdiag(K_Omega, K_v)` of eq. (12). See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Gains.txt")]
     "Gains" in "tvmd" => PyGains(Gains<f64>) repr gains_repr |py, o| {
         /// `K_x` (3, 3).
         k_x => matrix(py, &o.k_x())?,
@@ -161,7 +161,7 @@ pub(crate) fn reference_arg(obj: &Bound<'_, PyAny>) -> PyResult<Reference<f64>> 
 }
 
 record! {
-    /// The measured state (pose and body-frame twist). See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.State.txt")]
     "State" in "tvmd" => PyState(RigidState<f64>) |py, o| {
         /// `x` (3,) (m).
         position => matrix(py, &o.position)?,
@@ -193,7 +193,7 @@ record! {
 }
 
 record! {
-    /// The reference pose and its derivatives. See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.Reference.txt")]
     "Reference" in "tvmd" => PyReference(Reference<f64>) |py, o| {
         /// `x_r` (3,).
         position => matrix(py, &o.position)?,
@@ -267,7 +267,7 @@ fn plant_repr(p: &Plant<f64>) -> String {
 }
 
 record! {
-    /// Rigid-body parameters `m_C`, `J_C` and gravity `g`. See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.Plant.txt")]
     "Plant" in "tvmd" => PyPlant(Plant<f64>) repr plant_repr |py, o| {
         /// `m_C` (kg).
         mass => o.mass(),
@@ -303,7 +303,7 @@ fn law_args(
     Ok((plant, gains, state, reference))
 }
 
-/// `u_fr` (3,), the force part of `u_r` (eq. 12). See the stub.
+#[doc = include_str!("../docstrings/tvmd.force_request.txt")]
 #[pyfunction]
 pub(crate) fn force_request<'py>(
     py: Python<'py>,
@@ -316,7 +316,7 @@ pub(crate) fn force_request<'py>(
     matrix(py, &core_force_request(&plant, &gains, &state, &reference))
 }
 
-/// The torque part of eq. (12) with the planned `R_d`, and `u_r`, `u_d`. See the stub.
+#[doc = include_str!("../docstrings/tvmd.control_wrench.txt")]
 #[pyfunction]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub(crate) fn control_wrench(

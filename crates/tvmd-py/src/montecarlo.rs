@@ -15,7 +15,7 @@ use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
 use crate::errors::value_error;
 use crate::interrupt::{interruptible, Ended};
 
-/// The study's flights as JSON specs. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.monte_carlo_specs.txt")]
 #[pyfunction]
 #[pyo3(
     signature = (scenario = None, *, toml = None, runs = Int::of(100), seed = Int::of(0), teams = None, allocators = None, model_errors = None, distributions = None),
@@ -72,7 +72,7 @@ fn monte_carlo_specs(
         .collect()
 }
 
-/// Flies one JSON spec (GIL released) and returns its row as JSON. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.monte_carlo_flight.txt")]
 #[pyfunction]
 fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
     let spec = FlightSpec::from_json(spec).map_err(value_error)?;
@@ -85,7 +85,7 @@ fn monte_carlo_flight(py: Python<'_>, spec: &str) -> PyResult<String> {
     serde_json::to_string(&row).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// Flies the JSON specs on threads (GIL released), rows as JSON in input order. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.monte_carlo_fly.txt")]
 #[pyfunction]
 #[pyo3(signature = (specs, *, jobs = None))]
 fn monte_carlo_fly(py: Python<'_>, specs: Vec<String>, jobs: Option<Int>) -> PyResult<Vec<String>> {
@@ -121,8 +121,7 @@ fn monte_carlo_fly(py: Python<'_>, specs: Vec<String>, jobs: Option<Int>) -> PyR
     }
 }
 
-/// The report of JSON rows: the flights and groups as lists of dicts, the overall success
-/// rate, and with `out` the CSV tables and figures written there. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.monte_carlo_report.txt")]
 #[pyfunction]
 #[pyo3(signature = (rows, *, out = None))]
 fn monte_carlo_report<'py>(

@@ -20,7 +20,7 @@ pub(crate) fn planner(
     planner.with_tolerance(tolerance, max_iterations).or_raise()
 }
 
-/// The bisection attitude planner (eqs. 9-11). See the stub for arguments.
+#[doc = include_str!("../docstrings/tvmd.AttitudePlanner.txt")]
 #[pyclass(module = "tvmd", name = "AttitudePlanner", frozen)]
 pub struct PyAttitudePlanner {
     inner: AttitudePlanner<f64>,
@@ -64,7 +64,7 @@ impl PyAttitudePlanner {
         self.max_iterations
     }
 
-    /// Plans `R_d` for `R_r` and the inertial force request `f_r` (eq. 9). See the stub.
+    #[doc = include_str!("../docstrings/tvmd.AttitudePlanner.plan.txt")]
     #[allow(non_snake_case)]
     fn plan(
         &self,

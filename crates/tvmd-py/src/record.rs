@@ -18,7 +18,7 @@ macro_rules! record {
     };
     (@repr $name:literal $this:ident $py:ident $custom:path) => { Ok($custom(&$this.inner)) };
     (
-        $(#[doc = $doc:literal])*
+        $(#[doc = $doc:expr])*
         $name:literal in $module:literal => $rust:ident($inner:ty) $(repr $custom:path)?
         |$py:ident, $o:ident| {
             $( $(#[doc = $fdoc:literal])* $field:ident $(as $py_name:literal)? => $value:expr ),* $(,)?

@@ -95,13 +95,20 @@ impl RunArgs<'_, '_> {
     pub(crate) fn spec(mut self, scenario_name: &str) -> PyResult<RunSpec> {
         let team = self.team_config.take();
         let mut spec = self.request(scenario_name)?.spec().map_err(value_error)?;
-        if let Some((team, limits)) = team {
-            spec.scenario.team = team;
-            spec.scenario.limits = limits;
-            spec.scenario.validate().map_err(value_error)?;
-        }
+        fly_team(&mut spec, team)?;
         Ok(spec)
     }
+}
+
+/// Flies `team` (a `tvmd.Team`'s team and limits, [`team_arg`]) in `spec` instead of its
+/// scenario's, validated again; nothing to do without one.
+fn fly_team(spec: &mut RunSpec, team: Option<TeamConfigArg>) -> PyResult<()> {
+    if let Some((team, limits)) = team {
+        spec.scenario.team = team;
+        spec.scenario.limits = limits;
+        spec.scenario.validate().map_err(value_error)?;
+    }
+    Ok(())
 }
 
 /// A `team` argument: a catalogue name (a `str`) or a `tvmd.Team` ([`team_spec`]), as the
@@ -193,6 +200,14 @@ pub(crate) fn run_request(
         Some(l) if !l.is_none() => Some(law_arg(&l, &format!("{name}['law']"))?),
         _ => None,
     };
+    let (team, team_config) = match dict.get_item("team")? {
+        Some(t) => team_arg(Some(&t)).map_err(|e| {
+            let why = e.value(dict.py()).to_string();
+            let why = why.strip_prefix("`team` ").unwrap_or(&why);
+            PyErr::from_type(e.get_type(dict.py()), format!("`{name}['team']` {why}"))
+        })?,
+        None => (None, None),
+    };
     let request = RunArgs {
         scenario: scenario.as_ref(),
         toml: opt(dict, &name, "toml")?,
@@ -203,12 +218,14 @@ pub(crate) fn run_request(
         precision: opt(dict, &name, "precision")?,
         pil: opt(dict, &name, "pil")?,
         samples,
-        team: opt(dict, &name, "team")?,
+        team,
         team_config: None,
         law,
     }
     .request(&format!("{name}['scenario']"))?;
-    checked(request)
+    let (mut spec, input) = checked(request)?;
+    fly_team(&mut spec, team_config)?;
+    Ok((spec, input))
 }
 
 /// The runs of a `run_many` batch, each loaded and validated ([`run_item`]), and the batch's

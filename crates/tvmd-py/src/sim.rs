@@ -16,7 +16,9 @@ use crate::errors::value_error;
 use crate::runs::{batch_label, run_items, run_items_keeping, run_specs};
 use crate::runs::{sweep_label, sweep_run_specs};
 use crate::runs::{team_arg, RunArgs};
-use crate::sim_result::PySimResult;
+use crate::sim_result::{PySimResult, SimData};
+use tvmd_sim::runner::RunSpec;
+use tvmd_sim::SampleRetention;
 
 /// The names of the built-in scenarios.
 #[pyfunction]
@@ -24,7 +26,7 @@ fn builtin_scenarios() -> Vec<&'static str> {
     BUILTIN_NAMES.to_vec()
 }
 
-/// A built-in scenario as TOML text (every field). See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.scenario_toml.txt")]
 #[pyfunction]
 fn scenario_toml(name: &str) -> PyResult<String> {
     let scenario = Scenario::builtin(name);
@@ -33,7 +35,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
         .map_err(value_error)
 }
 
-/// Runs one scenario with the tvmd controller in the loop. See the stub for arguments.
+#[doc = include_str!("../docstrings/tvmd.sim.run.txt")]
 #[pyfunction]
 #[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None, law = None))]
 #[allow(clippy::too_many_arguments)]
@@ -74,8 +76,7 @@ fn run(
         .ok_or_else(|| PyRuntimeError::new_err("tvmd-sim returned no result"))
 }
 
-/// Runs many scenarios in parallel threads; results in input order (with `errors="keep"`, a
-/// failed run's exception in its place). See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.run_many.txt")]
 #[pyfunction]
 #[pyo3(signature = (runs, *, jobs = None, errors = "raise"))]
 fn run_many(
@@ -101,7 +102,7 @@ fn run_many(
     }
 }
 
-/// The paper's relaxation study: one scenario flown once per relaxation `s`. See the stub.
+#[doc = include_str!("../docstrings/tvmd.sim.relaxation_sweep.txt")]
 #[pyfunction]
 #[pyo3(signature = (relaxations = None, scenario = None, *, toml = None, allocator = None, precision = None, mcap_dir = None, jobs = None, pil = None, max_samples = None))]
 #[allow(clippy::too_many_arguments)]
@@ -131,6 +132,24 @@ fn relaxation_sweep(
     run_specs(py, specs, jobs, |_, s| sweep_label(s))
 }
 
+#[doc = include_str!("../docstrings/tvmd.sim.load.txt")]
+#[pyfunction]
+#[pyo3(signature = (path))]
+fn load(py: Python<'_>, path: PathBuf) -> PyResult<PySimResult> {
+    let loaded = py
+        .detach(|| tvmd_sim::load_run(&path))
+        .map_err(|e| PyValueError::new_err(format!("cannot load the run log: {e}")))?;
+    let spec = RunSpec {
+        scenario: loaded.scenario,
+        log: Some(path),
+        pil: None,
+        samples: SampleRetention::All,
+    };
+    Ok(PySimResult {
+        inner: SimData::new(spec, loaded.result),
+    })
+}
+
 /// Adds the documentation and the run functions to the `sim` submodule.
 pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.setattr(
@@ -143,5 +162,6 @@ pub(crate) fn register(sim: &Bound<'_, PyModule>) -> PyResult<()> {
     sim.add_function(wrap_pyfunction!(run, sim)?)?;
     sim.add_function(wrap_pyfunction!(run_many, sim)?)?;
     sim.add_function(wrap_pyfunction!(relaxation_sweep, sim)?)?;
+    sim.add_function(wrap_pyfunction!(load, sim)?)?;
     Ok(())
 }

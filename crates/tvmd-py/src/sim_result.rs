@@ -161,7 +161,7 @@ impl SimData {
 }
 
 record! {
-    /// One simulated run: time series (NumPy) and the summary dicts. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.sim.SimResult.txt")]
     "SimResult" in "tvmd.sim" => PySimResult(SimData) repr SimData::repr |py, o| {
         /// Name of the scenario that ran.
         scenario_name => o.scenario.name.as_str(),
@@ -260,13 +260,13 @@ record! {
             self.inner.samples.len()
         }
 
-        /// The time series as flat (K,) columns (a dict for `pandas.DataFrame`). See the stub.
+        #[doc = include_str!("../docstrings/tvmd.sim.SimResult.to_columns.txt")]
         fn to_columns<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
             let py = slf.py();
             py.import("tvmd.sim")?.getattr("_columns")?.call1((slf,))
         }
 
-        /// The flat columns as a `pandas.DataFrame` (pandas must be installed). See the stub.
+        #[doc = include_str!("../docstrings/tvmd.sim.SimResult.to_pandas.txt")]
         fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
             let py = slf.py();
             py.import("tvmd.sim")?.getattr("_to_pandas")?.call1((slf,))

@@ -57,7 +57,7 @@ record! {
 }
 
 record! {
-    /// What the null-space stage changed in one period. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.NullSpaceReport.txt")]
     "NullSpaceReport" in "tvmd" => PyNullSpaceReport(NullSpaceReport<f64>) |py, o| {
         /// The stage ran on this period's allocation.
         ran => o.ran,

@@ -195,7 +195,7 @@ fn arrangement(t: &TeamConfig<f64, CAPACITY>) -> &'static str {
 }
 
 record! {
-    /// The team configuration `Xi` (eqs. 3-6), up to 64 agents. See the stub for arguments.
+    #[doc = include_str!("../docstrings/tvmd.Team.txt")]
     "Team" in "tvmd" => PyTeam(TeamConfig<f64, CAPACITY>) repr team_repr |py, o| {
         /// The number of agents.
         n => o.len(),
@@ -341,7 +341,7 @@ record! {
         shaped(py, dense, &[6, 3 * n])
     }
 
-    /// `u = M(Xi) f` (6,) of the (n, 3) agent-frame forces. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Team.wrench.txt")]
     #[pyo3(signature = (forces, failed = None))]
     fn wrench<'py>(
         &self,
@@ -367,7 +367,7 @@ record! {
         PyPlant::create(self.inner.mass(), self.inner.inertia(), gravity)
     }
 
-    /// Whether the working agents can hold hover with a margin. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.Team.hover_capability.txt")]
     #[pyo3(signature = (failed = None, gravity = 9.81))]
     fn hover_capability(
         &self,
@@ -395,7 +395,7 @@ pub(crate) fn padded_forces(
 }
 
 record! {
-    /// Whether the working agents can hold hover with a margin. See the stub.
+    #[doc = include_str!("../docstrings/tvmd.HoverCapability.txt")]
     "HoverCapability" in "tvmd" => PyHoverCapability(HoverCapability<f64>) |py, o| {
         /// The hover wrench is strictly inside the working agents' attainable set.
         capable => o.capable,

@@ -108,3 +108,18 @@ def test_a_batch_on_an_executor_keeps_failures_too():
         out = sim.run_many([SHORT_HOVER, {"toml": DIVERGING}], executor=pool, errors="keep")
     assert isinstance(out[0], sim.SimResult)
     assert isinstance(out[1], RuntimeError) and "runs[1]" in str(out[1])
+
+
+def test_run_many_dicts_fly_a_tvmd_team_as_run_does():
+    import tvmd
+
+    team = tvmd.Team.preset("a6-inc")
+    alone = sim.run(**SHORT_HOVER, team=team)
+    (batched, by_name) = sim.run_many([{**SHORT_HOVER, "team": team}, {**SHORT_HOVER, "team": "a6-inc"}])
+    assert alone.n_agents == batched.n_agents == 6
+    np.testing.assert_array_equal(batched.position, alone.position)
+    np.testing.assert_array_equal(batched.commands, alone.commands)
+    assert batched.scenario_toml == alone.scenario_toml
+    assert by_name.n_agents == 6
+    with pytest.raises(TypeError, match=r"runs\[1\]\['team'\]"):
+        sim.run_many([SHORT_HOVER, {**SHORT_HOVER, "team": 3}])

@@ -32,6 +32,7 @@ pub mod control;
 pub mod diagnostics;
 pub mod error;
 pub mod flight;
+pub mod load;
 pub mod pool;
 pub mod request;
 pub mod runner;
@@ -45,6 +46,7 @@ pub use control::{AnyTvmdController, TvmdController, WrenchAllocation, MAX_AGENT
 pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};
 pub use flight::{FlightController, FlightInput, FlightOutput};
+pub use load::{load_run, LoadedRun};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
 pub use sim::{

@@ -14,6 +14,7 @@ use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
 use crate::flight::{FlightController, FlightInput, FlightOutput};
+use crate::load::write_result_metadata;
 use crate::sim::summary::Verdict;
 use crate::sim::{RunResult, SampleRetention, SimOptions, Simulation};
 use crate::sink::TickSink;
@@ -171,17 +172,32 @@ pub fn fly_live(
         Some(p) => sim.run_until(&mut WithProgress::new(&mut controller, p), sink, cancel),
         None => sim.run_until(&mut controller, sink, cancel),
     };
-    let finished = log
-        .as_mut()
-        .map_or(Ok(()), |l| l.finish().map_err(SimError::from));
-    let (mut result, error) = match (run, finished) {
-        (Ok(result), Ok(())) => (result, None),
-        (Err(e), _) | (Ok(_), Err(e)) => (sim.take_result(), Some(e)),
+    let (mut result, mut error) = match run {
+        Ok(result) => (result, None),
+        Err(e) => (sim.take_result(), Some(e)),
     };
-    result.summary.controller_target = controller.target_label();
-    result.summary.error = error.as_ref().map(ToString::to_string);
-    result.summary.verdict = Verdict::judge(&result.summary, &scenario.success);
+    let target = controller.target_label();
+    judge(&mut result, target.clone(), error.as_ref(), scenario);
+    if let Some(log) = log.as_mut() {
+        // The outcome goes into the file (for `load_run`) before it is finalised.
+        let written = match spec.log {
+            Some(_) => write_result_metadata(log, &result),
+            None => Ok(()),
+        };
+        let finished = written.and(log.finish().map_err(SimError::from));
+        if let (Err(e), None) = (finished, error.as_ref()) {
+            error = Some(e);
+            judge(&mut result, target, error.as_ref(), scenario);
+        }
+    }
     Ok(Flight { result, error })
+}
+
+/// The summary's controller target, error and verdict.
+fn judge(result: &mut RunResult, target: String, error: Option<&SimError>, scenario: &Scenario) {
+    result.summary.controller_target = target;
+    result.summary.error = error.map(ToString::to_string);
+    result.summary.verdict = Verdict::judge(&result.summary, &scenario.success);
 }
 
 /// One run of a batch: a validated scenario and the MCAP log to write, if any.

@@ -213,6 +213,7 @@ fn fault(t: f64, f: &FaultDiagnostics) -> proto::Fault {
         kind: f.kind.as_ref().map(kebab).unwrap_or_default(),
         efficiency: f.efficiency,
         masked: f.masked.and_then(|i| u32::try_from(i).ok()),
+        periods: f.periods,
     }
 }
 

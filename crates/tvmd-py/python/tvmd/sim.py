@@ -12,6 +12,7 @@ ascent to 1.5 m, roll tilt towards the infeasible ``pi/3``, descent; ``s = 0.5``
   is the tvmd controller as :func:`run` flies it, for the same steps.
 * :func:`run` -- one run (GIL released) -> :class:`SimResult` (NumPy time series and the
   summary dicts), optionally writing an MCAP log.
+* :func:`load` -- a run read back from its MCAP log, as the :class:`SimResult` it returned.
 * :func:`run_many`, :func:`relaxation_sweep` -- many runs in parallel threads, or one task per
   run on any ``concurrent.futures.Executor`` (``executor=``; results pickle back).
 * :func:`monte_carlo` -- a Monte Carlo study (model errors and initial conditions drawn per
@@ -49,7 +50,7 @@ def monte_carlo(
     jobs=None,
     executor=None,
 ):
-    """A Monte Carlo study; see the stub (``sim.pyi``) for the arguments and the result."""
+    """A Monte Carlo study of ``runs`` flights (the full docstring is the stub's, below)."""
     specs = _sim.monte_carlo_specs(
         scenario,
         toml=toml,
@@ -91,6 +92,7 @@ ScenarioController = _sim.ScenarioController
 ControllerOutput = _sim.ControllerOutput
 builtin_scenarios = _sim.builtin_scenarios
 run = _sim.run
+load = _sim.load
 scenario_toml = _sim.scenario_toml
 # `SimResult.__reduce__` names it here: an executor's worker sends its result back pickled.
 _sim_result_from_state = _sim._sim_result_from_state
@@ -182,7 +184,7 @@ def _run_one_keeping(item, index):
 
 
 def run_many(runs, *, jobs=None, executor=None, errors="raise"):
-    """Many runs, results in input order; see the stub (``sim.pyi``)."""
+    """Many runs in parallel, results in input order (the full docstring is the stub's, below)."""
     if errors not in ("raise", "keep"):
         raise ValueError(f'`errors` must be "raise" or "keep", got {errors!r}')
     if executor is None:
@@ -207,7 +209,7 @@ def relaxation_sweep(
     max_samples=None,
     executor=None,
 ):
-    """The relaxation study; see the stub (``sim.pyi``)."""
+    """The paper's relaxation study (the full docstring is the stub's, below)."""
     kw = dict(
         toml=toml,
         allocator=allocator,
@@ -221,6 +223,29 @@ def relaxation_sweep(
     items = _sim._relaxation_sweep_runs(relaxations, scenario, **kw)
     return _on_executor(items, jobs, executor, _run_swept)
 
+def _docs_from_stub(*functions):
+    # One source: these Python functions show the docstrings of ``sim.pyi`` (shipped beside this
+    # file) in ``help()``, as the Rust callables do (scripts/stub_docs.py). The longest
+    # overload's docstring is the full one.
+    import ast
+    from pathlib import Path
+
+    try:
+        tree = ast.parse(Path(__file__).with_name("sim.pyi").read_text())
+    except OSError:
+        return
+    docs = {}
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            doc = ast.get_docstring(node) or ""
+            if len(doc) > len(docs.get(node.name, "")):
+                docs[node.name] = doc
+    for f in functions:
+        f.__doc__ = docs.get(f.__name__) or f.__doc__
+
+
+_docs_from_stub(monte_carlo, run_many, relaxation_sweep)
+
 __all__ = [
     "ControllerOutput",
     "Observation",
@@ -229,6 +254,7 @@ __all__ = [
     "Simulation",
     "SimulationBatch",
     "builtin_scenarios",
+    "load",
     "monte_carlo",
     "monte_carlo_flight",
     "monte_carlo_fly",

@@ -619,7 +619,8 @@ def run(
             navigator, gimbal limits and largest thrust replace the scenario's ``[team]`` and
             ``[limits]``; a team with agent inertias or a ``min_thrust`` raises ``ValueError``
             (the simulator's agents are point masses that idle at zero thrust). In ``run_many``
-            dicts, a name only.
+            dicts too (on a process pool's ``executor``, a name only: a ``tvmd.Team`` does not
+            pickle).
         law: override the scenario's control law (scenario field ``law``): ``"paper"`` (the
             paper's eq. 12), ``"offset-free"`` (natural gains, disturbance observer, planned
             rates), or a dict with the keys of the TOML ``[law]`` table (as
@@ -644,6 +645,29 @@ def run(
         RuntimeError: the run failed while flying (the state diverged, the controller failed,
             the PIL link broke); with ``pil``, also ``qemu-system-arm`` or the PIL firmware not
             found (the message says how to install or build it).
+    """
+
+def load(path: _PathArg) -> SimResult:
+    """A run read back from the MCAP log it wrote (``run(..., mcap=path)``), as the
+    :class:`SimResult` that run returned.
+
+    The log stores every value as a float64 (protobuf ``double``), so the arrays equal the
+    in-memory result's exactly (NaN where it has NaN; a ``-0.0`` may read back as ``0.0``,
+    which compares equal) for a run that kept every tick
+    (``max_samples=None``): one sample per controller tick (``sample_stride`` 1). ``summary``
+    and ``paper_metrics`` are the ones the run computed (stored in the log's ``tvmd.result``
+    metadata); ``scenario_toml`` is the scenario that ran (``tvmd.scenario`` metadata);
+    ``mcap_path`` is ``path``. On ticks a scenario's ``[log] decimation > 1`` thinned, the
+    heavy topics are absent: those samples' commands, actual outputs, forces, rotor speeds,
+    planner and allocation values are NaN.
+
+    Args:
+        path: the ``.mcap`` file (a str or ``os.PathLike``).
+
+    Raises:
+        ValueError: the file is missing or unreadable, not MCAP, truncated, or not a tvmd-sim
+            run's log (no ``/state`` messages or no scenario metadata); the message names
+            ``path``.
     """
 
 @overload
@@ -846,6 +870,7 @@ __all__ = [
     "Simulation",
     "SimulationBatch",
     "builtin_scenarios",
+    "load",
     "monte_carlo",
     "monte_carlo_flight",
     "monte_carlo_fly",

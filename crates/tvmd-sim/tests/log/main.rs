@@ -5,4 +5,5 @@
 mod common;
 
 mod foxglove_layout;
+mod load;
 mod mcap_log;
