@@ -40,6 +40,7 @@ extern crate std;
 pub mod actuator;
 pub mod config;
 pub mod fault;
+pub mod fault_report;
 pub mod handle;
 pub mod law;
 pub mod reconfigure;

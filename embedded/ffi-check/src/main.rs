@@ -9,6 +9,7 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use tvmd_ffi::actuator::*;
 use tvmd_ffi::config::*;
+use tvmd_ffi::fault_report::*;
 use tvmd_ffi::handle::*;
 use tvmd_ffi::reconfigure::*;
 use tvmd_ffi::stages::*;
@@ -25,6 +26,8 @@ static mut MASK: u32 = 0;
 /// landing detector's flag.
 static mut PAPER: u32 = 0;
 static mut LANDED: u32 = 0;
+/// The fault detection mode (`TVMD_FAULT_*`), so the detector is linked and checked too.
+static mut FAULT_MODE: u32 = 0;
 static mut MAP_SHIFT: u32 = 0;
 /// Outputs a flight stack would read.
 static mut MOTORS: [f32; 16] = [0.0; 16];
@@ -32,6 +35,7 @@ static mut SERVOS: [f32; 16] = [0.0; 16];
 static mut STATUS: [i32; 8] = [0; 8];
 static mut COMPENSATION: [f32; 6] = [0.0; 6];
 static mut NAME: usize = 0;
+static mut FAULT_AGENT: i32 = 0;
 
 fn copy(dst: &mut [f32], src: &[f32]) {
     for (d, s) in dst.iter_mut().zip(src) {
@@ -53,6 +57,7 @@ pub extern "C" fn _start() -> ! {
         } else {
             tvmd_config_default(&mut config)
         };
+        config.fault.mode = read_volatile(addr_of!(FAULT_MODE));
         status[1] = tvmd_create(handle, core::mem::size_of::<TvmdController>(), &config);
         let mut map: TvmdActuatorMap = core::mem::zeroed();
         map.size = core::mem::size_of::<TvmdActuatorMap>() as u32;
@@ -119,6 +124,10 @@ pub extern "C" fn _start() -> ! {
                 law.force.as_ptr(),
                 &mut plan,
             );
+            let mut fault: TvmdFaultReport = core::mem::zeroed();
+            fault.size = core::mem::size_of::<TvmdFaultReport>() as u32;
+            status[4] += tvmd_fault_report(handle, &mut fault);
+            write_volatile(addr_of_mut!(FAULT_AGENT), fault.agent + fault.masked_agent);
             let [f0, f1, f2] = out.compensation_force;
             let [t0, t1, t2] = out.compensation_torque;
             write_volatile(addr_of_mut!(COMPENSATION), [f0, f1, f2, t0, t1, t2]);

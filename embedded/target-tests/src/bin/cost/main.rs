@@ -27,8 +27,8 @@ use tvmd_core::nalgebra::{convert, ComplexField, Vector3};
 use tvmd_core::team::presets;
 use tvmd_core::{
     Allocator, Controller, ControllerSettings, ExactBoundaryRedistribution, FaultDetection,
-    FaultResponse, PlannerStatus,
-    PseudoInverse, RedistributedPseudoInverse, Reference, RigidState, TeamConfig,
+    FaultResponse, PlannerStatus, PseudoInverse, RedistributedPseudoInverse, Reference, RigidState,
+    TeamConfig,
 };
 
 mod allocation;
@@ -192,7 +192,9 @@ fn report<const N: usize>(per_tick: u32) -> bool {
                 if as_intended { "" } else { "  FAIL: not the intended planner case" }
             );
             if law == "detecting" {
-                let extra = m.instructions.saturating_sub(offset_free_instructions.unwrap_or(0));
+                let extra = m
+                    .instructions
+                    .saturating_sub(offset_free_instructions.unwrap_or(0));
                 hprintln!(
                     "cost: n = {:2} {:9} cycle: the fault detector costs {} instructions more than the offset-free law",
                     N,
