@@ -404,6 +404,12 @@ impl fmt::Display for ConfigError {
             ),
             Self::AgentCount { n, n_x } => write!(f, "n_x = {n_x} exceeds n = {n} (or n = 0)"),
             Self::Relaxation { value } => write!(f, "relaxation s = {value} is outside (0, 1]"),
+            Self::Parameter {
+                field: ConfigField::FaultResidual,
+            } => f.write_str(
+                "fault detection reads the disturbance observer's residual: it needs the \
+                 offset-free law's observer",
+            ),
             Self::Parameter { field } => write!(f, "`{field}` must be positive and finite"),
             Self::FailureIndex { agent } => {
                 write!(f, "failure mask names agent {agent}, which the team does not have")

@@ -11,6 +11,7 @@ use crate::afs::PyAfs;
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
 use crate::convert::null_space_arg;
 use crate::convert::{class_arg, commands_array, finite, iteration_cap, law_arg, matrix};
+use crate::convert::{fault_detection_arg, record_to_py};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, value_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
@@ -51,9 +52,9 @@ impl PyController {
     // `law = None` is the offset-free law (a default here must be of the argument's type); the
     // text signature (kept equal to `signature`, checked by stubtest) shows it by its name.
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None, law = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None, law = None, fault_detection = None))]
     #[pyo3(
-        text_signature = "(team, gains=None, relaxation=None, gravity=9.81, period=0.01, allocator=\"exact-boundary-redistribution\", rate_limits=None, failed=None, weights=None, regularization=None, planner_tolerance=None, planner_max_iterations=None, *, s=None, null_space=None, law=\"offset-free\")"
+        text_signature = "(team, gains=None, relaxation=None, gravity=9.81, period=0.01, allocator=\"exact-boundary-redistribution\", rate_limits=None, failed=None, weights=None, regularization=None, planner_tolerance=None, planner_max_iterations=None, *, s=None, null_space=None, law=\"offset-free\", fault_detection=None)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -72,6 +73,7 @@ impl PyController {
         s: Option<f64>,
         null_space: Option<&str>,
         law: Option<&Bound<'_, PyAny>>,
+        fault_detection: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
@@ -83,6 +85,16 @@ impl PyController {
         let law = law.map_or(Ok(LawConfig::default()), |l| law_arg(l, "law"))?;
         let (gain_schedule, offset_free, attitude_rate) =
             law_settings::<f64>(&law).map_err(value_error)?;
+        let fault_detection = match fault_detection {
+            Some(f) => Some(
+                tvmd_sim::control::fault_detection::<f64>(&fault_detection_arg(
+                    f,
+                    "fault_detection",
+                )?)
+                .map_err(value_error)?,
+            ),
+            None => None,
+        };
         let settings = ControllerSettings {
             gains: gains_arg(gains)?,
             relaxation,
@@ -93,7 +105,7 @@ impl PyController {
             gain_schedule,
             offset_free,
             attitude_rate,
-            fault_detection: None,
+            fault_detection,
         };
         let allocator = make_allocator(allocator, weights, regularization, team.len())?;
         let mask = failure_mask(&team, failed)?;
@@ -110,6 +122,17 @@ impl PyController {
             null_space,
             law,
         })
+    }
+
+    #[doc = include_str!("../docstrings/tvmd.Controller.fault_report.txt")]
+    fn fault_report<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let this = borrow(slf)?;
+        let Some(report) = this.inner.fault_report() else {
+            return Ok(None);
+        };
+        let mut diagnostics = tvmd_sim::control::fault_diagnostics(report);
+        diagnostics.masked = this.inner.fault_masking().map(|m| m.agent);
+        record_to_py(slf.py(), &diagnostics).map(Some)
     }
 
     #[doc = include_str!("../docstrings/tvmd.Controller.set_failures.txt")]

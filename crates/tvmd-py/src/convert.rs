@@ -26,7 +26,7 @@ mod law;
 
 pub(crate) use commands::{batch_commands_arg, batch_wrench_arg, commands_arg, wrench_arg};
 
-pub(crate) use law::law_arg;
+pub(crate) use law::{fault_detection_arg, law_arg};
 
 /// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
 pub(crate) const CAPACITY: usize = 64;

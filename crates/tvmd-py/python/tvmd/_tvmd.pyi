@@ -14,7 +14,7 @@ configuration and input errors become ``ConfigError`` / ``InputError`` (both ``V
 with the core's message. No code path panics.
 """
 
-from typing import Any, ClassVar, Iterable, Literal, Mapping, Optional, Sequence, Tuple, Union, final, overload
+from typing import Any, ClassVar, Dict, Iterable, Literal, Mapping, Optional, Sequence, Tuple, Union, final, overload
 
 import os
 import numpy as np
@@ -948,6 +948,13 @@ class Controller:
             "integral", "k_x": [..], "k_r": [..], "max_torque": 5.0}`` in N/(m s), N m/(rad s)),
             ``attitude_rate`` (``"off"`` or ``{"bandwidth": 20.0, "max_rate": 5.0}`` in rad/s).
             Lists may be NumPy arrays. ``Controller.law`` names it.
+        fault_detection: agent fault detection (keyword only; default None, off): ``"report"``
+            or ``"mask"`` (the recommended detector: relative model error 0.015, threshold 5,
+            persistence 5 periods; with ``"mask"`` the controller masks an agent whose loss is
+            confirmed, as ``set_failures`` would), or a dict with the keys of a scenario's TOML
+            ``[fault_detection]`` table (``model_error``, ``threshold``, ``persistence``,
+            ``response``). It reads the disturbance observer's residual, so it needs the
+            offset-free law's observer. ``fault_report()`` gives each period's verdict.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
@@ -979,7 +986,21 @@ class Controller:
         s: Optional[float] = None,
         null_space: Optional[str] = None,
         law: _LawArg = "offset-free",
+        fault_detection: Union[str, Mapping[str, Any], None] = None,
     ) -> "Controller": ...
+    def fault_report(self) -> Optional[Dict[str, Any]]:
+        """The fault detector's report of the last period, or None (detection off, or no period
+        stepped yet).
+
+        Returns:
+            dict: ``statistic`` (the residual in noise units) and the ``threshold`` it was
+            compared with; ``verdict`` (``"nominal"``, ``"unexplained"``, ``"suspected"`` or
+            ``"confirmed"``); ``agent`` (the isolated agent, or None), ``kind`` (``"loss"``,
+            ``"partial-loss"``, ``"stuck-gimbal"`` or None) and ``efficiency`` (the fraction
+            delivered, for a partial loss); ``periods`` (consecutive periods of a suspicion);
+            ``masked`` (the agent the controller masked itself, with ``fault_detection="mask"``,
+            or None).
+        """
     def set_failures(self, failed: _Failed = None) -> "HoverCapability":
         """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``
         and is commanded idle.

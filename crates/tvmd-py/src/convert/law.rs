@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::{Map, Number, Value};
 
-use tvmd_scenario::{LawConfig, ScenarioError};
+use tvmd_scenario::{FaultDetectionConfig, FaultResponseConfig, LawConfig, ScenarioError};
 
 /// What a `law` argument may be, for `TypeError`s.
 const EXPECTED: &str = "\"paper\", \"offset-free\" or a dict with the keys of the TOML [law] \
@@ -39,6 +39,40 @@ pub(crate) fn law_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<LawConfig>
         other => PyValueError::new_err(format!("invalid `{name}`: {other}")),
     })?;
     Ok(law)
+}
+
+/// The `fault_detection` argument: `"report"` or `"mask"` (the recommended detector with that
+/// response), or a dict with the keys of a scenario's `[fault_detection]` table (`model_error`,
+/// `threshold`, `persistence`, `response`; a key left out takes the recommended value).
+/// `ValueError` names the field; the numbers are range-checked by the core where it is built.
+pub(crate) fn fault_detection_arg(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+) -> PyResult<FaultDetectionConfig> {
+    if let Ok(text) = obj.cast::<PyString>() {
+        return match text.to_cow()?.trim() {
+            "report" => Ok(FaultDetectionConfig::with_response(
+                FaultResponseConfig::Report,
+            )),
+            "mask" => Ok(FaultDetectionConfig::with_response(
+                FaultResponseConfig::Mask,
+            )),
+            other => Err(PyValueError::new_err(format!(
+                "invalid `{name}`: `{other}` (expected \"report\", \"mask\" or a dict)"
+            ))),
+        };
+    }
+    if obj.is_instance_of::<PyDict>() {
+        return serde_path_to_error::deserialize::<_, FaultDetectionConfig>(to_json(obj, name)?)
+            .map_err(|e| {
+                PyValueError::new_err(format!("invalid `{name}.{}`: {}", e.path(), e.inner()))
+            });
+    }
+    let got = obj.get_type().name()?;
+    Err(PyTypeError::new_err(format!(
+        "`{name}` must be \"report\", \"mask\" or a dict with the keys of the TOML \
+         [fault_detection] table, got {got}"
+    )))
 }
 
 /// Deserializes the `[law]` table with the path of a bad key in the message.

@@ -274,6 +274,14 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 /// [`tvmd_wire::LawWords`] of the f32 settings.
 pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
     use tvmd_wire::{CoreConfig, LawWords, AGENTS, ALLOCATOR_NAME_BYTES};
+    if scenario.fault_detection.is_some() {
+        // Refused rather than flown without it: the words carry no detector yet.
+        return Err(invalid(
+            "fault_detection",
+            "the fault detector is not carried to an emulated target (PIL) or into a cycle \
+             recording yet: fly it in process",
+        ));
+    }
     team_config::<f32>(scenario)?;
     let settings = controller_settings::<f32>(scenario)?;
     allocator::<f32>(&scenario.allocator)?;

@@ -82,7 +82,7 @@ pub(super) fn cycle_diagnostics<T: CoreFloat>(
 }
 
 /// The detector's report in f64 (no agent masked: the caller fills `masked`).
-pub(super) fn fault_diagnostics<T: CoreFloat>(report: &FaultReport<T>) -> FaultDiagnostics {
+pub fn fault_diagnostics<T: CoreFloat>(report: &FaultReport<T>) -> FaultDiagnostics {
     let (verdict, agent, kind, periods) = match report.verdict {
         FaultVerdict::Nominal => (FaultVerdictName::Nominal, None, None, 0),
         FaultVerdict::Unexplained => (FaultVerdictName::Unexplained, None, None, 0),

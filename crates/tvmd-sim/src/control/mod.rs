@@ -50,9 +50,11 @@ pub use landing::{Landing, Touchdown, LANDED_HEIGHT};
 pub use wrench::WrenchAllocation;
 
 pub use config::{
-    allocator, controller_settings, hover_roll_limit, law_settings, team_config, wire_config,
+    allocator, controller_settings, fault_detection, hover_roll_limit, law_settings, team_config,
+    wire_config,
 };
 pub use convert::{core_reference, core_state, sim_command, CoreFloat};
+pub use diagnostics::fault_diagnostics;
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
 pub const MAX_AGENTS: usize = 16;

@@ -210,3 +210,24 @@ fn cortex_m4_pil_flight_with_the_default_allocator() {
     assert!(d.gimbal < 5e-6, "{d:?}");
     assert!(d.thrust < 5e-4, "{d:?}");
 }
+
+/// A scenario with fault detection is refused on an emulated target (and by the cycle
+/// recorder) rather than flown without its detector: the configuration words carry none yet.
+#[test]
+fn pil_refuses_fault_detection_it_cannot_carry() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/faults/loss-hover.toml"
+    );
+    let s = Scenario {
+        controller_precision: Precision::F32,
+        ..Scenario::from_file(path).unwrap()
+    };
+    let e = run_scenario_on(&s, Some(PilTarget::CortexM4), None, None).unwrap_err();
+    assert!(
+        matches!(&e, SimError::Scenario(tvmd_scenario::ScenarioError::InvalidScenario { field, .. }) if field == "fault_detection"),
+        "{e}"
+    );
+    let e = tvmd_sim::runner::record_cycles(&s, 10).unwrap_err();
+    assert!(e.to_string().contains("fault_detection"), "{e}");
+}
