@@ -44,15 +44,7 @@ pub(crate) fn team_spec(team: &TeamConfig<f64, CAPACITY>) -> PyResult<(TeamSpec,
             limits.min_thrust()
         )));
     }
-    let agents = team
-        .agents()
-        .iter()
-        .map(|a| AgentBody {
-            position: a.position.into(),
-            mass: a.mass,
-            quarter_turns: a.quarter_turns,
-        })
-        .collect();
+    let agents = team.agents().iter().map(AgentBody::from).collect();
     // Rows of J_0: the columns of its transpose.
     let j0 = team.navigator().inertia.transpose();
     let row = |r: usize| {

@@ -18,6 +18,17 @@ pub struct AgentBody {
     pub quarter_turns: i32,
 }
 
+impl From<&tvmd_core::AgentSpec<f64>> for AgentBody {
+    /// The physics' view of a core agent (its position, mass and quarter turns).
+    fn from(a: &tvmd_core::AgentSpec<f64>) -> Self {
+        Self {
+            position: a.position.into(),
+            mass: a.mass,
+            quarter_turns: a.quarter_turns,
+        }
+    }
+}
+
 impl AgentBody {
     /// The exact rotation `R_z(m_i pi/2)` from the agent frame to the team frame.
     pub fn rotation(&self) -> Matrix3<f64> {
@@ -102,15 +113,7 @@ impl TeamBody {
     ) -> Result<Self, tvmd_core::ConfigError> {
         let team: tvmd_core::TeamConfig<f64, 16> = preset.team_with(unit, mass)?;
         Ok(Self {
-            agents: team
-                .agents()
-                .iter()
-                .map(|a| AgentBody {
-                    position: a.position.into(),
-                    mass: a.mass,
-                    quarter_turns: a.quarter_turns,
-                })
-                .collect(),
+            agents: team.agents().iter().map(AgentBody::from).collect(),
             navigator_mass: 0.0,
             navigator_inertia: [[0.0; 3]; 3],
             collider_radius: DEFAULT_COLLIDER_RADIUS,
