@@ -25,11 +25,23 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#if !defined(TVMD_CAPACITY_4)
 /*
  The capacity of the handle: the largest team it controls (and the channel count of
- [`actuator::TvmdActuatorOutputs`]).
+ [`actuator::TvmdActuatorOutputs`]): 16, or 4 when built with the feature `capacity-4`
+ (C: define `TVMD_CAPACITY_4` before including the header). Four is what PX4's stock output
+ path drives (8 servo channels, two per agent), and with it every entry point runs on less
+ stack (docs/c-interface.md, Stack).
  */
 #define TVMD_MAX_AGENTS 16
+#endif
+
+#if defined(TVMD_CAPACITY_4)
+/*
+ The capacity of the handle: 4 in this build (feature `capacity-4`, C: `TVMD_CAPACITY_4`).
+ */
+#define TVMD_MAX_AGENTS 4
+#endif
 
 /*
  The ABI version; raised on every incompatible change of a struct or function (2: the `law`
@@ -57,6 +69,12 @@
  drives at most four two-axis agents.
  */
 #define TVMD_SERVO_CHANNELS 8
+
+/*
+ Channels of each array of [`TvmdActuatorOutputs`], whatever the capacity: at least
+ `TVMD_MOTOR_CHANNELS` and `TVMD_SERVO_CHANNELS`.
+ */
+#define TVMD_OUTPUT_CHANNELS 16
 
 /*
  `fault.mode`: no detection (the paper's and the default configurations).
@@ -337,11 +355,11 @@ typedef struct TvmdActuatorOutputs {
   /*
    Motor channels in `[0, 1]`; NaN when unused or the agent failed (stopped).
    */
-  float motors[TVMD_MAX_AGENTS];
+  float motors[TVMD_OUTPUT_CHANNELS];
   /*
    Servo channels in `[-1, 1]`, NaN when unused.
    */
-  float servos[TVMD_MAX_AGENTS];
+  float servos[TVMD_OUTPUT_CHANNELS];
 } TvmdActuatorOutputs;
 
 /*

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 /// The roll `R_x(phi)`, at its old path (now in [`crate::rotation`]).
 pub use crate::rotation::roll;
 
+mod build;
 mod cycle;
 mod detection;
 mod guard;
@@ -39,7 +40,6 @@ use crate::planner::{AttitudePlanner, PlannerOutput};
 use crate::projection::ForceProjection;
 use crate::real::Real;
 use crate::team::{FailureMask, TeamConfig};
-use guard::input_limit;
 
 /// Every quantity of one control period.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -128,52 +128,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         settings: ControllerSettings<T>,
         allocator: A,
     ) -> Result<Self, ConfigError> {
-        settings.validate()?;
-        // Also rejects a gravity whose weight m_C g overflows.
-        let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
-        let gains =
-            settings
-                .gain_schedule
-                .resolve(&settings.gains, team.mass(), &team.inertia())?;
-        let failures = FailureMask::none();
-        let afs = team.afs(&failures)?;
-        let effectiveness = team.effectiveness(&failures);
-        let mut allocator = allocator;
-        allocator.configure(&effectiveness);
-        let input_limit = input_limit(&team, &gains, settings.gravity);
-        let offset_free = OffsetFreeState::new(
-            settings.offset_free.as_ref(),
-            settings.period,
-            afs.max_force(),
-        );
-        let attitude_rate = match settings.attitude_rate {
-            Some(filter) => Some(AttitudeRateState::new(filter, settings.period)?),
-            None => None,
-        };
-        let admissible = AdmissibleSet::from_limits(team.limits());
-        let hover = hover_capability(&effectiveness, &admissible, plant.weight());
-        let fault = detection::FaultMonitor::new(&settings, &team, plant.weight())?;
-        Ok(Self {
-            fault,
-            input_limit,
-            gains,
-            offset_free,
-            attitude_rate,
-            pending: None,
-            full_cone: afs.cone(Relaxation::none()),
-            planner_cone: afs.cone(settings.relaxation),
-            afs,
-            plant,
-            planner: AttitudePlanner::new(settings.relaxation),
-            effectiveness,
-            admissible,
-            hover,
-            team,
-            settings,
-            allocator,
-            failures,
-            previous: [AgentCommand::idle(); N],
-        })
+        let mut slot = core::mem::MaybeUninit::uninit();
+        Self::init_in(&mut slot, &team, &settings, allocator)?;
+        // SAFETY: `init_in` returned `Ok`, so it initialized every field.
+        Ok(unsafe { slot.assume_init() })
     }
 
     /// Tells the controller which agents failed, and classifies the working agents: whether
@@ -203,7 +161,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.afs = self.team.afs(&failures)?;
         self.full_cone = self.afs.cone(Relaxation::none());
         self.planner_cone = self.afs.cone(self.settings.relaxation);
-        self.effectiveness = self.team.effectiveness(&failures);
+        self.team
+            .effectiveness_into(&failures, &mut self.effectiveness);
         self.allocator.configure(&self.effectiveness);
         self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
         self.failures = failures;

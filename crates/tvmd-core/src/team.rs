@@ -1,12 +1,12 @@
 //! The team configuration `Xi` (paper, "Modeling"): agents, limits, navigator, and the derived
 //! team mass `m_C`, inertia `J_C`, `n_x` / `n_y` and the Con/Inc arrangement.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
 use crate::admissible::AdmissibleSet;
 use crate::afs::AttainableForceSpace;
 use crate::definite::{is_symmetric_pd, is_symmetric_psd};
-use crate::effectiveness::Effectiveness;
+use crate::effectiveness::{agent_block, check_gram_rank, Effectiveness};
 use crate::error::{ConfigError, ConfigField, MassOf};
 /// The failure mask, at its old path (now in [`crate::failure`]).
 pub use crate::failure::FailureMask;
@@ -14,6 +14,7 @@ use crate::hover::{hover_capability, HoverCapability};
 use crate::law::Plant;
 /// The agent limits, at their old path (now in [`crate::limits`]).
 pub use crate::limits::AgentLimits;
+use crate::linalg::weighted_gram;
 use crate::real::{count, lit, Real};
 
 /// One agent of the team: its frame in the team CoM frame `{C}`.
@@ -190,13 +191,9 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
             mass,
             inertia,
         };
-        let effectiveness = team.effectiveness(&FailureMask::none());
-        finite_derived(
-            effectiveness.gram().iter(),
-            "Gram matrix M M^T",
-            ConfigField::AgentPosition,
-        )?;
-        effectiveness.check_rank()?;
+        let gram = team.gram(&FailureMask::none());
+        finite_derived(gram.iter(), "Gram matrix M M^T", ConfigField::AgentPosition)?;
+        check_gram_rank(&gram)?;
         // Rank 6 rules out collinear teams, the only ones whose point masses alone give a
         // singular J_C; this catches what rounding or a navigator inertia could still leave.
         if !is_symmetric_pd(&inertia) {
@@ -284,6 +281,24 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         )
     }
 
+    /// [`Self::effectiveness`] written into `model` in place ([`Effectiveness::assign`]).
+    pub fn effectiveness_into(&self, failures: &FailureMask<N>, model: &mut Effectiveness<T, N>) {
+        model.assign(
+            self.working(failures)
+                .map(|(i, a)| (i, &a.position, a.quarter_turns)),
+        );
+    }
+
+    /// `M M^T` of the working agents, the same sum as [`Effectiveness::gram`], one block at a
+    /// time (the checks need no whole model on the stack).
+    fn gram(&self, failures: &FailureMask<N>) -> Matrix6<T> {
+        self.working(failures)
+            .fold(Matrix6::zeros(), |gram, (_, a)| {
+                let block = agent_block(&a.position, a.quarter_turns);
+                weighted_gram(gram, [(&block, T::one())])
+            })
+    }
+
     /// The attainable-force-space approximation of the working agents (eqs. 7-8).
     /// Errors with [`ConfigError::NoAgents`] when every agent failed.
     pub fn afs(&self, failures: &FailureMask<N>) -> Result<AttainableForceSpace<T>, ConfigError> {
@@ -329,7 +344,7 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
     /// Checks that a degraded team can still produce every wrench (rank-6 `M`).
     pub fn validate_failures(&self, failures: &FailureMask<N>) -> Result<(), ConfigError> {
         self.check_mask(failures)?;
-        self.effectiveness(failures).check_rank()
+        check_gram_rank(&self.gram(failures))
     }
 
     fn check_mask(&self, failures: &FailureMask<N>) -> Result<(), ConfigError> {

@@ -47,7 +47,7 @@ fn a_refused_reconfiguration_changes_nothing() {
         ..ControllerSettings::offset_free_law()
     };
     assert!(c
-        .reconfigure(team, bad, ExactBoundaryRedistribution::new())
+        .reconfigure(&team, &bad, ExactBoundaryRedistribution::new())
         .is_err());
     let mut twin = before;
     let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
@@ -72,7 +72,7 @@ fn an_accepted_reconfiguration_keeps_the_flight_state() {
         relaxation: Relaxation::new(0.8).unwrap(),
         ..ControllerSettings::offset_free_law()
     };
-    c.reconfigure(team, settings, ExactBoundaryRedistribution::new())
+    c.reconfigure(&team, &settings, ExactBoundaryRedistribution::new())
         .unwrap();
     assert_eq!(c.failures(), &FailureMask::with_failed(&[5]).unwrap());
     assert_eq!(c.settings().relaxation, Relaxation::new(0.8).unwrap());
@@ -136,4 +136,44 @@ fn setters_and_the_seed_check_their_inputs() {
         .step(&bad, &Reference::hover(Vector3::zeros()))
         .unwrap_err();
     assert_eq!(held.commands, [hover; 4]);
+}
+
+/// Steps two controllers on the same body and reference and asserts every output is equal.
+fn step_alike(a: &mut C, b: &mut C, body: &Body) {
+    let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
+    reference.attitude = roll(0.8);
+    for _ in 0..20 {
+        assert_eq!(
+            a.step(&body.state(), &reference).unwrap(),
+            b.step(&body.state(), &reference).unwrap()
+        );
+    }
+}
+
+#[test]
+fn built_in_place_equals_built_anew() {
+    let team = presets::a6_inc::<f64, 6>().unwrap();
+    let settings = ControllerSettings::offset_free_law();
+    let mut fresh = Controller::new(team, settings, ExactBoundaryRedistribution::new()).unwrap();
+    let mut slot = core::mem::MaybeUninit::uninit();
+    let in_place = Controller::init_in(
+        &mut slot,
+        &team,
+        &settings,
+        ExactBoundaryRedistribution::new(),
+    )
+    .unwrap();
+    let body = Body::at(Vector3::new(0.1, 0.0, 1.5));
+    step_alike(&mut fresh, in_place, &body);
+    // A never-flown controller reconfigured (same mask, no state to carry) flies as one built
+    // anew with the new settings.
+    let paper = ControllerSettings::paper();
+    let mut reconfigured = fresh.clone();
+    reconfigured
+        .reconfigure(&team, &paper, ExactBoundaryRedistribution::new())
+        .unwrap();
+    let mut anew = Controller::new(team, paper, ExactBoundaryRedistribution::new()).unwrap();
+    reconfigured.reset();
+    anew.reset();
+    step_alike(&mut reconfigured, &mut anew, &body);
 }

@@ -37,6 +37,13 @@ pub const TVMD_MOTOR_CHANNELS: u32 = 12;
 /// drives at most four two-axis agents.
 pub const TVMD_SERVO_CHANNELS: u32 = 8;
 
+/// Channels of each array of [`TvmdActuatorOutputs`], whatever the capacity: at least
+/// `TVMD_MOTOR_CHANNELS` and `TVMD_SERVO_CHANNELS`.
+pub const TVMD_OUTPUT_CHANNELS: usize = 16;
+
+const _: () = assert!(TVMD_OUTPUT_CHANNELS >= TVMD_MOTOR_CHANNELS as usize);
+const _: () = assert!(TVMD_OUTPUT_CHANNELS >= TVMD_SERVO_CHANNELS as usize);
+
 /// One agent's channels.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -75,9 +82,9 @@ pub struct TvmdActuatorOutputs {
     /// `sizeof(TvmdActuatorOutputs)`, set by the caller.
     pub size: u32,
     /// Motor channels in `[0, 1]`; NaN when unused or the agent failed (stopped).
-    pub motors: [f32; TVMD_MAX_AGENTS],
+    pub motors: [f32; TVMD_OUTPUT_CHANNELS],
     /// Servo channels in `[-1, 1]`, NaN when unused.
-    pub servos: [f32; TVMD_MAX_AGENTS],
+    pub servos: [f32; TVMD_OUTPUT_CHANNELS],
 }
 
 fn size_ok<T>(size: u32) -> bool {
@@ -86,7 +93,11 @@ fn size_ok<T>(size: u32) -> bool {
 
 /// The used channels of one kind; `TVMD_ERR_MAP_*` for an index at or beyond `limit` or a
 /// repeat.
-fn mark(used: &mut [bool; TVMD_MAX_AGENTS], channel: u32, limit: u32) -> Result<(), TvmdStatus> {
+fn mark(
+    used: &mut [bool; TVMD_OUTPUT_CHANNELS],
+    channel: u32,
+    limit: u32,
+) -> Result<(), TvmdStatus> {
     let slot = usize::try_from(channel)
         .ok()
         .filter(|_| channel < limit)
@@ -115,7 +126,7 @@ fn validate<'a>(
     let agents = map.agents.get(..n).ok_or(TVMD_ERR_MAP_AGENT_COUNT)?;
     let limits = controller.team().limits();
     let sigma = [limits.sigma_x(), limits.sigma_y()];
-    let (mut motors, mut servos) = ([false; TVMD_MAX_AGENTS], [false; TVMD_MAX_AGENTS]);
+    let (mut motors, mut servos) = ([false; TVMD_OUTPUT_CHANNELS], [false; TVMD_OUTPUT_CHANNELS]);
     for agent in agents {
         for m in agent.motor {
             mark(&mut motors, m, TVMD_MOTOR_CHANNELS)?;
@@ -284,8 +295,8 @@ pub unsafe extern "C" fn tvmd_actuator_outputs(
             return TVMD_ERR_ACTUATOR_VALUE;
         }
     }
-    let mut motors = [f32::NAN; TVMD_MAX_AGENTS];
-    let mut servos = [f32::NAN; TVMD_MAX_AGENTS];
+    let mut motors = [f32::NAN; TVMD_OUTPUT_CHANNELS];
+    let mut servos = [f32::NAN; TVMD_OUTPUT_CHANNELS];
     for (i, (agent, c)) in agents.iter().zip(commands).enumerate() {
         let failed = failures.is_failed(i);
         let motor = if failed {

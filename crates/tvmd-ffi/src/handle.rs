@@ -6,7 +6,7 @@
 //! chosen at run time) into it; nothing needs freeing. A handle is not thread-safe: call its
 //! entry points from one task (the control loop), or serialize them.
 
-use core::mem::{align_of, size_of};
+use core::mem::{align_of, size_of, MaybeUninit};
 
 use tvmd_core::allocation::{
     AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
@@ -139,8 +139,16 @@ pub(crate) fn held_commands(controller: &FfiController) -> [TvmdAgentCommand; TV
     held
 }
 
-/// The core controller a configuration describes.
-pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> {
+/// What a configuration describes: the parts a controller is built from.
+pub(crate) struct Blueprint {
+    pub(crate) team: TeamConfig<f32, TVMD_MAX_AGENTS>,
+    pub(crate) settings: ControllerSettings<f32>,
+    pub(crate) allocator: AnyAllocator<f32, TVMD_MAX_AGENTS>,
+}
+
+/// The team, settings and allocator `config` describes, each checked (the controller's own
+/// checks run when it is built, [`Controller::check`]).
+pub(crate) fn blueprint(config: &TvmdConfig) -> Result<Blueprint, ConvertError> {
     let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
     let Some(agents) = config.agents.get(..count) else {
         return Err(ConfigError::TooManyAgents {
@@ -198,7 +206,11 @@ pub(crate) fn build(config: &TvmdConfig) -> Result<FfiController, ConvertError> 
         options.max_rounds = Some(config.allocator_max_rounds);
     }
     let allocator = AnyAllocator::from_name(name, &options)?;
-    Ok(Controller::new(team, settings, allocator)?)
+    Ok(Blueprint {
+        team,
+        settings,
+        allocator,
+    })
 }
 
 /// Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
@@ -230,12 +242,21 @@ pub unsafe extern "C" fn tvmd_create(
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    match build(config) {
-        Ok(controller) => {
-            inner.write(Inner {
-                magic: MAGIC,
-                controller,
-            });
+    let blueprint = match blueprint(config) {
+        Ok(b) => b,
+        Err(e) => return e.status(),
+    };
+    // Built in place: a controller on the stack would cost a small-stack caller 4 KB more.
+    let slot =
+        &mut *core::ptr::addr_of_mut!((*inner).controller).cast::<MaybeUninit<FfiController>>();
+    match Controller::init_in(
+        slot,
+        &blueprint.team,
+        &blueprint.settings,
+        blueprint.allocator,
+    ) {
+        Ok(_) => {
+            core::ptr::addr_of_mut!((*inner).magic).write(MAGIC);
             storage
                 .cast::<u8>()
                 .add(TAIL_OFFSET)
@@ -243,7 +264,7 @@ pub unsafe extern "C" fn tvmd_create(
                 .write(TAIL);
             TVMD_OK
         }
-        Err(e) => e.status(),
+        Err(e) => config_status(&e),
     }
 }
 

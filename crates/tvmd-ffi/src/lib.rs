@@ -49,8 +49,16 @@ pub mod status;
 pub mod types;
 
 /// The capacity of the handle: the largest team it controls (and the channel count of
-/// [`actuator::TvmdActuatorOutputs`]).
+/// [`actuator::TvmdActuatorOutputs`]): 16, or 4 when built with the feature `capacity-4`
+/// (C: define `TVMD_CAPACITY_4` before including the header). Four is what PX4's stock output
+/// path drives (8 servo channels, two per agent), and with it every entry point runs on less
+/// stack (docs/c-interface.md, Stack).
+#[cfg(not(feature = "capacity-4"))]
 pub const TVMD_MAX_AGENTS: usize = 16;
+
+/// The capacity of the handle: 4 in this build (feature `capacity-4`, C: `TVMD_CAPACITY_4`).
+#[cfg(feature = "capacity-4")]
+pub const TVMD_MAX_AGENTS: usize = 4;
 
 /// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 /// of `TvmdConfig` and the compensation of `TvmdOutput`).

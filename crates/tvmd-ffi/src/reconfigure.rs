@@ -6,7 +6,7 @@
 
 use tvmd_core::{AgentCommand, RateLimits, Relaxation};
 
-use crate::handle::{build, checked_size, inner_mut, TvmdController};
+use crate::handle::{blueprint, checked_size, inner_mut, FfiController, TvmdController};
 use crate::status::*;
 use crate::types::*;
 use crate::TVMD_MAX_AGENTS;
@@ -26,8 +26,11 @@ pub unsafe extern "C" fn tvmd_validate_config(config: *const TvmdConfig) -> Tvmd
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    match build(config) {
-        Ok(_) => TVMD_OK,
+    match blueprint(config) {
+        Ok(b) => match FfiController::check(&b.team, &b.settings) {
+            Ok(()) => TVMD_OK,
+            Err(e) => config_status(&e),
+        },
         Err(e) => e.status(),
     }
 }
@@ -56,11 +59,14 @@ pub unsafe extern "C" fn tvmd_reconfigure(
         Ok(inner) => inner,
         Err(status) => return status,
     };
-    let next = match build(config) {
+    let next = match blueprint(config) {
         Ok(next) => next,
         Err(e) => return e.status(),
     };
-    match inner.controller.take_over(next) {
+    match inner
+        .controller
+        .reconfigure(&next.team, &next.settings, next.allocator)
+    {
         Ok(()) => TVMD_OK,
         Err(e) => config_status(&e),
     }

@@ -11,10 +11,9 @@ use crate::law::Gains;
 use crate::limits::RateLimits;
 use crate::planner::AttitudePlanner;
 use crate::real::{lit, Real};
-use crate::team::TeamConfig;
 
 use super::guard::input_limit;
-use super::{Controller, ControllerSettings};
+use super::Controller;
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// New gains of eq. (12) (resolved by the settings' gain schedule for the team, as at
@@ -72,44 +71,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Whether agent `i` may hold `command`: inside its admissible set (gimbal and thrust
     /// limits, within the inversion's tolerance) when it works, idle when it failed or the slot
     /// is unused.
-    fn admits(&self, i: usize, command: &AgentCommand<T>) -> bool {
+    pub(super) fn admits(&self, i: usize, command: &AgentCommand<T>) -> bool {
         if self.effectiveness.block(i).is_some() {
             self.admissible.contains(&command.gimbal(), lit(1e-4)) && command.omega >= T::zero()
         } else {
             *command == AgentCommand::idle()
         }
-    }
-
-    /// Replaces team, settings and allocator while flying: all or nothing. The new controller
-    /// is built and given the running one's failure mask, landed flag, held commands (when they
-    /// are admissible for the new team, agent by agent; otherwise idle) and offset-free estimate (when both run
-    /// the same kind of action, clamped onto the new bounds); only then does it replace the
-    /// running one. On an error the running controller is untouched and steps exactly as
-    /// before.
-    pub fn reconfigure(
-        &mut self,
-        team: TeamConfig<T, N>,
-        settings: ControllerSettings<T>,
-        allocator: A,
-    ) -> Result<(), ConfigError> {
-        self.take_over(Self::new(team, settings, allocator)?)
-    }
-
-    /// As [`Self::reconfigure`] with the new controller already built: `next` is given this
-    /// one's failure mask, landed flag, held commands and offset-free estimate, then replaces
-    /// it. On an error (the mask does not fit `next`'s team) nothing changes.
-    pub fn take_over(&mut self, mut next: Self) -> Result<(), ConfigError> {
-        next.set_failures(self.failures)?;
-        next.set_landed(self.landed());
-        next.offset_free.carry_over(&self.offset_free);
-        let mut held = [AgentCommand::idle(); N];
-        for (i, (slot, old)) in held.iter_mut().zip(&self.previous).enumerate() {
-            if next.admits(i, old) {
-                *slot = *old;
-            }
-        }
-        next.previous = held;
-        *self = next;
-        Ok(())
     }
 }

@@ -1,0 +1,214 @@
+//! Building a controller where it lives. [`Controller::init_in`] writes each part straight into
+//! the caller's storage and [`Controller::reconfigure`] rebuilds a running controller the same
+//! way, so no whole controller is ever on the stack: with 16 agents in `f32` it is about 4 KB,
+//! more than a flight stack's work queue has (PX4: 2.2-3.2 KB). Every fallible step runs before
+//! the first write, so an error leaves the storage, or the running controller, untouched.
+
+use core::mem::{ManuallyDrop, MaybeUninit};
+use core::ptr::{addr_of_mut, read};
+
+use crate::admissible::AdmissibleSet;
+use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::allocation::Allocator;
+use crate::attitude_rate::AttitudeRateState;
+use crate::command::AgentCommand;
+use crate::effectiveness::Effectiveness;
+use crate::error::ConfigError;
+use crate::hover::hover_capability;
+use crate::law::{Gains, Plant};
+use crate::offset_free::OffsetFreeState;
+use crate::planner::AttitudePlanner;
+use crate::real::Real;
+use crate::team::{FailureMask, TeamConfig};
+
+use super::detection::FaultMonitor;
+use super::guard::input_limit;
+use super::{Controller, ControllerSettings};
+
+/// What a controller derives from its team and settings for a failure mask: everything that
+/// can fail, computed before anything is written.
+struct Parts<T: Real, const N: usize> {
+    failures: FailureMask<N>,
+    plant: Plant<T>,
+    gains: Gains<T>,
+    afs: AttainableForceSpace<T>,
+    input_limit: T,
+    offset_free: OffsetFreeState<T>,
+    attitude_rate: Option<AttitudeRateState<T>>,
+    admissible: AdmissibleSet<T>,
+    fault: Option<FaultMonitor<T>>,
+}
+
+impl<T: Real, const N: usize> Parts<T, N> {
+    // Not inlined, here and in `write`: their temporaries then share the stack one after the
+    // other instead of adding up in the caller's frame.
+    #[inline(never)]
+    fn new(
+        team: &TeamConfig<T, N>,
+        settings: &ControllerSettings<T>,
+        failures: FailureMask<N>,
+    ) -> Result<Self, ConfigError> {
+        settings.validate()?;
+        // Also rejects a gravity whose weight m_C g overflows.
+        let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
+        let gains =
+            settings
+                .gain_schedule
+                .resolve(&settings.gains, team.mass(), &team.inertia())?;
+        team.validate_failures(&failures)?;
+        let afs = team.afs(&failures)?;
+        let attitude_rate = match settings.attitude_rate {
+            Some(filter) => Some(AttitudeRateState::new(filter, settings.period)?),
+            None => None,
+        };
+        let fault = FaultMonitor::new(settings, team, plant.weight())?;
+        Ok(Self {
+            failures,
+            input_limit: input_limit(team, &gains, settings.gravity),
+            offset_free: OffsetFreeState::new(
+                settings.offset_free.as_ref(),
+                settings.period,
+                afs.max_force(),
+            ),
+            admissible: AdmissibleSet::from_limits(team.limits()),
+            plant,
+            gains,
+            afs,
+            attitude_rate,
+            fault,
+        })
+    }
+}
+
+impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
+    /// Builds the controller of [`Self::new`] in `slot`, part by part, and returns it there:
+    /// the same checks, errors and controller, without the whole controller on the stack (for
+    /// storage of the caller's, such as the C interface's handle). On an error `slot` is not
+    /// written.
+    ///
+    /// ```
+    /// use core::mem::MaybeUninit;
+    /// use tvmd_core::{team::presets, Controller, ControllerSettings, ExactBoundaryRedistribution};
+    /// let team = presets::a4_inc::<f32, 16>()?;
+    /// let mut slot = MaybeUninit::uninit();
+    /// let controller = Controller::init_in(
+    ///     &mut slot,
+    ///     &team,
+    ///     &ControllerSettings::default(),
+    ///     ExactBoundaryRedistribution::new(),
+    /// )?;
+    /// assert!(controller.hover_capability().capable);
+    /// # Ok::<(), tvmd_core::ConfigError>(())
+    /// ```
+    pub fn init_in<'s>(
+        slot: &'s mut MaybeUninit<Self>,
+        team: &TeamConfig<T, N>,
+        settings: &ControllerSettings<T>,
+        allocator: A,
+    ) -> Result<&'s mut Self, ConfigError> {
+        let parts = Parts::new(team, settings, FailureMask::none())?;
+        // SAFETY: `slot` is valid for writes and aligned; `write` initializes every field.
+        unsafe {
+            write(slot.as_mut_ptr(), team, settings, allocator, parts);
+            Ok(slot.assume_init_mut())
+        }
+    }
+
+    /// The checks of [`Self::new`] for `team` and `settings` (the allocator checks its own
+    /// options when it is built), without building the controller.
+    pub fn check(
+        team: &TeamConfig<T, N>,
+        settings: &ControllerSettings<T>,
+    ) -> Result<(), ConfigError> {
+        Parts::new(team, settings, FailureMask::none()).map(|_| ())
+    }
+
+    /// Replaces team, settings and allocator while flying: all or nothing. The controller is
+    /// rebuilt in place with the running one's failure mask, landed flag, held commands (when
+    /// they are admissible for the new team, agent by agent; otherwise idle) and offset-free
+    /// estimate (when both run the same kind of action, clamped onto the new bounds). On an
+    /// error the running controller is untouched and steps exactly as before.
+    pub fn reconfigure(
+        &mut self,
+        team: &TeamConfig<T, N>,
+        settings: &ControllerSettings<T>,
+        allocator: A,
+    ) -> Result<(), ConfigError> {
+        let parts = Parts::new(team, settings, self.failures)?;
+        let (offset_free, previous) = (self.offset_free, self.previous);
+        let this: *mut Self = self;
+        // SAFETY: `this` is valid, aligned and initialized. The old allocator is moved out
+        // first and dropped after every field was written again, so nothing is dropped twice
+        // and nothing but the allocator owns anything to drop.
+        let old = unsafe {
+            let old = ManuallyDrop::new(read(addr_of_mut!((*this).allocator)));
+            write(this, team, settings, allocator, parts);
+            ManuallyDrop::into_inner(old)
+        };
+        drop(old);
+        self.offset_free.carry_over(&offset_free);
+        self.previous = self.held_from(&previous);
+        Ok(())
+    }
+
+    /// `previous` agent by agent where this controller admits it, otherwise idle.
+    fn held_from(&self, previous: &[AgentCommand<T>; N]) -> [AgentCommand<T>; N] {
+        let mut held = [AgentCommand::idle(); N];
+        for (i, (slot, old)) in held.iter_mut().zip(previous).enumerate() {
+            if self.admits(i, old) {
+                *slot = *old;
+            }
+        }
+        held
+    }
+}
+
+/// Writes every field of the controller of `team`, `settings`, `allocator` and `parts` at
+/// `this`, the effectiveness model in place. What `this` held is overwritten, not dropped.
+///
+/// # Safety
+/// `this` is valid for writes and aligned.
+#[inline(never)]
+unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
+    this: *mut Controller<T, N, A>,
+    team: &TeamConfig<T, N>,
+    settings: &ControllerSettings<T>,
+    allocator: A,
+    parts: Parts<T, N>,
+) {
+    let Parts {
+        failures,
+        plant,
+        gains,
+        afs,
+        input_limit,
+        offset_free,
+        attitude_rate,
+        admissible,
+        fault,
+    } = parts;
+    addr_of_mut!((*this).team).write(*team);
+    addr_of_mut!((*this).settings).write(*settings);
+    addr_of_mut!((*this).gains).write(gains);
+    addr_of_mut!((*this).offset_free).write(offset_free);
+    addr_of_mut!((*this).attitude_rate).write(attitude_rate);
+    addr_of_mut!((*this).fault).write(fault);
+    addr_of_mut!((*this).pending).write(None);
+    addr_of_mut!((*this).plant).write(plant);
+    addr_of_mut!((*this).planner).write(AttitudePlanner::new(settings.relaxation));
+    addr_of_mut!((*this).failures).write(failures);
+    addr_of_mut!((*this).full_cone).write(afs.cone(Relaxation::none()));
+    addr_of_mut!((*this).planner_cone).write(afs.cone(settings.relaxation));
+    addr_of_mut!((*this).afs).write(afs);
+    addr_of_mut!((*this).admissible).write(admissible);
+    addr_of_mut!((*this).previous).write([AgentCommand::idle(); N]);
+    addr_of_mut!((*this).input_limit).write(input_limit);
+    let effectiveness = addr_of_mut!((*this).effectiveness);
+    effectiveness.write(Effectiveness::new([]));
+    team.effectiveness_into(&failures, &mut *effectiveness);
+    let hover = hover_capability(&*effectiveness, &admissible, plant.weight());
+    addr_of_mut!((*this).hover).write(hover);
+    let slot = addr_of_mut!((*this).allocator);
+    slot.write(allocator);
+    (*slot).configure(&*effectiveness);
+}
