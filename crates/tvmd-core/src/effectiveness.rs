@@ -52,6 +52,23 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
         m
     }
 
+    /// Writes the model [`Self::new`] builds from `agents` at `this`, without a model on the
+    /// stack.
+    ///
+    /// # Safety
+    /// `this` is valid for writes and aligned; what it held is overwritten, not dropped.
+    pub(crate) unsafe fn write_new<'a>(
+        this: *mut Self,
+        agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>,
+    ) {
+        let blocks = core::ptr::addr_of_mut!((*this).blocks).cast::<Option<Matrix6x3<T>>>();
+        for i in 0..N {
+            blocks.add(i).write(None);
+        }
+        core::ptr::addr_of_mut!((*this).gram).write(GramSolver::Zero);
+        (*this).assign(agents);
+    }
+
     /// Rebuilds this model from `(slot, p_i, m_i)` in place, as [`Self::new`] would build it.
     /// Why in place: with 16 agents in `f32` the model is 1.4 KB, and a new one built on the
     /// stack and moved here costs a small-stack caller (a flight stack's work queue) twice that.

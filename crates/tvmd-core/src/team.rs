@@ -289,6 +289,22 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
         );
     }
 
+    /// [`Self::effectiveness`] written at `model`, without a model on the stack.
+    ///
+    /// # Safety
+    /// `model` is valid for writes and aligned; what it held is overwritten, not dropped.
+    pub(crate) unsafe fn write_effectiveness(
+        &self,
+        failures: &FailureMask<N>,
+        model: *mut Effectiveness<T, N>,
+    ) {
+        Effectiveness::write_new(
+            model,
+            self.working(failures)
+                .map(|(i, a)| (i, &a.position, a.quarter_turns)),
+        );
+    }
+
     /// `M M^T` of the working agents, the same sum as [`Effectiveness::gram`], one block at a
     /// time (the checks need no whole model on the stack).
     fn gram(&self, failures: &FailureMask<N>) -> Matrix6<T> {

@@ -8,15 +8,9 @@
 
 use core::mem::{align_of, size_of, MaybeUninit};
 
-use tvmd_core::allocation::{
-    AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
-    WEIGHTED_PSEUDO_INVERSE,
-};
-use tvmd_core::{
-    AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings, FailureMask, Navigator,
-    RateLimits, Relaxation, TeamConfig,
-};
+use tvmd_core::{AnyAllocator, ConfigError, Controller, FailureMask};
 
+use crate::blueprint::Blueprint;
 use crate::status::*;
 use crate::types::*;
 use crate::TVMD_MAX_AGENTS;
@@ -139,80 +133,6 @@ pub(crate) fn held_commands(controller: &FfiController) -> [TvmdAgentCommand; TV
     held
 }
 
-/// What a configuration describes: the parts a controller is built from.
-pub(crate) struct Blueprint {
-    pub(crate) team: TeamConfig<f32, TVMD_MAX_AGENTS>,
-    pub(crate) settings: ControllerSettings<f32>,
-    pub(crate) allocator: AnyAllocator<f32, TVMD_MAX_AGENTS>,
-}
-
-/// The team, settings and allocator `config` describes, each checked (the controller's own
-/// checks run when it is built, [`Controller::check`]).
-pub(crate) fn blueprint(config: &TvmdConfig) -> Result<Blueprint, ConvertError> {
-    let count = usize::try_from(config.agent_count).unwrap_or(usize::MAX);
-    let Some(agents) = config.agents.get(..count) else {
-        return Err(ConfigError::TooManyAgents {
-            count,
-            capacity: TVMD_MAX_AGENTS,
-        }
-        .into());
-    };
-    let mut specs = [AgentSpec::new(vector(&[0.0; 3]), 0, 0.0); TVMD_MAX_AGENTS];
-    for (spec, agent) in specs.iter_mut().zip(agents) {
-        *spec = agent.to_core();
-    }
-    let navigator = Navigator {
-        mass: config.navigator_mass,
-        inertia: matrix(&config.navigator_inertia),
-    };
-    let limits = config.limits.to_core()?;
-    let team = TeamConfig::new(specs.get(..count).unwrap_or(&[]), limits, navigator)?;
-    let rate_limits = if config.rate_limited != 0 {
-        let [x, y] = config.rate_limits;
-        Some(RateLimits::new(x, y)?)
-    } else {
-        None
-    };
-    let law = config.law.to_core()?;
-    let settings = ControllerSettings {
-        gains: config.gains.to_core()?,
-        relaxation: Relaxation::new(config.relaxation)?,
-        gravity: config.gravity,
-        period: config.period,
-        rate_limits,
-        null_space: None,
-        gain_schedule: law.gain_schedule,
-        offset_free: law.offset_free,
-        attitude_rate: law.attitude_rate,
-        fault_detection: config.fault.to_core()?,
-    };
-    let name = match config.allocator {
-        TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,
-        TVMD_ALLOCATOR_PSEUDO_INVERSE => PSEUDO_INVERSE,
-        TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE => WEIGHTED_PSEUDO_INVERSE,
-        TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION => EXACT_BOUNDARY_REDISTRIBUTION,
-        _ => "",
-    };
-    let mut options = AllocatorOptions::default();
-    if name == WEIGHTED_PSEUDO_INVERSE {
-        // Slots beyond the team are unused; the core wants a valid weight in each.
-        let mut weights = [1.0; TVMD_MAX_AGENTS];
-        for (w, given) in weights.iter_mut().zip(&config.agent_weights).take(count) {
-            *w = *given;
-        }
-        options.agent_weights = Some(weights);
-    }
-    if config.allocator_max_rounds != 0 {
-        options.max_rounds = Some(config.allocator_max_rounds);
-    }
-    let allocator = AnyAllocator::from_name(name, &options)?;
-    Ok(Blueprint {
-        team,
-        settings,
-        allocator,
-    })
-}
-
 /// Creates a controller from `config` in `storage` (`storage_size` = `sizeof(TvmdController)`).
 /// On an error the storage is marked not initialized, and every other entry point refuses it.
 /// Calling it again on a created handle replaces the controller.
@@ -242,7 +162,8 @@ pub unsafe extern "C" fn tvmd_create(
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    let blueprint = match blueprint(config) {
+    let mut blueprint = MaybeUninit::uninit();
+    let blueprint = match Blueprint::write_in(&mut blueprint, config) {
         Ok(b) => b,
         Err(e) => return e.status(),
     };
@@ -253,7 +174,7 @@ pub unsafe extern "C" fn tvmd_create(
         slot,
         &blueprint.team,
         &blueprint.settings,
-        blueprint.allocator,
+        blueprint.allocator.clone(),
     ) {
         Ok(_) => {
             core::ptr::addr_of_mut!((*inner).magic).write(MAGIC);

@@ -38,6 +38,7 @@
 extern crate std;
 
 pub mod actuator;
+mod blueprint;
 pub mod config;
 pub mod fault;
 pub mod fault_report;

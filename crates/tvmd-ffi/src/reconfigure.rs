@@ -6,7 +6,10 @@
 
 use tvmd_core::{AgentCommand, RateLimits, Relaxation};
 
-use crate::handle::{blueprint, checked_size, inner_mut, FfiController, TvmdController};
+use core::mem::MaybeUninit;
+
+use crate::blueprint::Blueprint;
+use crate::handle::{checked_size, inner_mut, FfiController, TvmdController};
 use crate::status::*;
 use crate::types::*;
 use crate::TVMD_MAX_AGENTS;
@@ -26,7 +29,7 @@ pub unsafe extern "C" fn tvmd_validate_config(config: *const TvmdConfig) -> Tvmd
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    match blueprint(config) {
+    match Blueprint::write_in(&mut MaybeUninit::uninit(), config) {
         Ok(b) => match FfiController::check(&b.team, &b.settings) {
             Ok(()) => TVMD_OK,
             Err(e) => config_status(&e),
@@ -59,13 +62,14 @@ pub unsafe extern "C" fn tvmd_reconfigure(
         Ok(inner) => inner,
         Err(status) => return status,
     };
-    let next = match blueprint(config) {
+    let mut next = MaybeUninit::uninit();
+    let next = match Blueprint::write_in(&mut next, config) {
         Ok(next) => next,
         Err(e) => return e.status(),
     };
     match inner
         .controller
-        .reconfigure(&next.team, &next.settings, next.allocator)
+        .reconfigure(&next.team, &next.settings, next.allocator.clone())
     {
         Ok(()) => TVMD_OK,
         Err(e) => config_status(&e),

@@ -12,9 +12,8 @@ use crate::afs::{AttainableForceSpace, Relaxation};
 use crate::allocation::Allocator;
 use crate::attitude_rate::AttitudeRateState;
 use crate::command::AgentCommand;
-use crate::effectiveness::Effectiveness;
 use crate::error::ConfigError;
-use crate::hover::hover_capability;
+use crate::hover::{hover_capability, HoverCapability, HoverLimit};
 use crate::law::{Gains, Plant};
 use crate::offset_free::OffsetFreeState;
 use crate::planner::AttitudePlanner;
@@ -40,14 +39,15 @@ struct Parts<T: Real, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Parts<T, N> {
-    // Not inlined, here and in `write`: their temporaries then share the stack one after the
-    // other instead of adding up in the caller's frame.
+    // Written in place and not inlined, here and in `write`: their temporaries then share the
+    // stack one after the other instead of adding up in the caller's frame.
     #[inline(never)]
-    fn new(
+    fn write_in<'p>(
+        slot: &'p mut MaybeUninit<Self>,
         team: &TeamConfig<T, N>,
         settings: &ControllerSettings<T>,
         failures: FailureMask<N>,
-    ) -> Result<Self, ConfigError> {
+    ) -> Result<&'p Self, ConfigError> {
         settings.validate()?;
         // Also rejects a gravity whose weight m_C g overflows.
         let plant = Plant::new(team.mass(), team.inertia(), settings.gravity)?;
@@ -62,7 +62,7 @@ impl<T: Real, const N: usize> Parts<T, N> {
             None => None,
         };
         let fault = FaultMonitor::new(settings, team, plant.weight())?;
-        Ok(Self {
+        Ok(slot.write(Self {
             failures,
             input_limit: input_limit(team, &gains, settings.gravity),
             offset_free: OffsetFreeState::new(
@@ -76,7 +76,7 @@ impl<T: Real, const N: usize> Parts<T, N> {
             afs,
             attitude_rate,
             fault,
-        })
+        }))
     }
 }
 
@@ -106,21 +106,37 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         settings: &ControllerSettings<T>,
         allocator: A,
     ) -> Result<&'s mut Self, ConfigError> {
-        let parts = Parts::new(team, settings, FailureMask::none())?;
-        // SAFETY: `slot` is valid for writes and aligned; `write` initializes every field.
-        unsafe {
-            write(slot.as_mut_ptr(), team, settings, allocator, parts);
-            Ok(slot.assume_init_mut())
-        }
+        // SAFETY: `slot` is valid for writes and aligned; `build_at` initializes every field
+        // when it returns `Ok`.
+        let controller = unsafe {
+            build_at(
+                slot.as_mut_ptr(),
+                team,
+                settings,
+                allocator,
+                FailureMask::none(),
+            )?;
+            slot.assume_init_mut()
+        };
+        controller.classify_hover();
+        Ok(controller)
     }
 
     /// The checks of [`Self::new`] for `team` and `settings` (the allocator checks its own
     /// options when it is built), without building the controller.
+    // Not inlined, as `reconfigure`: the parts' frame is not the caller's.
+    #[inline(never)]
     pub fn check(
         team: &TeamConfig<T, N>,
         settings: &ControllerSettings<T>,
     ) -> Result<(), ConfigError> {
-        Parts::new(team, settings, FailureMask::none()).map(|_| ())
+        Parts::write_in(
+            &mut MaybeUninit::uninit(),
+            team,
+            settings,
+            FailureMask::none(),
+        )
+        .map(|_| ())
     }
 
     /// Replaces team, settings and allocator while flying: all or nothing. The controller is
@@ -128,27 +144,35 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// they are admissible for the new team, agent by agent; otherwise idle) and offset-free
     /// estimate (when both run the same kind of action, clamped onto the new bounds). On an
     /// error the running controller is untouched and steps exactly as before.
+    #[inline(never)]
     pub fn reconfigure(
         &mut self,
         team: &TeamConfig<T, N>,
         settings: &ControllerSettings<T>,
         allocator: A,
     ) -> Result<(), ConfigError> {
-        let parts = Parts::new(team, settings, self.failures)?;
-        let (offset_free, previous) = (self.offset_free, self.previous);
+        let (failures, offset_free, previous) = (self.failures, self.offset_free, self.previous);
         let this: *mut Self = self;
-        // SAFETY: `this` is valid, aligned and initialized. The old allocator is moved out
-        // first and dropped after every field was written again, so nothing is dropped twice
-        // and nothing but the allocator owns anything to drop.
-        let old = unsafe {
+        // SAFETY: `this` is valid, aligned and initialized. A bitwise copy of the old
+        // allocator is taken first: on an error `build_at` wrote nothing and the copy is
+        // forgotten (the controller still owns the allocator); on success every field was
+        // written again and the copy is the only owner, dropped here. Nothing but the
+        // allocator owns anything to drop.
+        unsafe {
             let old = ManuallyDrop::new(read(addr_of_mut!((*this).allocator)));
-            write(this, team, settings, allocator, parts);
-            ManuallyDrop::into_inner(old)
-        };
-        drop(old);
+            build_at(this, team, settings, allocator, failures)?;
+            drop(ManuallyDrop::into_inner(old));
+        }
+        self.classify_hover();
         self.offset_free.carry_over(&offset_free);
         self.previous = self.held_from(&previous);
         Ok(())
+    }
+
+    /// The hover classification of the working agents (after `write`, on its own stack).
+    #[inline(never)]
+    fn classify_hover(&mut self) {
+        self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
     }
 
     /// `previous` agent by agent where this controller admits it, otherwise idle.
@@ -163,8 +187,28 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     }
 }
 
+/// Derives the parts (every fallible step) and, when all succeed, writes the controller at
+/// `this`. On an error nothing is written. Not inlined: the parts' frame is not the caller's.
+///
+/// # Safety
+/// `this` is valid for writes and aligned.
+#[inline(never)]
+unsafe fn build_at<T: Real, const N: usize, A: Allocator<T, N>>(
+    this: *mut Controller<T, N, A>,
+    team: &TeamConfig<T, N>,
+    settings: &ControllerSettings<T>,
+    allocator: A,
+    failures: FailureMask<N>,
+) -> Result<(), ConfigError> {
+    let mut parts = MaybeUninit::uninit();
+    let parts = Parts::write_in(&mut parts, team, settings, failures)?;
+    write(this, team, settings, allocator, parts);
+    Ok(())
+}
+
 /// Writes every field of the controller of `team`, `settings`, `allocator` and `parts` at
-/// `this`, the effectiveness model in place. What `this` held is overwritten, not dropped.
+/// `this`, the effectiveness model in place; the hover classification is a placeholder until
+/// `classify_hover`. What `this` held is overwritten, not dropped.
 ///
 /// # Safety
 /// `this` is valid for writes and aligned.
@@ -174,9 +218,9 @@ unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
     team: &TeamConfig<T, N>,
     settings: &ControllerSettings<T>,
     allocator: A,
-    parts: Parts<T, N>,
+    parts: &Parts<T, N>,
 ) {
-    let Parts {
+    let &Parts {
         failures,
         plant,
         gains,
@@ -204,10 +248,14 @@ unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
     addr_of_mut!((*this).previous).write([AgentCommand::idle(); N]);
     addr_of_mut!((*this).input_limit).write(input_limit);
     let effectiveness = addr_of_mut!((*this).effectiveness);
-    effectiveness.write(Effectiveness::new([]));
-    team.effectiveness_into(&failures, &mut *effectiveness);
-    let hover = hover_capability(&*effectiveness, &admissible, plant.weight());
-    addr_of_mut!((*this).hover).write(hover);
+    team.write_effectiveness(&failures, effectiveness);
+    addr_of_mut!((*this).hover).write(HoverCapability {
+        capable: false,
+        margin: T::zero(),
+        limiting_agent: None,
+        limit: HoverLimit::MaxThrust,
+        weight: plant.weight(),
+    });
     let slot = addr_of_mut!((*this).allocator);
     slot.write(allocator);
     (*slot).configure(&*effectiveness);
