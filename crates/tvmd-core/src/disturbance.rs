@@ -124,6 +124,11 @@ impl<T: Real> ObserverState<T> {
         (-self.force, -self.torque)
     }
 
+    /// The filter gains `(1 - e^(-L_f dt), 1 - e^(-L_tau dt))`.
+    pub fn gains(&self) -> (T, T) {
+        self.gamma
+    }
+
     /// The estimates `(d^_f, d^_tau)`.
     pub fn estimate(&self) -> (Vector3<T>, Vector3<T>) {
         (self.force, self.torque)

@@ -99,6 +99,15 @@ impl<T: Real> OffsetFreeState<T> {
         }
     }
 
+    /// The disturbance observer's filter gains `(gamma_f, gamma_tau)`
+    /// ([`ObserverState::gains`]); `None` without an observer.
+    pub fn observer_gains(&self) -> Option<(T, T)> {
+        match &self.kind {
+            Kind::Observer(o) => Some(o.gains()),
+            _ => None,
+        }
+    }
+
     /// Clears the state (zero estimate or integral, no observer sample); the landed flag,
     /// which is the caller's input, is kept.
     pub fn reset(&mut self) {
