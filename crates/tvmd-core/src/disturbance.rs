@@ -141,6 +141,20 @@ impl<T: Real> ObserverState<T> {
         self.measured
     }
 
+    /// The estimates set to `(d^_f, d^_tau)` = `(force, torque)` (`{I}`, `{C}`; non-finite
+    /// values give zero), the rest as it is.
+    pub fn reseed(&mut self, force: Vector3<T>, torque: Vector3<T>) {
+        let finite = |v: Vector3<T>| {
+            if v.iter().all(|x| x.is_finite()) {
+                v
+            } else {
+                Vector3::zeros()
+            }
+        };
+        self.force = finite(force);
+        self.torque = finite(torque);
+    }
+
     /// Zero estimates, no sample.
     pub fn reset(&mut self) {
         self.force = Vector3::zeros();

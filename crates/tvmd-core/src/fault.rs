@@ -163,7 +163,8 @@ pub struct FaultReport<T: Real> {
 pub struct FaultState {
     /// The candidate agent (`u16`: a mask's slot; keeps the controller's state small).
     candidate: Option<u16>,
-    periods: u32,
+    /// Its consecutive periods (`u16`, saturating: the state stays small).
+    periods: u16,
 }
 
 /// One agent's fit of the residual.
@@ -261,16 +262,43 @@ impl FaultState {
             1
         };
         self.candidate = slot;
-        report.verdict = if self.periods >= detector.persistence {
+        report.verdict = if u32::from(self.periods) >= detector.persistence {
             FaultVerdict::Confirmed { agent, kind }
         } else {
             FaultVerdict::Suspected {
                 agent,
                 kind,
-                periods: self.periods,
+                periods: u32::from(self.periods),
             }
         };
         report
+    }
+}
+
+/// The share `c` in `[0, 1]` of agent `i`'s commanded wrench `M_i f` that `residual` lacks
+/// (`residual = -c M_i f`, weighted by the detector's stated noise): the loss hypothesis' one
+/// parameter. `None` for an agent with no command to lose.
+pub(crate) fn lost_share<T: Real>(
+    detector: &FaultDetector<T>,
+    residual: &Vector6<T>,
+    m: &Matrix6x3<T>,
+    f: &Vector3<T>,
+) -> Option<T> {
+    let w = detector.weights();
+    let lost = (m * f).component_mul(&w);
+    let ll = lost.dot(&lost);
+    let c = -residual.component_mul(&w).dot(&lost) / ll;
+    (ll > T::zero() && c.is_finite()).then(|| c.max(T::zero()).min(T::one()))
+}
+
+/// The kind of a loss of share `c` of the command: a loss when the efficiency `1 - c` is at
+/// most 0.2, otherwise a partial loss.
+pub(crate) fn loss_kind<T: Real>(c: T) -> FaultKind<T> {
+    let efficiency = T::one() - c;
+    if efficiency <= lit(0.2) {
+        FaultKind::Loss
+    } else {
+        FaultKind::PartialLoss { efficiency }
     }
 }
 
@@ -305,12 +333,7 @@ fn fit<T: Real>(
     }
     let c = (-r.dot(&lost) / ll).max(T::zero()).min(T::one());
     let loss = (r + lost * c).norm();
-    let efficiency = T::one() - c;
-    let loss_kind = if efficiency <= lit(0.2) {
-        FaultKind::Loss
-    } else {
-        FaultKind::PartialLoss { efficiency }
-    };
+    let loss_kind = loss_kind(c);
     // Two directions across `f`: `f x e_k` (`e_k` the axis along its smallest component) and
     // `f x (f x e_k)`.
     let k = if f.x.abs() <= f.y.abs() && f.x.abs() <= f.z.abs() {

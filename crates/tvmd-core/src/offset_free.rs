@@ -108,6 +108,15 @@ impl<T: Real> OffsetFreeState<T> {
         }
     }
 
+    /// As [`Self::reset`], with the observer's estimates then set to `(force, torque)` (`{I}`,
+    /// `{C}`; [`ObserverState::reseed`]): what the caller knows the unmodelled wrench to be.
+    pub fn reseed(&mut self, force: Vector3<T>, torque: Vector3<T>) {
+        self.reset();
+        if let Kind::Observer(o) = &mut self.kind {
+            o.reseed(force, torque);
+        }
+    }
+
     /// Clears the state (zero estimate or integral, no observer sample); the landed flag,
     /// which is the caller's input, is kept.
     pub fn reset(&mut self) {

@@ -17,7 +17,9 @@ use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
 use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
-use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
+use crate::fault::{
+    loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
+};
 use crate::fault_detection::{
     FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
 };
@@ -61,6 +63,9 @@ pub(super) struct FaultMonitor<T: Real> {
     /// The wrench the actuators delivered at the end of the last period, modelled as a
     /// first-order lag ([`FAULT_ACTUATOR_LAG`]) of the allocated one.
     delivered: Vector6<T>,
+    /// The candidate's lost share `c` from the unfiltered measurements (a running mean over
+    /// its periods, [`crate::fault`]'s loss hypothesis).
+    raw_share: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
 }
@@ -94,6 +99,7 @@ impl<T: Real> FaultMonitor<T> {
             baseline: Vector6::zeros(),
             wrench: Vector6::zeros(),
             delivered: Vector6::zeros(),
+            raw_share: T::zero(),
             report: None,
             masked: None,
         }))
@@ -106,10 +112,12 @@ impl<T: Real> FaultMonitor<T> {
         self.baseline = Vector6::zeros();
         self.wrench = Vector6::zeros();
         self.delivered = Vector6::zeros();
+        self.raw_share = T::zero();
         self.report = None;
     }
 
-    /// Filters this period's measurement (`{I}` force, `{C}` torque) into the residual.
+    /// Filters this period's measurement (`{I}` force, `{C}` torque) into the residual;
+    /// returns the measurement (`{C}`, the lag added back) unfiltered.
     fn filter(
         &mut self,
         attitude_t: &nalgebra::Matrix3<T>,
@@ -117,7 +125,7 @@ impl<T: Real> FaultMonitor<T> {
         d_tau: &Vector3<T>,
         lag: &Vector6<T>,
         gains: (T, T),
-    ) {
+    ) -> Vector6<T> {
         let f = attitude_t * d_f;
         let measured = Vector6::new(d_tau.x, d_tau.y, d_tau.z, f.x, f.y, f.z) + lag;
         let (g_f, g_tau) = gains;
@@ -125,6 +133,7 @@ impl<T: Real> FaultMonitor<T> {
             let g = if k < 3 { g_tau } else { g_f };
             *r += (*m - *r) * g;
         }
+        measured
     }
 }
 
@@ -132,7 +141,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// This period's detection, after the observer measured the last period: the filtered
     /// residual `[r_tau; r_f]` against the working agents; with [`FaultResponse::Mask`], a
     /// confirmed loss masks the agent now (this period's projection and allocation already
-    /// fly without it) and clears the observer's estimate and the residual, which held that
+    /// fly without it) and sets the observer's estimate and the residual back to the baseline
+    /// (the persistent model error): the part of them above it held that
     /// agent's wrench.
     pub(super) fn detect_faults(&mut self, state: &RigidState<T>) {
         let measurement = self.offset_free.observer_measurement();
@@ -154,9 +164,12 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let closed = T::one() - (-(period / lit(FAULT_ACTUATOR_LAG))).exp();
         let undelivered = lit::<T>(FAULT_ACTUATOR_LAG) / period * closed;
         let lag = gap * undelivered;
-        if let (Some((d_f, d_tau)), Some(gains)) = (measurement, gains) {
-            monitor.filter(&state.attitude.transpose(), &d_f, &d_tau, &lag, gains);
-        }
+        let raw = match (measurement, gains) {
+            (Some((d_f, d_tau)), Some(gains)) => {
+                Some(monitor.filter(&state.attitude.transpose(), &d_f, &d_tau, &lag, gains))
+            }
+            _ => None,
+        };
         monitor.delivered += gap * closed;
         let change = monitor.residual - monitor.baseline;
         // The stated noise, grown by a share of the gap the lag model read (what it misses
@@ -178,13 +191,41 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         // only when the statistic crosses the threshold (f32 trigonometry in f32).
         let previous = &self.previous;
         let force_of = |i: usize| previous.get(i).map_or_else(Vector3::zeros, command_force);
-        let report = monitor.state.update_with(
-            &detector,
-            &change,
-            self.effectiveness.blocks(),
-            force_of,
-            &self.failures,
-        );
+        let blocks = self.effectiveness.blocks();
+        let mut report =
+            monitor
+                .state
+                .update_with(&detector, &change, blocks, force_of, &self.failures);
+        // A loss's share from the unfiltered measurements since the candidate appeared: the
+        // filtered residual reaches a step's full size only after the filter's ramp, the
+        // unfiltered measurement at once (noisier: averaged over the candidate's periods).
+        let (agent, kind, periods) = match &mut report.verdict {
+            FaultVerdict::Suspected {
+                agent,
+                kind,
+                periods,
+            } => (*agent, Some(kind), *periods),
+            FaultVerdict::Confirmed { agent, kind } => (*agent, Some(kind), detector.persistence()),
+            _ => (0, None, 0),
+        };
+        if let (Some(kind), Some(raw), Some(Some(m)), Some(c)) = (
+            kind,
+            raw,
+            blocks.get(agent),
+            self.previous.get(agent).map(command_force),
+        ) {
+            if !matches!(kind, FaultKind::StuckGimbal) {
+                if let Some(share) = lost_share(&detector, &(raw - monitor.baseline), m, &c) {
+                    let n = T::from_u32(periods.max(1)).unwrap_or_else(T::one);
+                    monitor.raw_share = if periods <= 1 {
+                        share
+                    } else {
+                        monitor.raw_share + (share - monitor.raw_share) / n
+                    };
+                    *kind = loss_kind(monitor.raw_share);
+                }
+            }
+        }
         monitor.report = Some(report);
         // The baseline follows the slow model error, not a fault: held above half the threshold.
         if report.statistic <= report.threshold * lit(0.5) {
@@ -206,16 +247,20 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if monitor.response != FaultResponse::Mask || refused_before {
             return;
         }
+        // The persistent model error the baseline holds stays; the fault's part leaves with
+        // the agent.
+        let baseline = monitor.baseline;
         let mut mask = self.failures;
         let hover = mask.set(agent, true).and_then(|()| self.set_failures(mask));
         if hover.is_ok() {
-            self.offset_free.reset();
+            let force = state.attitude * baseline.fixed_rows::<3>(3);
+            let torque = baseline.fixed_rows::<3>(0).into_owned();
+            self.offset_free.reseed(force, torque);
         }
         if let Some(monitor) = self.fault.as_mut() {
             monitor.state.reset();
             if hover.is_ok() {
-                monitor.residual = Vector6::zeros();
-                monitor.baseline = Vector6::zeros();
+                monitor.residual = baseline;
             }
             monitor.masked = Some(Masked {
                 // agent < N, a slot of the mask.
