@@ -246,8 +246,12 @@ impl FaultState {
                 }
             }
         }
+        // The runner-up is rejected against the best by the likelihood ratio of the two
+        // hypotheses (`runner_up^2 - best^2`) at half the detection's `k^2`.
+        let k = detector.threshold;
         let explained = best.filter(|(_, b)| {
-            b.misfit <= detector.threshold && report.runner_up_misfit > detector.threshold
+            let ratio = report.runner_up_misfit * report.runner_up_misfit - b.misfit * b.misfit;
+            b.misfit <= k && ratio > k * k * lit(0.5)
         });
         let Some((agent, b)) = explained else {
             self.reset();
