@@ -25,7 +25,8 @@
 //!   (`eta` reported) or a stuck gimbal;
 //! - persistence: the same candidate for [`FaultDetector::persistence`] consecutive periods
 //!   confirms it, so a gust or a payload pickup (a residual no single agent explains, or one that
-//!   passes) does not.
+//!   passes) does not. A period that does not tell the candidate from its runner-up, while the
+//!   candidate is still the best explanation within the noise, holds the count.
 //!
 //! Proven: with exact `M_i f_i` and no noise, a loss of agent `i` gives misfit 0 for `i` and,
 //! when `w_i` is neither along another agent's `w_j` nor in the span of its block across `f_j`,
@@ -249,16 +250,24 @@ impl FaultState {
         // The runner-up is rejected against the best by the likelihood ratio of the two
         // hypotheses (`runner_up^2 - best^2`) at half the detection's `k^2`.
         let k = detector.threshold;
-        let explained = best.filter(|(_, b)| {
-            let ratio = report.runner_up_misfit * report.runner_up_misfit - b.misfit * b.misfit;
+        let runner_up = report.runner_up_misfit;
+        let explained = best.as_ref().filter(|(_, b)| {
+            let ratio = runner_up * runner_up - b.misfit * b.misfit;
             b.misfit <= k && ratio > k * k * lit(0.5)
         });
         let Some((agent, b)) = explained else {
-            self.reset();
+            // A period that does not tell the candidate from its runner-up, while the candidate
+            // is still the best explanation, holds the count; anything else forgets it.
+            let still_best = best
+                .as_ref()
+                .is_some_and(|(i, b)| b.misfit <= k && self.candidate == u16::try_from(*i).ok());
+            if !still_best {
+                self.reset();
+            }
             report.verdict = FaultVerdict::Unexplained;
             return report;
         };
-        let kind = b.kind;
+        let (agent, kind) = (*agent, b.kind);
         let slot = u16::try_from(agent).ok();
         self.periods = if self.candidate.is_some() && self.candidate == slot {
             self.periods.saturating_add(1)
