@@ -97,7 +97,7 @@ impl<T: Real> FaultDetector<T> {
     }
 
     /// `Sigma^(-1/2)`: the weight of each residual component (torque first).
-    fn weights(&self) -> Vector6<T> {
+    pub(crate) fn weights(&self) -> Vector6<T> {
         let (f, t) = (T::one() / self.force_noise, T::one() / self.torque_noise);
         Vector6::new(t, t, t, f, f, f)
     }
@@ -286,22 +286,6 @@ impl FaultState {
         };
         report
     }
-}
-
-/// The share `c` in `[0, 1]` of agent `i`'s commanded wrench `M_i f` that `residual` lacks
-/// (`residual = -c M_i f`, weighted by the detector's stated noise): the loss hypothesis' one
-/// parameter. `None` for an agent with no command to lose.
-pub(crate) fn lost_share<T: Real>(
-    detector: &FaultDetector<T>,
-    residual: &Vector6<T>,
-    m: &Matrix6x3<T>,
-    f: &Vector3<T>,
-) -> Option<T> {
-    let w = detector.weights();
-    let lost = (m * f).component_mul(&w);
-    let ll = lost.dot(&lost);
-    let c = -residual.component_mul(&w).dot(&lost) / ll;
-    (ll > T::zero() && c.is_finite()).then(|| c.max(T::zero()).min(T::one()))
 }
 
 /// The kind of a loss of share `c` of the command: a loss when the efficiency `1 - c` is at

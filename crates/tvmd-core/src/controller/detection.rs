@@ -11,15 +11,13 @@
 //! The settings ([`crate::FaultDetection`]) and how their noise is resolved for the team are in
 //! [`crate::fault_detection`].
 
-use nalgebra::{Vector3, Vector6};
+use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
 use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
-use crate::fault::{
-    loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
-};
+use crate::fault::{loss_kind, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
 use crate::fault_detection::{
     FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
 };
@@ -308,4 +306,20 @@ fn command_force<T: Real>(c: &AgentCommand<T>) -> Vector3<T> {
     let (sx, cx) = sin_cos(c.eta_x);
     let (sy, cy) = sin_cos(c.eta_y);
     Vector3::new(cx * sy, -sx, cx * cy) * c.thrust
+}
+
+/// The share `c` in `[0, 1]` of agent `i`'s commanded wrench `M_i f` that `residual` lacks
+/// (`residual = -c M_i f`, weighted by the detector's stated noise): the loss hypothesis' one
+/// parameter. `None` for an agent with no command to lose.
+fn lost_share<T: Real>(
+    detector: &FaultDetector<T>,
+    residual: &Vector6<T>,
+    m: &Matrix6x3<T>,
+    f: &Vector3<T>,
+) -> Option<T> {
+    let w = detector.weights();
+    let lost = (m * f).component_mul(&w);
+    let ll = lost.dot(&lost);
+    let c = -residual.component_mul(&w).dot(&lost) / ll;
+    (ll > T::zero() && c.is_finite()).then(|| c.max(T::zero()).min(T::one()))
 }
