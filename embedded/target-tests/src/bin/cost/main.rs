@@ -152,7 +152,7 @@ fn measure<const N: usize, A: Allocator<f32, N> + Clone>(
 const FAULT_DETECTION_EXTRA_BOUND: u32 = 1_500;
 
 /// Largest extra cost (instructions) of the fault detector over the offset-free law, n = 4,
-/// while it isolates (every working agent's two fits each period): the measured 3,278 plus
+/// while it isolates (every working agent's two fits each period): the measured 3,269 plus
 /// about 10% (a regression bound; issue 47's 1,500 is met only under the threshold).
 const FAULT_ISOLATION_EXTRA_BOUND: u32 = 3_600;
 
