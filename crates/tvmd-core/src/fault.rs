@@ -478,6 +478,35 @@ mod tests {
     }
 
     #[test]
+    fn an_ambiguous_period_holds_the_count_and_a_nominal_one_forgets_it() {
+        let (blocks, f) = setup();
+        let d = detector();
+        let none = FailureMask::none();
+        let full = -(blocks[0].unwrap() * f[0]);
+        // The same loss read with the torque's noise so large that only the force counts: the
+        // agents' losses push alike, so no runner-up is rejected while agent 0 stays the best.
+        let blind = FaultDetector::new(0.2, 1e6, 5.0, 3).unwrap();
+        let mut s = FaultState::new();
+        let periods = |rep: FaultReport<f64>| match rep.verdict {
+            FaultVerdict::Suspected {
+                agent: 0, periods, ..
+            } => Some(periods),
+            _ => None,
+        };
+        assert_eq!(periods(s.update(&d, &full, &blocks, &f, &none)), Some(1));
+        let rep = s.update(&blind, &full, &blocks, &f, &none);
+        assert_eq!(rep.verdict, FaultVerdict::Unexplained, "{rep:?}");
+        assert!(rep.best_misfit <= rep.threshold && rep.runner_up_misfit <= rep.threshold);
+        assert_eq!(periods(s.update(&d, &full, &blocks, &f, &none)), Some(2));
+        let quiet = Vector6::zeros();
+        assert_eq!(
+            s.update(&d, &quiet, &blocks, &f, &none).verdict,
+            FaultVerdict::Nominal
+        );
+        assert_eq!(periods(s.update(&d, &full, &blocks, &f, &none)), Some(1));
+    }
+
+    #[test]
     fn settings_are_validated() {
         assert!(FaultDetector::new(0.0, 0.1, 5.0, 3).is_err());
         assert!(FaultDetector::new(0.1, f64::NAN, 5.0, 3).is_err());
