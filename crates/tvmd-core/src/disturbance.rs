@@ -124,6 +124,11 @@ impl<T: Real> ObserverState<T> {
         (-self.force, -self.torque)
     }
 
+    /// The filter gains `(1 - e^(-L_f dt), 1 - e^(-L_tau dt))`.
+    pub fn gains(&self) -> (T, T) {
+        self.gamma
+    }
+
     /// The estimates `(d^_f, d^_tau)`.
     pub fn estimate(&self) -> (Vector3<T>, Vector3<T>) {
         (self.force, self.torque)
@@ -134,6 +139,20 @@ impl<T: Real> ObserverState<T> {
     /// anti-windup. `None` when this period measured nothing (no sample yet, after a reset).
     pub fn measurement(&self) -> Option<(Vector3<T>, Vector3<T>)> {
         self.measured
+    }
+
+    /// The estimates set to `(d^_f, d^_tau)` = `(force, torque)` (`{I}`, `{C}`; non-finite
+    /// values give zero), the rest as it is.
+    pub fn reseed(&mut self, force: Vector3<T>, torque: Vector3<T>) {
+        let finite = |v: Vector3<T>| {
+            if v.iter().all(|x| x.is_finite()) {
+                v
+            } else {
+                Vector3::zeros()
+            }
+        };
+        self.force = finite(force);
+        self.torque = finite(torque);
     }
 
     /// Zero estimates, no sample.

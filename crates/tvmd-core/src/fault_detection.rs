@@ -21,9 +21,16 @@ pub const FAULT_THRESHOLD: f64 = 5.0;
 /// error, a steady wind) is not a fault, while a fault, which steps within a few periods, is
 /// read whole (the baseline is held while the statistic is above half the threshold).
 pub const FAULT_BASELINE_BANDWIDTH: f64 = 1.0;
+/// The actuators' stated lag (s): the time constant of a first-order lag from the allocated
+/// wrench to the delivered one (rotors and gimbal servos; the simulator's default conditions
+/// have a 30 ms rotor lag and 40 rad/s servos). The detector adds what this lag leaves
+/// undelivered back to the residual, so a changing command (the tilt manoeuvre) is not read as
+/// a fault.
+pub const FAULT_ACTUATOR_LAG: f64 = 0.03;
 /// The share of the last jump of the commanded wrench added to the residual's stated noise:
-/// the part of a period the actuators (servo, rotor) may still deliver the old wrench.
-pub const FAULT_JUMP_SHARE: f64 = 0.5;
+/// what the lag model ([`FAULT_ACTUATOR_LAG`]) misses of a jump (rate limits, the servos' own
+/// dynamics).
+pub const FAULT_JUMP_SHARE: f64 = 0.1;
 /// Persistence (periods) of [`FaultDetection::recommended`].
 pub const FAULT_PERSISTENCE: u32 = 5;
 

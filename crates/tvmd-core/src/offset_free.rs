@@ -99,6 +99,24 @@ impl<T: Real> OffsetFreeState<T> {
         }
     }
 
+    /// The disturbance observer's filter gains `(gamma_f, gamma_tau)`
+    /// ([`ObserverState::gains`]); `None` without an observer.
+    pub fn observer_gains(&self) -> Option<(T, T)> {
+        match &self.kind {
+            Kind::Observer(o) => Some(o.gains()),
+            _ => None,
+        }
+    }
+
+    /// As [`Self::reset`], with the observer's estimates then set to `(force, torque)` (`{I}`,
+    /// `{C}`; [`ObserverState::reseed`]): what the caller knows the unmodelled wrench to be.
+    pub fn reseed(&mut self, force: Vector3<T>, torque: Vector3<T>) {
+        self.reset();
+        if let Kind::Observer(o) = &mut self.kind {
+            o.reseed(force, torque);
+        }
+    }
+
     /// Clears the state (zero estimate or integral, no observer sample); the landed flag,
     /// which is the caller's input, is kept.
     pub fn reset(&mut self) {

@@ -11,17 +11,20 @@
 //! The settings ([`crate::FaultDetection`]) and how their noise is resolved for the team are in
 //! [`crate::fault_detection`].
 
-use nalgebra::{Vector3, Vector6};
+use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
 use crate::allocation::Allocator;
+use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
-use crate::fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
-use crate::fault_detection::{FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE};
+use crate::fault::{loss_kind, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
+use crate::fault_detection::{
+    FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
+};
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
 use crate::offset_free::OffsetFree;
-use crate::real::{lit, Real};
+use crate::real::{lit, sin_cos, Real};
 use crate::team::TeamConfig;
 
 /// A mask the controller set itself on a confirmed loss ([`FaultResponse::Mask`]).
@@ -38,7 +41,7 @@ pub struct FaultMasking<T: Real> {
 /// What the monitor keeps of a masking (the certificate is the controller's own).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Masked {
-    agent: u32,
+    agent: u16,
     refused: bool,
 }
 
@@ -48,8 +51,6 @@ pub(super) struct FaultMonitor<T: Real> {
     response: FaultResponse,
     detector: FaultDetector<T>,
     state: FaultState,
-    /// `1 - e^(-L dt)` of the observer's torque and force bandwidths.
-    gamma: (T, T),
     /// The filtered residual `[r_tau; r_f]` (`{C}`).
     residual: Vector6<T>,
     /// Its slow baseline ([`FAULT_BASELINE_BANDWIDTH`]): the model error's persistent part,
@@ -57,10 +58,12 @@ pub(super) struct FaultMonitor<T: Real> {
     baseline: Vector6<T>,
     /// The wrench `M f` allocated for the coming period.
     wrench: Vector6<T>,
-    /// `(||Delta u_tau||, ||Delta u_f||)`: how much the allocated wrench jumped at the start
-    /// of the period the next residual measures. Actuators that lag (servos, rotors) deliver
-    /// part of the old wrench for part of that period, so the residual's noise grows by it.
-    jump: (T, T),
+    /// The wrench the actuators delivered at the end of the last period, modelled as a
+    /// first-order lag ([`FAULT_ACTUATOR_LAG`]) of the allocated one.
+    delivered: Vector6<T>,
+    /// The candidate's lost share `c` from the unfiltered measurements (a running mean over
+    /// its periods, [`crate::fault`]'s loss hypothesis).
+    raw_share: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
 }
@@ -77,12 +80,11 @@ impl<T: Real> FaultMonitor<T> {
         let Some(detection) = settings.fault_detection else {
             return Ok(None);
         };
-        let Some(OffsetFree::Observer(observer)) = settings.offset_free else {
+        let Some(OffsetFree::Observer(_)) = settings.offset_free else {
             return Err(ConfigError::Parameter {
                 field: ConfigField::FaultResidual,
             });
         };
-        let gamma = |l: T| T::one() - (-(l * settings.period)).exp();
         let arm = team
             .agents()
             .iter()
@@ -91,14 +93,11 @@ impl<T: Real> FaultMonitor<T> {
             response: detection.response(),
             detector: detection.detector(weight, arm)?,
             state: FaultState::new(),
-            gamma: (
-                gamma(observer.torque_bandwidth()),
-                gamma(observer.force_bandwidth()),
-            ),
             residual: Vector6::zeros(),
             baseline: Vector6::zeros(),
             wrench: Vector6::zeros(),
-            jump: (T::zero(), T::zero()),
+            delivered: Vector6::zeros(),
+            raw_share: T::zero(),
             report: None,
             masked: None,
         }))
@@ -110,19 +109,29 @@ impl<T: Real> FaultMonitor<T> {
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
         self.wrench = Vector6::zeros();
-        self.jump = (T::zero(), T::zero());
+        self.delivered = Vector6::zeros();
+        self.raw_share = T::zero();
         self.report = None;
     }
 
-    /// Filters this period's measurement (`{I}` force, `{C}` torque) into the residual.
-    fn filter(&mut self, attitude_t: &nalgebra::Matrix3<T>, d_f: &Vector3<T>, d_tau: &Vector3<T>) {
+    /// Filters this period's measurement (`{I}` force, `{C}` torque) into the residual;
+    /// returns the measurement (`{C}`, the lag added back) unfiltered.
+    fn filter(
+        &mut self,
+        attitude_t: &nalgebra::Matrix3<T>,
+        d_f: &Vector3<T>,
+        d_tau: &Vector3<T>,
+        lag: &Vector6<T>,
+        gains: (T, T),
+    ) -> Vector6<T> {
         let f = attitude_t * d_f;
-        let measured = Vector6::new(d_tau.x, d_tau.y, d_tau.z, f.x, f.y, f.z);
-        let (g_tau, g_f) = self.gamma;
+        let measured = Vector6::new(d_tau.x, d_tau.y, d_tau.z, f.x, f.y, f.z) + lag;
+        let (g_f, g_tau) = gains;
         for (k, (r, m)) in self.residual.iter_mut().zip(measured.iter()).enumerate() {
             let g = if k < 3 { g_tau } else { g_f };
             *r += (*m - *r) * g;
         }
+        measured
     }
 }
 
@@ -130,10 +139,12 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// This period's detection, after the observer measured the last period: the filtered
     /// residual `[r_tau; r_f]` against the working agents; with [`FaultResponse::Mask`], a
     /// confirmed loss masks the agent now (this period's projection and allocation already
-    /// fly without it) and clears the observer's estimate and the residual, which held that
+    /// fly without it) and sets the observer's estimate and the residual back to the baseline
+    /// (the persistent model error): the part of them above it held that
     /// agent's wrench.
     pub(super) fn detect_faults(&mut self, state: &RigidState<T>) {
         let measurement = self.offset_free.observer_measurement();
+        let gains = self.offset_free.observer_gains();
         let period = self.settings.period;
         let landed = self.offset_free.landed();
         let Some(monitor) = self.fault.as_mut() else {
@@ -144,19 +155,29 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             monitor.reset();
             return;
         }
-        if let Some((d_f, d_tau)) = measurement {
-            monitor.filter(&state.attitude.transpose(), &d_f, &d_tau);
-        }
-        // The forces of the commands held over the period the residual measures.
-        let mut forces = [Vector3::zeros(); N];
-        for (f, c) in forces.iter_mut().zip(&self.previous) {
-            *f = c.force();
-        }
+        // The actuators' first-order lag over the period the residual measures: the share of
+        // the gap to the commanded wrench they did not deliver on average over the period
+        // (`tau / dt (1 - e^(-dt/tau))`), added back to the measurement, and the gap they close.
+        let gap = monitor.wrench - monitor.delivered;
+        let closed = T::one() - (-(period / lit(FAULT_ACTUATOR_LAG))).exp();
+        let undelivered = lit::<T>(FAULT_ACTUATOR_LAG) / period * closed;
+        let lag = gap * undelivered;
+        let raw = match (measurement, gains) {
+            (Some((d_f, d_tau)), Some(gains)) => {
+                Some(monitor.filter(&state.attitude.transpose(), &d_f, &d_tau, &lag, gains))
+            }
+            _ => None,
+        };
+        monitor.delivered += gap * closed;
         let change = monitor.residual - monitor.baseline;
-        // The stated noise, grown by the last jump of the commanded wrench.
+        // The stated noise, grown by a share of the gap the lag model read (what it misses
+        // of a changing command: rate limits, the servos' own dynamics).
         let d = &monitor.detector;
-        let half = lit::<T>(FAULT_JUMP_SHARE);
-        let (j_tau, j_f) = (monitor.jump.0 * half, monitor.jump.1 * half);
+        let share = lit::<T>(FAULT_JUMP_SHARE);
+        let (j_tau, j_f) = (
+            gap.fixed_rows::<3>(0).norm() * share,
+            gap.fixed_rows::<3>(3).norm() * share,
+        );
         let detector = FaultDetector::new(
             d.force_noise() + j_f,
             d.torque_noise() + j_tau,
@@ -164,13 +185,45 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             d.persistence(),
         )
         .unwrap_or(*d);
-        let report = monitor.state.update(
-            &detector,
-            &change,
-            self.effectiveness.blocks(),
-            &forces,
-            &self.failures,
-        );
+        // The forces of the commands held over the period the residual measures, computed
+        // only when the statistic crosses the threshold (f32 trigonometry in f32).
+        let previous = &self.previous;
+        let force_of = |i: usize| previous.get(i).map_or_else(Vector3::zeros, command_force);
+        let blocks = self.effectiveness.blocks();
+        let mut report =
+            monitor
+                .state
+                .update_with(&detector, &change, blocks, force_of, &self.failures);
+        // A loss's share from the unfiltered measurements since the candidate appeared: the
+        // filtered residual reaches a step's full size only after the filter's ramp, the
+        // unfiltered measurement at once (noisier: averaged over the candidate's periods).
+        let (agent, kind, periods) = match &mut report.verdict {
+            FaultVerdict::Suspected {
+                agent,
+                kind,
+                periods,
+            } => (*agent, Some(kind), *periods),
+            FaultVerdict::Confirmed { agent, kind } => (*agent, Some(kind), detector.persistence()),
+            _ => (0, None, 0),
+        };
+        if let (Some(kind), Some(raw), Some(Some(m)), Some(c)) = (
+            kind,
+            raw,
+            blocks.get(agent),
+            self.previous.get(agent).map(command_force),
+        ) {
+            if !matches!(kind, FaultKind::StuckGimbal) {
+                if let Some(share) = lost_share(&detector, &(raw - monitor.baseline), m, &c) {
+                    let n = T::from_u32(periods.max(1)).unwrap_or_else(T::one);
+                    monitor.raw_share = if periods <= 1 {
+                        share
+                    } else {
+                        monitor.raw_share + (share - monitor.raw_share) / n
+                    };
+                    *kind = loss_kind(monitor.raw_share);
+                }
+            }
+        }
         monitor.report = Some(report);
         // The baseline follows the slow model error, not a fault: held above half the threshold.
         if report.statistic <= report.threshold * lit(0.5) {
@@ -192,20 +245,24 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if monitor.response != FaultResponse::Mask || refused_before {
             return;
         }
+        // The persistent model error the baseline holds stays; the fault's part leaves with
+        // the agent.
+        let baseline = monitor.baseline;
         let mut mask = self.failures;
         let hover = mask.set(agent, true).and_then(|()| self.set_failures(mask));
         if hover.is_ok() {
-            self.offset_free.reset();
+            let force = state.attitude * baseline.fixed_rows::<3>(3);
+            let torque = baseline.fixed_rows::<3>(0).into_owned();
+            self.offset_free.reseed(force, torque);
         }
         if let Some(monitor) = self.fault.as_mut() {
             monitor.state.reset();
             if hover.is_ok() {
-                monitor.residual = Vector6::zeros();
-                monitor.baseline = Vector6::zeros();
+                monitor.residual = baseline;
             }
             monitor.masked = Some(Masked {
                 // agent < N, a slot of the mask.
-                agent: u32::try_from(agent).unwrap_or(u32::MAX),
+                agent: u16::try_from(agent).unwrap_or(u16::MAX),
                 refused: hover.is_err(),
             });
         }
@@ -217,16 +274,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(monitor) = self.fault.as_mut() {
             // A non-finite wrench (refused before it is sent) is not recorded.
             if wrench.iter().all(|x| x.is_finite()) {
-                let jump = wrench - monitor.wrench;
-                let (tau, f) = (
-                    jump.fixed_rows::<3>(0).norm(),
-                    jump.fixed_rows::<3>(3).norm(),
-                );
-                monitor.jump = if tau.is_finite() && f.is_finite() {
-                    (tau, f)
-                } else {
-                    (T::zero(), T::zero())
-                };
+                if monitor.wrench == Vector6::zeros() {
+                    // The first wrench after a reset: the actuators are taken to deliver it.
+                    monitor.delivered = *wrench;
+                }
                 monitor.wrench = *wrench;
             }
         }
@@ -247,4 +298,28 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             hover: (!m.refused).then_some(self.hover),
         })
     }
+}
+
+/// The agent-frame force `T a_hat(eta_x, eta_y)` of a command, with [`sin_cos`] (in `f32`
+/// arithmetic for `f32`: no software double precision on a single-precision FPU).
+fn command_force<T: Real>(c: &AgentCommand<T>) -> Vector3<T> {
+    let (sx, cx) = sin_cos(c.eta_x);
+    let (sy, cy) = sin_cos(c.eta_y);
+    Vector3::new(cx * sy, -sx, cx * cy) * c.thrust
+}
+
+/// The share `c` in `[0, 1]` of agent `i`'s commanded wrench `M_i f` that `residual` lacks
+/// (`residual = -c M_i f`, weighted by the detector's stated noise): the loss hypothesis' one
+/// parameter. `None` for an agent with no command to lose.
+fn lost_share<T: Real>(
+    detector: &FaultDetector<T>,
+    residual: &Vector6<T>,
+    m: &Matrix6x3<T>,
+    f: &Vector3<T>,
+) -> Option<T> {
+    let w = detector.weights();
+    let lost = (m * f).component_mul(&w);
+    let ll = lost.dot(&lost);
+    let c = -residual.component_mul(&w).dot(&lost) / ll;
+    (ll > T::zero() && c.is_finite()).then(|| c.max(T::zero()).min(T::one()))
 }

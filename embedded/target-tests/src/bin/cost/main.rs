@@ -1,7 +1,9 @@
 //! On-target cost of the f32 control cycle (`Controller::step`, redistributed pseudo-inverse,
 //! named rather than the default allocator: BENCHMARKS.md's counts are of the paper's cycle),
 //! with the paper's law and with the offset-free law (`ControllerSettings::offset_free_law`;
-//! n = 4 searching fails above 1,500 extra instructions):
+//! n = 4 searching fails above 1,500 extra instructions), and with the fault detector reporting,
+//! under the threshold and isolating (n = 4 fails above 1,500 and 3,600 extra instructions
+//! over the offset-free law):
 //! instructions per cycle counted on QEMU (`mps2-an386` Cortex-M4F, `mps2-an500` Cortex-M7)
 //! run with `-icount shift=0`, and the cycle's peak stack measured by painting. Cases: hover and
 //! planner-searching cycles of the paper's team (n = 4, A4-Inc) and of a 16-agent inconsistent
@@ -145,6 +147,15 @@ fn measure<const N: usize, A: Allocator<f32, N> + Clone>(
     })
 }
 
+/// Largest extra cost (instructions) of the fault detector over the offset-free law, n = 4,
+/// with the statistic under the threshold, hover or searching (issue 47's bound).
+const FAULT_DETECTION_EXTRA_BOUND: u32 = 1_500;
+
+/// Largest extra cost (instructions) of the fault detector over the offset-free law, n = 4,
+/// while it isolates (every working agent's two fits each period): the measured 3,269 plus
+/// about 10% (a regression bound; issue 47's 1,500 is met only under the threshold).
+const FAULT_ISOLATION_EXTRA_BOUND: u32 = 3_600;
+
 /// Largest extra cost (instructions) of the offset-free law over the paper's, n = 4,
 /// searching (issue 44's bound).
 const OFFSET_FREE_EXTRA_BOUND: u32 = 1_500;
@@ -160,10 +171,18 @@ fn report<const N: usize>(per_tick: u32) -> bool {
             fault_detection: Some(FaultDetection::recommended(FaultResponse::Report)),
             ..ControllerSettings::offset_free_law()
         };
+        // The same with a stated model error so small that every residual is above the
+        // threshold: the isolation (every working agent's fit) runs each period, the cost of a
+        // period while a fault is suspected or confirmed.
+        let isolating = ControllerSettings {
+            fault_detection: FaultDetection::new(1e-6, 5.0, 5, FaultResponse::Report).ok(),
+            ..ControllerSettings::offset_free_law()
+        };
         for (law, settings) in [
             ("paper", ControllerSettings::paper()),
             ("offset-free", ControllerSettings::offset_free_law()),
             ("detecting", detecting),
+            ("isolating", isolating),
         ] {
             let Some(m) =
                 measure::<N, _>(searching, settings, RedistributedPseudoInverse, per_tick)
@@ -191,15 +210,24 @@ fn report<const N: usize>(per_tick: u32) -> bool {
                 m.iterations,
                 if as_intended { "" } else { "  FAIL: not the intended planner case" }
             );
-            if law == "detecting" {
+            if law == "detecting" || law == "isolating" {
                 let extra = m
                     .instructions
                     .saturating_sub(offset_free_instructions.unwrap_or(0));
+                let bound = if law == "detecting" {
+                    FAULT_DETECTION_EXTRA_BOUND
+                } else {
+                    FAULT_ISOLATION_EXTRA_BOUND
+                };
+                let bounded = N != 4 || extra <= bound;
+                ok &= bounded;
                 hprintln!(
-                    "cost: n = {:2} {:9} cycle: the fault detector costs {} instructions more than the offset-free law",
+                    "cost: n = {:2} {:9} cycle: the fault detector {} costs {} instructions more than the offset-free law{}",
                     N,
                     name,
-                    extra
+                    if law == "detecting" { "(under the threshold)" } else { "(isolating)" },
+                    extra,
+                    if bounded { "" } else { "  FAIL: above the bound" }
                 );
                 continue;
             }
