@@ -2,7 +2,7 @@
 //! rate limits, and the intervals admissible sets are made of.
 
 use crate::error::{ConfigError, ConfigField, GimbalAxis};
-use crate::real::{sqrt, Real};
+use crate::real::{fmax, fmin, sqrt, Real};
 
 /// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
 /// `T = rho d^4 c_l omega^2` (eq. 5).
@@ -221,12 +221,12 @@ impl<T: Real> Interval<T> {
 
     /// The nearest point of the interval.
     pub fn clamp(&self, x: T) -> T {
-        x.max(self.lo).min(self.hi)
+        fmin(fmax(x, self.lo), self.hi)
     }
 
     /// How far `x` lies outside, 0 inside.
     pub fn excess(&self, x: T) -> T {
-        (self.lo - x).max(x - self.hi).max(T::zero())
+        fmax(fmax(self.lo - x, x - self.hi), T::zero())
     }
 
     /// Intersection with `[centre - radius, centre + radius]`; if they do not meet, the end of

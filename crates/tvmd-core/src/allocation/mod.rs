@@ -171,6 +171,12 @@ pub(crate) fn outside<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bo
         || set.violation(&GimbalCommand::from_force(force)) > T::zero()
 }
 
+/// [`outside`] with [`GimbalCommand::from_force_fast`] (the exact-boundary redistribution's).
+pub(crate) fn outside_fast<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bool {
+    !force.iter().all(|x| x.is_finite())
+        || set.violation(&GimbalCommand::from_force_fast(force)) > T::zero()
+}
+
 /// `sum_{i free} M_i M_i^T / w_i`.
 pub(crate) fn gram_of<T: Real, const N: usize>(
     effectiveness: &Effectiveness<T, N>,

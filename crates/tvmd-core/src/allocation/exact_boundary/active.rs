@@ -85,12 +85,13 @@ impl<T: Real> ActiveSet<T> {
         self.basis = [None, None];
         self.fixed = false;
         self.curved = false;
+        let force_norm = norm(force);
         for (k, c) in constraints.iter().enumerate() {
             if !self.holds(k) {
                 continue;
             }
             self.curved |= c.curved();
-            let mut v = c.gradient(force);
+            let mut v = c.gradient_with_norm(force, force_norm);
             let length = norm(&v);
             if length <= T::zero() {
                 continue;

@@ -11,7 +11,7 @@ use super::cost::WalkCost;
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
 use crate::linalg::{norm, solve_gram};
-use crate::real::{eps, Real};
+use crate::real::{eps, fmax, sqrt, Real};
 
 /// The walk's state over the agents.
 pub(super) struct Walk<'a, T: Real, const N: usize> {
@@ -96,14 +96,15 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 continue;
             }
             let free_norm = norm(free);
+            let f_norm = norm(f);
             for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
-                let g = c.gradient(f);
+                let g = c.gradient_with_norm(f, f_norm);
                 let scale = norm(&g) * free_norm;
                 if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                     continue;
                 }
                 let slope = g.dot(free) / scale;
-                if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
+                if slope < -sqrt(eps::<T>()) && worst.is_none_or(|(_, _, s)| slope < s) {
                     worst = Some((i, k, slope));
                 }
             }
@@ -138,7 +139,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             if !*w || a.fixed() {
                 continue;
             }
-            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), T::max);
+            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), fmax);
             let Some(ray) = Ray::new(f, d, offset) else {
                 continue;
             };
@@ -187,7 +188,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 if a.curved() && violated(b, f) {
                     *f = retract(b, a, f);
                     if violated(b, f) {
-                        *f = set.saturate(f);
+                        *f = set.saturate_fast(f);
                     }
                 }
             }
@@ -260,6 +261,6 @@ pub(super) fn on_boundary<T: Real>(
     set: &AdmissibleSet<T>,
     f: &Vector3<T>,
 ) -> bool {
-    let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
+    let tol = sqrt(eps::<T>()) * fmax(set.thrust().hi, T::one());
     bounds.iter().any(|c| c.value(f) > -tol)
 }
