@@ -12,7 +12,7 @@ use nalgebra::{Vector3, Vector6};
 use self::active::ActiveSet;
 use self::constraint::{constraints, regular};
 pub use self::cost::WalkCost;
-use self::walk::{on_boundary, Walk};
+use self::walk::{offset, on_boundary, Walk};
 use super::{
     outside_fast, redistributed::redistribute, working_mask, Allocation, AllocationRequest,
     Allocator,
@@ -241,6 +241,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let mut walk = Walk {
             effectiveness: e,
             sets,
+            offsets: bounds.each_ref().map(offset),
             bounds,
             gram: e.gram(),
             working,

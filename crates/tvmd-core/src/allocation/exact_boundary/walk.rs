@@ -18,6 +18,8 @@ pub(super) struct Walk<'a, T: Real, const N: usize> {
     pub(super) effectiveness: &'a Effectiveness<T, N>,
     pub(super) sets: &'a [AdmissibleSet<T>; N],
     pub(super) bounds: [[Constraint<T>; CONSTRAINTS]; N],
+    /// Each agent's largest constraint offset `|k|` ([`offset`]), for the line search's rays.
+    pub(super) offsets: [T; N],
     /// `sum_i M_i M_i^T` over the working agents, before any is held.
     pub(super) gram: Matrix6<T>,
     pub(super) working: [bool; N],
@@ -127,11 +129,11 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         let mut tau = T::one();
         let mut first = None;
         let mut at_once = [None; N];
-        for (i, ((((f, d), b), a), (w, now))) in self
+        for (i, ((((f, d), (b, offset)), a), (w, now))) in self
             .forces
             .iter()
             .zip(delta)
-            .zip(&self.bounds)
+            .zip(self.bounds.iter().zip(&self.offsets))
             .zip(&self.active)
             .zip(self.working.iter().zip(at_once.iter_mut()))
             .enumerate()
@@ -139,8 +141,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             if !*w || a.fixed() {
                 continue;
             }
-            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), fmax);
-            let Some(ray) = Ray::new(f, d, offset) else {
+            let Some(ray) = Ray::new(f, d, *offset) else {
                 continue;
             };
             for (k, c) in b.iter().enumerate() {
@@ -242,6 +243,11 @@ fn retract<T: Real>(
         }
     }
     out
+}
+
+/// The largest `|k|` of an agent's constraints (the scale its line-search rays need).
+pub(super) fn offset<T: Real>(bounds: &[Constraint<T>; CONSTRAINTS]) -> T {
+    bounds.iter().map(|c| c.offset()).fold(T::zero(), fmax)
 }
 
 /// Whether `f` is outside the set its constraints describe (or not finite): the same test as
