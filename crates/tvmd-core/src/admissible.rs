@@ -164,13 +164,14 @@ impl<T: Real> AdmissibleSet<T> {
         })
     }
 
-    /// [`Self::saturate`] with the gimbal inverse and the unit direction of clamped angles given.
-    #[inline]
+    /// [`Self::saturate`] with the gimbal inverse and the unit direction of clamped angles given
+    /// (function pointers, one copy for both forms: the C interface's text is bounded).
+    #[inline(never)]
     fn saturate_along(
         &self,
         force: &Vector3<T>,
-        inverse: impl Fn(&Vector3<T>) -> GimbalCommand<T>,
-        direction: impl Fn(T, T) -> Vector3<T>,
+        inverse: fn(&Vector3<T>) -> GimbalCommand<T>,
+        direction: fn(T, T) -> Vector3<T>,
     ) -> Vector3<T> {
         let g = self.clamp(&inverse(force));
         let direction = direction(g.eta_x, g.eta_y);

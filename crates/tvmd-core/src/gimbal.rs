@@ -55,9 +55,10 @@ impl<T: Real> GimbalCommand<T> {
         Self::inverse(force, asin)
     }
 
-    /// The gimbal inverse with `asin` given.
-    #[inline]
-    fn inverse(force: &Vector3<T>, asin: impl Fn(T) -> T) -> Self {
+    /// The gimbal inverse with `asin` given (a function pointer, one copy for both forms: the
+    /// C interface's text is bounded).
+    #[inline(never)]
+    fn inverse(force: &Vector3<T>, asin: fn(T) -> T) -> Self {
         let squared = force.norm_squared();
         let (unit_scaled, n, m) = if plain_is_exact(squared) {
             (*force, sqrt(squared), T::one())

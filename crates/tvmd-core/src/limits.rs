@@ -226,7 +226,14 @@ impl<T: Real> Interval<T> {
 
     /// How far `x` lies outside, 0 inside.
     pub fn excess(&self, x: T) -> T {
-        fmax(fmax(self.lo - x, x - self.hi), T::zero())
+        // `max(lo - x, x - hi, 0)` by comparisons (`lo <= hi`; a NaN `x` gives 0, as `max` does).
+        if x < self.lo {
+            self.lo - x
+        } else if x > self.hi {
+            x - self.hi
+        } else {
+            T::zero()
+        }
     }
 
     /// Intersection with `[centre - radius, centre + radius]`; if they do not meet, the end of

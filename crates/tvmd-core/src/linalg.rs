@@ -109,7 +109,6 @@ pub(crate) struct Ldlt<T: Real> {
 }
 
 impl<T: Real> Ldlt<T> {
-    #[inline]
     pub(crate) fn new(a: &Matrix6<T>, tol: T) -> Option<Self> {
         let mut l = [[T::zero(); 6]; 6];
         let mut d = [T::zero(); 6];
@@ -174,12 +173,7 @@ pub(crate) fn weighted_gram<'a, T: Real>(
 ) -> Matrix6<T> {
     let mut gram = initial;
     for (b, w) in blocks {
-        // Dividing by one is exact: skipped (36 divisions per agent on a Cortex-M4F).
-        if w == T::one() {
-            gram += b * b.transpose();
-        } else {
-            gram += b * b.transpose() / w;
-        }
+        gram += b * b.transpose() / w;
     }
     gram
 }

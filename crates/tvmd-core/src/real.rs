@@ -89,7 +89,7 @@ pub(crate) fn fmax<T: Real>(a: T, b: T) -> T {
 
 /// The smaller of `a` and `b`, a NaN ignored and `-0` below `+0` (IEEE 754 `minNum`, as
 /// `T::min`), by comparisons (see [`fmax`]).
-#[inline]
+#[inline(never)]
 pub(crate) fn fmin<T: Real>(a: T, b: T) -> T {
     if b < a || a.partial_cmp(&a).is_none() || (b == a && b.is_sign_negative()) {
         b

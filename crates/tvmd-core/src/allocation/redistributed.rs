@@ -49,11 +49,14 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
 /// the saturation `saturate` (the paper's: [`GimbalCommand::from_force`],
 /// [`AdmissibleSet::saturate`]; the exact-boundary redistribution's start: their `_fast`
 /// forms, without `libm`'s software-`f64` trigonometry on a Cortex-M4F).
-#[inline]
+///
+/// Function pointers, not generic closures: one copy of the redistribution for both callers
+/// (the C interface's text is bounded, `scripts/ffi.sh`), not inlined into either.
+#[inline(never)]
 pub(super) fn redistribute<T: Real, const N: usize>(
     request: &AllocationRequest<'_, T, N>,
-    inverse: impl Fn(&Vector3<T>) -> GimbalCommand<T>,
-    saturate: impl Fn(&AdmissibleSet<T>, &Vector3<T>) -> Vector3<T>,
+    inverse: fn(&Vector3<T>) -> GimbalCommand<T>,
+    saturate: fn(&AdmissibleSet<T>, &Vector3<T>) -> Vector3<T>,
 ) -> Allocation<T, N> {
     {
         let e = request.effectiveness;

@@ -166,6 +166,11 @@ impl<T: Real> ActiveSet<T> {
         self.basis.iter().flatten()
     }
 
+    /// Whether [`Self::downdate`] changes a Gram matrix (a held normal, or a fixed agent).
+    pub(in crate::allocation) fn downdates(&self) -> bool {
+        self.fixed || self.basis.iter().any(Option::is_some)
+    }
+
     /// Whether a held constraint is a cone or a sphere.
     pub(in crate::allocation) fn curved(&self) -> bool {
         self.curved

@@ -44,6 +44,7 @@ impl<T: Real> Constraint<T> {
     }
 
     /// `grad g(f) = c + s f / ||f||` (`c` at the origin, where the cones have no normal).
+    #[cfg(any(test, feature = "null-space"))]
     pub(in crate::allocation) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
         self.gradient_with_norm(f, norm(f))
     }

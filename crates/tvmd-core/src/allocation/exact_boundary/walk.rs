@@ -38,6 +38,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     pub(super) fn direction(&mut self, r: &Vector6<T>, release: bool) -> Option<[Vector3<T>; N]> {
         let mut gram = self.gram;
         let mut movable = false;
+        let mut downdated = false;
         for (((block, a), f), (w, b)) in self
             .effectiveness
             .blocks()
@@ -50,13 +51,20 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 a.update(b, f);
                 a.downdate(block, &mut gram);
                 movable |= !a.fixed();
+                downdated |= a.downdates();
             }
         }
         if !movable {
             return None;
         }
         self.cost.solves += 1;
-        let lambda = solve_gram(&gram, r);
+        // Nothing held (the first round): the effectiveness's own factor of this Gram matrix,
+        // the same bits as factoring it again.
+        let lambda = if downdated {
+            solve_gram(&gram, r)
+        } else {
+            self.effectiveness.gram_solver().solve(r)
+        };
         // `M_i^T lambda`, the free increments, once for the release test and the step.
         let mut delta = [Vector3::zeros(); N];
         for ((d, block), w) in delta
@@ -205,7 +213,11 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     /// there (measured: 0.17 rad in one period on paper-tilt at `s = 1`).
     pub(super) fn shed_internal(&mut self) {
         self.cost.solves += 1;
-        let lambda = solve_gram(&self.gram, &self.effectiveness.wrench(&self.forces));
+        // `self.gram` is the effectiveness's Gram matrix: its factor, kept there.
+        let lambda = self
+            .effectiveness
+            .gram_solver()
+            .solve(&self.effectiveness.wrench(&self.forces));
         let mut delta = [Vector3::zeros(); N];
         for (((d, block), f), w) in delta
             .iter_mut()
