@@ -9,7 +9,7 @@ use crate::limits::AgentLimits;
 /// The interval and rate limits, at their old paths (now in [`crate::limits`]).
 pub use crate::limits::{Interval, RateLimits};
 use crate::linalg::max_abs;
-use crate::real::Real;
+use crate::real::{fmax, sin_cos, Real};
 
 /// Each agent's admissible set for one period: `base` everywhere, narrowed around each agent's
 /// previous command by `rate_limits = (rates, dt)` when given
@@ -123,10 +123,13 @@ impl<T: Real> AdmissibleSet<T> {
     /// Normalized distance outside the set (0 inside): the largest of the angle excesses over
     /// their range widths and the thrust excess over the thrust range.
     pub fn violation(&self, cmd: &GimbalCommand<T>) -> T {
-        let width = |i: &Interval<T>| (i.hi - i.lo).max(T::default_epsilon());
-        (self.eta_x.excess(cmd.eta_x) / width(&self.eta_x))
-            .max(self.eta_y.excess(cmd.eta_y) / width(&self.eta_y))
-            .max(self.thrust.excess(cmd.thrust) / width(&self.thrust))
+        let width = |i: &Interval<T>| fmax(i.hi - i.lo, T::default_epsilon());
+        let x = self.eta_x.excess(cmd.eta_x) / width(&self.eta_x);
+        let y = self.eta_y.excess(cmd.eta_y) / width(&self.eta_y);
+        fmax(
+            fmax(x, y),
+            self.thrust.excess(cmd.thrust) / width(&self.thrust),
+        )
     }
 
     /// The command clamped into the set, axis by axis on the exact gimbal map.
@@ -145,8 +148,33 @@ impl<T: Real> AdmissibleSet<T> {
     /// direction it does not have. A non-finite force gives the least thrust, gimbal clamped
     /// from centre. Always finite and inside the set (up to the gimbal inverse's round-off).
     pub fn saturate(&self, force: &Vector3<T>) -> Vector3<T> {
-        let g = self.clamp(&GimbalCommand::from_force(force));
-        let direction = thrust_direction(g.eta_x, g.eta_y);
+        self.saturate_along(force, GimbalCommand::from_force, thrust_direction)
+    }
+
+    /// [`Self::saturate`] with the gimbal inverse of [`GimbalCommand::from_force_fast`] and the
+    /// clamped direction's sines and cosines from [`crate::real::sin_cos`]: the same bits in
+    /// `f64`; in `f32` within 2 ulp, without `libm`'s `sincosf` (software `f64` on a
+    /// Cortex-M4F, about 2,200 instructions a call). The
+    /// exact-boundary redistribution's; the paper's allocator keeps [`Self::saturate`]'s bits.
+    pub(crate) fn saturate_fast(&self, force: &Vector3<T>) -> Vector3<T> {
+        self.saturate_along(force, GimbalCommand::from_force_fast, |x, y| {
+            let (sx, cx) = sin_cos(x);
+            let (sy, cy) = sin_cos(y);
+            Vector3::new(cx * sy, -sx, cx * cy)
+        })
+    }
+
+    /// [`Self::saturate`] with the gimbal inverse and the unit direction of clamped angles given
+    /// (function pointers, one copy for both forms: the C interface's text is bounded).
+    #[inline(never)]
+    fn saturate_along(
+        &self,
+        force: &Vector3<T>,
+        inverse: fn(&Vector3<T>) -> GimbalCommand<T>,
+        direction: fn(T, T) -> Vector3<T>,
+    ) -> Vector3<T> {
+        let g = self.clamp(&inverse(force));
+        let direction = direction(g.eta_x, g.eta_y);
         let m = max_abs(force);
         let along = if m > T::zero() && m.is_finite() {
             // Scaled so that a huge force does not overflow the dot product into NaN.

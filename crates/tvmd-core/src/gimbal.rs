@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 
 use crate::linalg::EuclideanNorm;
 use crate::linalg::{max_abs, plain_is_exact};
-use crate::real::{sqrt, Real};
+use crate::real::{asin, sqrt, Real};
 
 /// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
 /// unit thrust direction in the agent frame.
@@ -45,6 +45,20 @@ impl<T: Real> GimbalCommand<T> {
     /// first, so the angles are exact to round-off at any magnitude (no overflow at `1e155`, no
     /// underflow at `1e-160` in `f64`); `T` is `+inf` only when `||f||` exceeds the type's `MAX`.
     pub fn from_force(force: &Vector3<T>) -> Self {
+        Self::inverse(force, |s| s.asin())
+    }
+
+    /// [`Self::from_force`] with `asin` from [`crate::real::asin`]: the same bits in `f64`; in
+    /// `f32` within 2 ulp without `libm`'s software-`f64` branch (a Cortex-M4F). The
+    /// exact-boundary redistribution's; the paper's allocator keeps [`Self::from_force`]'s bits.
+    pub(crate) fn from_force_fast(force: &Vector3<T>) -> Self {
+        Self::inverse(force, asin)
+    }
+
+    /// The gimbal inverse with `asin` given (a function pointer, one copy for both forms: the
+    /// C interface's text is bounded).
+    #[inline(never)]
+    fn inverse(force: &Vector3<T>, asin: fn(T) -> T) -> Self {
         let squared = force.norm_squared();
         let (unit_scaled, n, m) = if plain_is_exact(squared) {
             (*force, sqrt(squared), T::one())
@@ -60,7 +74,7 @@ impl<T: Real> GimbalCommand<T> {
         let sin_x = (-unit_scaled.y / n).clamp(-T::one(), T::one());
         Self {
             thrust: n * m,
-            eta_x: sin_x.asin(),
+            eta_x: asin(sin_x),
             eta_y: unit_scaled.x.atan2(unit_scaled.z),
         }
     }

@@ -2,7 +2,7 @@
 //! rate limits, and the intervals admissible sets are made of.
 
 use crate::error::{ConfigError, ConfigField, GimbalAxis};
-use crate::real::{sqrt, Real};
+use crate::real::{fmax, fmin, sqrt, Real};
 
 /// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
 /// `T = rho d^4 c_l omega^2` (eq. 5).
@@ -221,12 +221,19 @@ impl<T: Real> Interval<T> {
 
     /// The nearest point of the interval.
     pub fn clamp(&self, x: T) -> T {
-        x.max(self.lo).min(self.hi)
+        fmin(fmax(x, self.lo), self.hi)
     }
 
     /// How far `x` lies outside, 0 inside.
     pub fn excess(&self, x: T) -> T {
-        (self.lo - x).max(x - self.hi).max(T::zero())
+        // `max(lo - x, x - hi, 0)` by comparisons (`lo <= hi`; a NaN `x` gives 0, as `max` does).
+        if x < self.lo {
+            self.lo - x
+        } else if x > self.hi {
+            x - self.hi
+        } else {
+            T::zero()
+        }
     }
 
     /// Intersection with `[centre - radius, centre + radius]`; if they do not meet, the end of

@@ -7,7 +7,7 @@
 use nalgebra::storage::Storage;
 use nalgebra::{Dim, Matrix, Matrix6, Matrix6x3, SVector, Vector6};
 
-use crate::real::{eps, lit, sqrt, Real};
+use crate::real::{eps, fmax, lit, sqrt, Real};
 
 /// `||v||` without overflow or underflow (hand-written: nalgebra's `norm()` squares the
 /// components, which overflows above `sqrt(MAX)` and underflows below `sqrt(MIN_POSITIVE)`).
@@ -92,7 +92,10 @@ pub(crate) fn max_abs<T: Real, const D: usize>(v: &SVector<T, D>) -> T {
         if !a.is_finite() {
             return a;
         }
-        m = m.max(a);
+        // `a >= +0` and finite, `m` too: the larger by one comparison (as `T::max`).
+        if a > m {
+            m = a;
+        }
     }
     m
 }
@@ -177,7 +180,7 @@ pub(crate) fn weighted_gram<'a, T: Real>(
 
 /// Largest diagonal entry (the scale of a Gram matrix).
 pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
-    a.diagonal().iter().fold(T::zero(), |m, x| m.max(*x))
+    a.diagonal().iter().fold(T::zero(), |m, x| fmax(m, *x))
 }
 
 /// Solves `A lambda = r` for a symmetric positive semi-definite `A`: exactly when `A` is
@@ -185,7 +188,23 @@ pub(crate) fn max_diagonal<T: Real>(a: &Matrix6<T>) -> T {
 /// (damped least squares: a rank-deficient free set in the redistribution still gets the
 /// nearest wrench it can make). Zero when `A = 0` or the input is not finite.
 pub(crate) fn solve_gram<T: Real>(a: &Matrix6<T>, r: &Vector6<T>) -> Vector6<T> {
-    GramSolver::new(a).solve(r)
+    // `GramSolver::new(a).solve(r)` without building the solver: the factor is solved where it
+    // is made instead of moved into the enum and out (two copies of 42 floats, as much as the
+    // solve itself on a Cortex-M4F). The same arithmetic, so the same bits.
+    let scale = max_diagonal(a);
+    if scale <= T::zero() || !scale.is_finite() {
+        return Vector6::zeros();
+    }
+    let tol = scale * eps::<T>() * lit(1e3);
+    if let Some(f) = Ldlt::new(a, tol) {
+        return f.solve(r);
+    }
+    // `sqrt` is correctly rounded, as `T::sqrt`.
+    let damped = a + Matrix6::identity() * (scale * sqrt(eps::<T>()));
+    match Ldlt::new(&damped, T::zero()) {
+        Some(f) => f.solve(r),
+        None => Vector6::zeros(),
+    }
 }
 
 /// The factorization [`solve_gram`] uses, kept so a Gram matrix that changes only with the

@@ -74,6 +74,30 @@ fn vsqrt_f32(x: f32) -> f32 {
     f32::from_bits(bits)
 }
 
+/// The larger of `a` and `b`, a NaN ignored and `+0` above `-0` (IEEE 754 `maxNum`, as
+/// `T::max`), by comparisons. Why by hand: on a Cortex-M4F `f32::max` is a call of `libm`'s
+/// `fmaxf` (Armv7-M has no `vmaxnm`), about 11 instructions; the allocators take it per
+/// component.
+#[inline]
+pub(crate) fn fmax<T: Real>(a: T, b: T) -> T {
+    if b > a || a.partial_cmp(&a).is_none() || (b == a && a.is_sign_negative()) {
+        b
+    } else {
+        a
+    }
+}
+
+/// The smaller of `a` and `b`, a NaN ignored and `-0` below `+0` (IEEE 754 `minNum`, as
+/// `T::min`), by comparisons (see [`fmax`]).
+#[inline(never)]
+pub(crate) fn fmin<T: Real>(a: T, b: T) -> T {
+    if b < a || a.partial_cmp(&a).is_none() || (b == a && b.is_sign_negative()) {
+        b
+    } else {
+        a
+    }
+}
+
 /// `(sin x, cos x)`. In `f32` for `|x| <= pi`, an `f32`-only kernel ([`sin_cos_f32`]); else the
 /// type's own `sin_cos`. Why by hand: the `libm` crate's `sincosf` (what nalgebra's `f32`
 /// `sin_cos` is on a `no_std` target) evaluates in `f64`, which a Cortex-M4F (single-precision
@@ -95,6 +119,56 @@ pub(crate) fn sin_cos<T: Real>(x: T) -> (T, T) {
         }
     }
     x.sin_cos()
+}
+
+/// `asin x` for `|x| <= 1`. In `f32`, an `f32`-only kernel ([`asin_f32`]); else the type's
+/// own `asin`. Why by hand: `libm`'s `asinf` takes the root of `(1 - |x|) / 2` in `f64` for
+/// `|x| >= 0.5` (a gimbal angle beyond 30 degrees), in software on a Cortex-M4F (about 1,500
+/// instructions a call).
+#[inline]
+pub(crate) fn asin<T: Real>(x: T) -> T {
+    if core::mem::size_of::<T>() == core::mem::size_of::<f32>() {
+        if let Some(v) = x.to_subset() as Option<f64> {
+            // `T` is `f32` here, so both conversions are exact.
+            return nalgebra::convert(f64::from(asin_f32(v as f32)));
+        }
+    }
+    x.asin()
+}
+
+/// `asin x` in `f32` arithmetic only (NaN beyond `[-1, 1]`): `libm`'s `asinf` (musl's
+/// rational approximation `R`) with its `f64` branch, `pi/2 - 2 asin(sqrt((1 - |x|) / 2))`,
+/// taken in `f32` with `pi/2` split in two. Within 2 ulp of the correctly rounded value
+/// (tested against `f64`).
+fn asin_f32(x: f32) -> f32 {
+    const PIO2_HI: f32 = core::f32::consts::FRAC_PI_2;
+    // `pi/2 - PIO2_HI`.
+    const PIO2_LO: f32 = -4.371_139e-8;
+    let r = |z: f32| {
+        let p = z * (1.666_658_7e-1 + z * (-4.274_342_2e-2 + z * -8.656_363e-3));
+        let q = 1.0 + z * -7.066_296_3e-1;
+        p / q
+    };
+    let a = x.abs();
+    if a < 0.5 {
+        // Below 2^-12 `asin x` rounds to `x`.
+        if a < 2.441_406_3e-4 {
+            return x;
+        }
+        return x + x * r(x * x);
+    }
+    if a >= 1.0 {
+        return if a == 1.0 { x * PIO2_HI } else { f32::NAN };
+    }
+    // Exact: `1 - a` by Sterbenz's lemma (`a >= 0.5`), the halving by its exponent.
+    let z = (1.0 - a) * 0.5;
+    let s = sqrt(z);
+    let y = (PIO2_HI - 2.0 * (s + s * r(z))) + PIO2_LO;
+    if x < 0.0 {
+        -y
+    } else {
+        y
+    }
 }
 
 /// `(sin x, cos x)` for `|x| <= pi` (finite), in `f32` arithmetic only: Cody-Waite reduction
@@ -158,6 +232,30 @@ mod tests {
             worst_s <= 2.0 && worst_c <= 2.0,
             "sin {worst_s} ulp, cos {worst_c} ulp"
         );
+    }
+
+    #[test]
+    fn f32_asin_is_within_two_ulp_on_minus_one_to_one() {
+        let mut worst = 0.0f64;
+        let steps = 2_000_000;
+        for k in 0..=steps {
+            let x = (-1.0 + 2.0 * (k as f64 / steps as f64)) as f32;
+            worst = worst.max(ulps(asin_f32(x), f64::from(x).asin()));
+        }
+        // Every float near the ends of the range, where the root's branch is steepest.
+        for bits in 0..20_000u32 {
+            for x in [
+                f32::from_bits(1.0f32.to_bits() - bits),
+                f32::from_bits(0.5f32.to_bits() + bits),
+            ] {
+                worst = worst.max(ulps(asin_f32(x), f64::from(x).asin()));
+                worst = worst.max(ulps(asin_f32(-x), f64::from(-x).asin()));
+            }
+        }
+        assert!(worst <= 2.0, "asin {worst} ulp");
+        assert!(asin_f32(1.5).is_nan() && asin_f32(f32::NAN).is_nan());
+        assert_eq!(asin(0.3f64), 0.3f64.asin());
+        assert_eq!(asin(0.7f32), asin_f32(0.7));
     }
 
     #[test]

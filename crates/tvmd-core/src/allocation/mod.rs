@@ -166,9 +166,26 @@ fn bounded_rhs<T: Real>(rhs: &Vector6<T>) -> Vector6<T> {
 /// Whether `force` must be saturated into `set`: outside it, or not finite (the gimbal inverse
 /// of a non-finite force is the idle command, which may lie inside, so it is caught here rather
 /// than kept).
+#[inline]
 pub(crate) fn outside<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bool {
-    !force.iter().all(|x| x.is_finite())
-        || set.violation(&GimbalCommand::from_force(force)) > T::zero()
+    outside_with(set, force, GimbalCommand::from_force)
+}
+
+/// [`outside`] with [`GimbalCommand::from_force_fast`] (the exact-boundary redistribution's).
+#[inline]
+pub(crate) fn outside_fast<T: Real>(set: &AdmissibleSet<T>, force: &Vector3<T>) -> bool {
+    outside_with(set, force, GimbalCommand::from_force_fast)
+}
+
+/// [`outside`] with the gimbal inverse given (one copy for both: the C interface's text is
+/// bounded).
+#[inline(never)]
+fn outside_with<T: Real>(
+    set: &AdmissibleSet<T>,
+    force: &Vector3<T>,
+    inverse: fn(&Vector3<T>) -> GimbalCommand<T>,
+) -> bool {
+    !force.iter().all(|x| x.is_finite()) || set.violation(&inverse(force)) > T::zero()
 }
 
 /// `sum_{i free} M_i M_i^T / w_i`.

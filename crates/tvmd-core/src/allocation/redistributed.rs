@@ -2,9 +2,8 @@
 
 use nalgebra::Vector3;
 
-use super::{
-    outside, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
-};
+use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
+use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::real::Real;
@@ -38,6 +37,28 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
     fn configure(&mut self, _effectiveness: &Effectiveness<T, N>) {}
 
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
+        redistribute(request, GimbalCommand::from_force, AdmissibleSet::saturate)
+    }
+
+    fn name(&self) -> &'static str {
+        super::names::REDISTRIBUTED_PSEUDO_INVERSE
+    }
+}
+
+/// The redistribution of [`RedistributedPseudoInverse`], with the gimbal inverse `inverse` and
+/// the saturation `saturate` (the paper's: [`GimbalCommand::from_force`],
+/// [`AdmissibleSet::saturate`]; the exact-boundary redistribution's start: their `_fast`
+/// forms, without `libm`'s software-`f64` trigonometry on a Cortex-M4F).
+///
+/// Function pointers, not generic closures: one copy of the redistribution for both callers
+/// (the C interface's text is bounded, `scripts/ffi.sh`), not inlined into either.
+#[inline(never)]
+pub(super) fn redistribute<T: Real, const N: usize>(
+    request: &AllocationRequest<'_, T, N>,
+    inverse: fn(&Vector3<T>) -> GimbalCommand<T>,
+    saturate: fn(&AdmissibleSet<T>, &Vector3<T>) -> Vector3<T>,
+) -> Allocation<T, N> {
+    {
         let e = request.effectiveness;
         let mut free = working_mask(e);
         let mut forces = [Vector3::zeros(); N];
@@ -61,18 +82,16 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
                 .zip(&free)
                 .enumerate()
                 .filter(|(_, (_, is_free))| **is_free)
-                .filter(|(_, ((f, set), _))| outside(set, f))
-                // A non-finite force counts as the worst.
-                .map(|(i, ((f, set), _))| {
-                    let v = set.violation(&GimbalCommand::from_force(f));
-                    (
-                        i,
-                        if f.iter().all(|x| x.is_finite()) {
-                            v
-                        } else {
-                            T::one() / T::zero()
-                        },
-                    )
+                // `outside` with the one gimbal inverse per agent; a non-finite force counts as
+                // the worst.
+                .filter_map(|(i, ((f, set), _))| {
+                    let v = set.violation(&inverse(f));
+                    let finite = f.iter().all(|x| x.is_finite());
+                    match (finite, v > T::zero()) {
+                        (true, true) => Some((i, v)),
+                        (true, false) => None,
+                        (false, _) => Some((i, T::one() / T::zero())),
+                    }
                 })
                 .fold(None, |best: Option<(usize, T)>, (i, v)| match best {
                     Some((_, bv)) if bv >= v => best,
@@ -87,7 +106,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
                 free.get_mut(j),
                 saturated.get_mut(j),
             ) {
-                *f = set.saturate(f);
+                *f = saturate(set, f);
                 *is_free = false;
                 *sat = true;
             }
@@ -99,15 +118,13 @@ impl<T: Real, const N: usize> Allocator<T, N> for RedistributedPseudoInverse {
             .zip(&free)
             .zip(saturated.iter_mut())
         {
-            if *is_free && outside(set, f) {
-                *f = set.saturate(f);
+            if *is_free
+                && (!f.iter().all(|x| x.is_finite()) || set.violation(&inverse(f)) > T::zero())
+            {
+                *f = saturate(set, f);
                 *sat = true;
             }
         }
         Allocation::from_forces(request, forces, rounds, saturated)
-    }
-
-    fn name(&self) -> &'static str {
-        super::names::REDISTRIBUTED_PSEUDO_INVERSE
     }
 }

@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use crate::admissible::AdmissibleSet;
 use crate::limits::Interval;
 use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, sqrt, Real};
+use crate::real::{eps, fmax, lit, sin_cos, sqrt, Real};
 
 /// Number of constraints of one agent.
 pub(in crate::allocation) const CONSTRAINTS: usize = 6;
@@ -44,8 +44,13 @@ impl<T: Real> Constraint<T> {
     }
 
     /// `grad g(f) = c + s f / ||f||` (`c` at the origin, where the cones have no normal).
+    #[cfg(any(test, feature = "null-space"))]
     pub(in crate::allocation) fn gradient(&self, f: &Vector3<T>) -> Vector3<T> {
-        let n = norm(f);
+        self.gradient_with_norm(f, norm(f))
+    }
+
+    /// [`Self::gradient`] given `n = ||f||` (one norm for all of an agent's constraints).
+    pub(super) fn gradient_with_norm(&self, f: &Vector3<T>, n: T) -> Vector3<T> {
         if n > T::zero() {
             self.c + f * (self.s / n)
         } else {
@@ -102,7 +107,7 @@ impl<T: Real> Constraint<T> {
             return None;
         }
         if !self.curved() {
-            return (q > T::zero()).then(|| (-p / q).max(T::zero()));
+            return (q > T::zero()).then(|| fmax(-p / q, T::zero()));
         }
         let s2 = self.s * self.s;
         let a = q * q - s2 * ray.dd;
@@ -157,7 +162,7 @@ impl<T: Real> Constraint<T> {
             let fy = -(self.s * n + self.k) / self.c.y;
             let side = Vector3::new(f.x, zero, f.z);
             let side_len = norm(&side);
-            let rest = sqrt((n * n - fy * fy).max(zero));
+            let rest = sqrt(fmax(n * n - fy * fy, zero));
             if side_len <= zero {
                 return *f;
             }
@@ -196,7 +201,7 @@ pub(super) struct Ray<T: Real> {
 impl<T: Real> Ray<T> {
     /// `None` when everything is zero or a component is not finite (no exit).
     pub(super) fn new(f: &Vector3<T>, d: &Vector3<T>, offset: T) -> Option<Self> {
-        let scale = max_abs(f).max(max_abs(d)).max(offset);
+        let scale = fmax(fmax(max_abs(f), max_abs(d)), offset);
         if scale <= T::zero() || !scale.is_finite() {
             return None;
         }
@@ -235,14 +240,16 @@ pub(in crate::allocation) fn regular<T: Real>(set: &AdmissibleSet<T>) -> Admissi
 }
 
 /// The six constraints of `set` (a bound that can never bind, `T >= 0`, is `-T_max <= 0`:
-/// never violated, never crossed, never on the boundary).
+/// never violated, never crossed, never on the boundary). The limits' sines through
+/// [`sin_cos`]: `libm`'s `f32` ones run in software `f64` on a Cortex-M4F (about 2,200
+/// instructions each, four per allocation); the same bits as `T::sin_cos` in `f64`.
 pub(in crate::allocation) fn constraints<T: Real>(
     set: &AdmissibleSet<T>,
 ) -> [Constraint<T>; CONSTRAINTS] {
     let zero = T::zero();
     let y = Vector3::new(zero, T::one(), zero);
     let plane = |b: T, sign: T| {
-        let (sb, cb) = b.sin_cos();
+        let (sb, cb) = sin_cos(b);
         Vector3::new(cb, zero, -sb) * sign
     };
     let ex = set.eta_x();
@@ -256,8 +263,8 @@ pub(in crate::allocation) fn constraints<T: Real>(
     };
     let never = constraint(Vector3::zeros(), zero, -th.hi.max(T::one()));
     [
-        constraint(-y, -ex.hi.sin(), zero),
-        constraint(y, ex.lo.sin(), zero),
+        constraint(-y, -sin_cos(ex.hi).0, zero),
+        constraint(y, sin_cos(ex.lo).0, zero),
         constraint(plane(ey.hi, T::one()), zero, zero),
         constraint(plane(ey.lo, -T::one()), zero, zero),
         constraint(Vector3::zeros(), T::one(), -th.hi),

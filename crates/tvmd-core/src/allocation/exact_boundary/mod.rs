@@ -12,14 +12,16 @@ use nalgebra::{Vector3, Vector6};
 use self::active::ActiveSet;
 use self::constraint::{constraints, regular};
 pub use self::cost::WalkCost;
-use self::walk::{on_boundary, Walk};
+use self::walk::{offset, on_boundary, Walk};
 use super::{
-    outside, working_mask, Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse,
+    outside_fast, redistributed::redistribute, working_mask, Allocation, AllocationRequest,
+    Allocator,
 };
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
+use crate::gimbal::GimbalCommand;
 use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, fmax, lit, Real};
 
 /// Incremental allocation on the exact admissible boundary.
 ///
@@ -181,14 +183,30 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let e = request.effectiveness;
         let working = working_mask(e);
         let sets = &per_set(request.sets, regular);
-        let scale = max_abs(&request.wrench).max(T::one());
+        let scale = fmax(max_abs(&request.wrench), T::one());
         let tol = eps::<T>() * lit(64.0) * scale;
-        let start = RedistributedPseudoInverse.allocate(request);
+        // The paper's redistribution, saturating without `libm`'s `f32` trigonometry.
+        let start = redistribute(
+            request,
+            GimbalCommand::from_force_fast,
+            AdmissibleSet::saturate_fast,
+        );
         let mut forces = start.forces;
         let mut moved = false;
-        for (f, set) in forces.iter_mut().zip(sets) {
-            if outside(set, f) {
-                *f = set.saturate(f);
+        for ((f, set), ((given, saturated), w)) in forces
+            .iter_mut()
+            .zip(sets)
+            .zip(request.sets.iter().zip(&start.saturated).zip(&working))
+        {
+            // A failed agent's zero force is not walked (its force stays zero). A working agent
+            // the start left unsaturated was found inside `given` by the start's own test: the
+            // same answer here when the set is unchanged (the gimbal inverse costs more than the
+            // rest of an interior request's allocation on a Cortex-M4F).
+            if !*w || (!*saturated && set == given) {
+                continue;
+            }
+            if outside_fast(set, f) {
+                *f = set.saturate_fast(f);
                 moved = true;
             }
         }
@@ -208,7 +226,11 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             let mut kept = [Vector3::zeros(); N];
             for (((k, p), set), w) in kept.iter_mut().zip(previous).zip(sets).zip(&working) {
                 if *w {
-                    *k = if outside(set, p) { set.saturate(p) } else { *p };
+                    *k = if outside_fast(set, p) {
+                        set.saturate_fast(p)
+                    } else {
+                        *p
+                    };
                 }
             }
             if torque_first(&(request.wrench - e.wrench(&kept))) < rpi.0 {
@@ -219,6 +241,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         let mut walk = Walk {
             effectiveness: e,
             sets,
+            offsets: bounds.each_ref().map(offset),
             bounds,
             gram: e.gram(),
             working,
@@ -276,8 +299,8 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
                 *f = Vector3::zeros();
                 continue;
             }
-            if outside(set, f) {
-                *f = set.saturate(f);
+            if outside_fast(set, f) {
+                *f = set.saturate_fast(f);
             }
             *s = on_boundary(b, set, f);
         }

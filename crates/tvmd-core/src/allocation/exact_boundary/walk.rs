@@ -11,13 +11,15 @@ use super::cost::WalkCost;
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
 use crate::linalg::{norm, solve_gram};
-use crate::real::{eps, Real};
+use crate::real::{eps, fmax, sqrt, Real};
 
 /// The walk's state over the agents.
 pub(super) struct Walk<'a, T: Real, const N: usize> {
     pub(super) effectiveness: &'a Effectiveness<T, N>,
     pub(super) sets: &'a [AdmissibleSet<T>; N],
     pub(super) bounds: [[Constraint<T>; CONSTRAINTS]; N],
+    /// Each agent's largest constraint offset `|k|` ([`offset`]), for the line search's rays.
+    pub(super) offsets: [T; N],
     /// `sum_i M_i M_i^T` over the working agents, before any is held.
     pub(super) gram: Matrix6<T>,
     pub(super) working: [bool; N],
@@ -36,6 +38,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     pub(super) fn direction(&mut self, r: &Vector6<T>, release: bool) -> Option<[Vector3<T>; N]> {
         let mut gram = self.gram;
         let mut movable = false;
+        let mut downdated = false;
         for (((block, a), f), (w, b)) in self
             .effectiveness
             .blocks()
@@ -48,13 +51,20 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 a.update(b, f);
                 a.downdate(block, &mut gram);
                 movable |= !a.fixed();
+                downdated |= a.downdates();
             }
         }
         if !movable {
             return None;
         }
         self.cost.solves += 1;
-        let lambda = solve_gram(&gram, r);
+        // Nothing held (the first round): the effectiveness's own factor of this Gram matrix,
+        // the same bits as factoring it again.
+        let lambda = if downdated {
+            solve_gram(&gram, r)
+        } else {
+            self.effectiveness.gram_solver().solve(r)
+        };
         // `M_i^T lambda`, the free increments, once for the release test and the step.
         let mut delta = [Vector3::zeros(); N];
         for ((d, block), w) in delta
@@ -96,14 +106,15 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 continue;
             }
             let free_norm = norm(free);
+            let f_norm = norm(f);
             for (k, c) in b.iter().enumerate().filter(|(k, _)| a.releasable(*k)) {
-                let g = c.gradient(f);
+                let g = c.gradient_with_norm(f, f_norm);
                 let scale = norm(&g) * free_norm;
                 if scale.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                     continue;
                 }
                 let slope = g.dot(free) / scale;
-                if slope < -eps::<T>().sqrt() && worst.is_none_or(|(_, _, s)| slope < s) {
+                if slope < -sqrt(eps::<T>()) && worst.is_none_or(|(_, _, s)| slope < s) {
                     worst = Some((i, k, slope));
                 }
             }
@@ -126,11 +137,11 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         let mut tau = T::one();
         let mut first = None;
         let mut at_once = [None; N];
-        for (i, ((((f, d), b), a), (w, now))) in self
+        for (i, ((((f, d), (b, offset)), a), (w, now))) in self
             .forces
             .iter()
             .zip(delta)
-            .zip(&self.bounds)
+            .zip(self.bounds.iter().zip(&self.offsets))
             .zip(&self.active)
             .zip(self.working.iter().zip(at_once.iter_mut()))
             .enumerate()
@@ -138,8 +149,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             if !*w || a.fixed() {
                 continue;
             }
-            let offset = b.iter().map(|c| c.offset()).fold(T::zero(), T::max);
-            let Some(ray) = Ray::new(f, d, offset) else {
+            let Some(ray) = Ray::new(f, d, *offset) else {
                 continue;
             };
             for (k, c) in b.iter().enumerate() {
@@ -187,7 +197,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
                 if a.curved() && violated(b, f) {
                     *f = retract(b, a, f);
                     if violated(b, f) {
-                        *f = set.saturate(f);
+                        *f = set.saturate_fast(f);
                     }
                 }
             }
@@ -203,7 +213,11 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
     /// there (measured: 0.17 rad in one period on paper-tilt at `s = 1`).
     pub(super) fn shed_internal(&mut self) {
         self.cost.solves += 1;
-        let lambda = solve_gram(&self.gram, &self.effectiveness.wrench(&self.forces));
+        // `self.gram` is the effectiveness's Gram matrix: its factor, kept there.
+        let lambda = self
+            .effectiveness
+            .gram_solver()
+            .solve(&self.effectiveness.wrench(&self.forces));
         let mut delta = [Vector3::zeros(); N];
         for (((d, block), f), w) in delta
             .iter_mut()
@@ -243,6 +257,11 @@ fn retract<T: Real>(
     out
 }
 
+/// The largest `|k|` of an agent's constraints (the scale its line-search rays need).
+pub(super) fn offset<T: Real>(bounds: &[Constraint<T>; CONSTRAINTS]) -> T {
+    bounds.iter().map(|c| c.offset()).fold(T::zero(), fmax)
+}
+
 /// Whether `f` is outside the set its constraints describe (or not finite): the same test as
 /// [`outside`] up to round-off, with a dot product per constraint and one norm instead of the
 /// gimbal inverse.
@@ -260,6 +279,6 @@ pub(super) fn on_boundary<T: Real>(
     set: &AdmissibleSet<T>,
     f: &Vector3<T>,
 ) -> bool {
-    let tol = eps::<T>().sqrt() * set.thrust().hi.max(T::one());
+    let tol = sqrt(eps::<T>()) * fmax(set.thrust().hi, T::one());
     bounds.iter().any(|c| c.value(f) > -tol)
 }
