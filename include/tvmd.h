@@ -45,9 +45,10 @@
 
 /*
  The ABI version; raised on every incompatible change of a struct or function (2: the `law`
- of `TvmdConfig` and the compensation of `TvmdOutput`).
+ of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
+ the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`).
  */
-#define TVMD_ABI_VERSION 3
+#define TVMD_ABI_VERSION 4
 
 /*
  `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
@@ -137,11 +138,22 @@
  */
 #define TVMD_FAULT_KIND_STUCK_GIMBAL 3
 
+#if !defined(TVMD_CAPACITY_4)
 /*
  Bytes of a [`TvmdController`]: at least the controller's size on every supported target
- (checked at compile time), with room for the core to grow within one ABI version.
+ (checked at compile time), with room for the core to grow within one ABI version. 8,192 at
+ the 16-agent capacity (the controller keeps its allocator's working set, so no entry point
+ holds it on the stack), 4,096 at the 4-agent one.
+ */
+#define TVMD_CONTROLLER_SIZE 8192
+#endif
+
+#if defined(TVMD_CAPACITY_4)
+/*
+ Bytes of a [`TvmdController`] at the 4-agent capacity (feature `capacity-4`).
  */
 #define TVMD_CONTROLLER_SIZE 4096
+#endif
 
 /*
  `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C

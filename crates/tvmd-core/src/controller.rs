@@ -129,7 +129,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         allocator: A,
     ) -> Result<Self, ConfigError> {
         let mut slot = core::mem::MaybeUninit::uninit();
-        Self::init_in(&mut slot, &team, &settings, allocator)?;
+        Self::init_in(&mut slot, &team, &settings, move || allocator)?;
         // SAFETY: `init_in` returned `Ok`, so it initialized every field.
         Ok(unsafe { slot.assume_init() })
     }

@@ -47,7 +47,7 @@ fn a_refused_reconfiguration_changes_nothing() {
         ..ControllerSettings::offset_free_law()
     };
     assert!(c
-        .reconfigure(&team, &bad, ExactBoundaryRedistribution::new())
+        .reconfigure(&team, &bad, ExactBoundaryRedistribution::new)
         .is_err());
     let mut twin = before;
     let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
@@ -72,7 +72,7 @@ fn an_accepted_reconfiguration_keeps_the_flight_state() {
         relaxation: Relaxation::new(0.8).unwrap(),
         ..ControllerSettings::offset_free_law()
     };
-    c.reconfigure(&team, &settings, ExactBoundaryRedistribution::new())
+    c.reconfigure(&team, &settings, ExactBoundaryRedistribution::new)
         .unwrap();
     assert_eq!(c.failures(), &FailureMask::with_failed(&[5]).unwrap());
     assert_eq!(c.settings().relaxation, Relaxation::new(0.8).unwrap());
@@ -160,7 +160,7 @@ fn built_in_place_equals_built_anew() {
         &mut slot,
         &team,
         &settings,
-        ExactBoundaryRedistribution::new(),
+        ExactBoundaryRedistribution::new,
     )
     .unwrap();
     let body = Body::at(Vector3::new(0.1, 0.0, 1.5));
@@ -170,7 +170,7 @@ fn built_in_place_equals_built_anew() {
     let paper = ControllerSettings::paper();
     let mut reconfigured = fresh.clone();
     reconfigured
-        .reconfigure(&team, &paper, ExactBoundaryRedistribution::new())
+        .reconfigure(&team, &paper, ExactBoundaryRedistribution::new)
         .unwrap();
     let mut anew = Controller::new(team, paper, ExactBoundaryRedistribution::new()).unwrap();
     reconfigured.reset();

@@ -7,23 +7,23 @@ use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
 use tvmd_core::allocation::{
-    AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
-    WEIGHTED_PSEUDO_INVERSE,
+    AllocatorChoice, AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 use tvmd_core::{
-    AgentSpec, AnyAllocator, ConfigError, ControllerSettings, Navigator, RateLimits, Relaxation,
-    TeamConfig,
+    AgentSpec, ConfigError, ControllerSettings, Navigator, RateLimits, Relaxation, TeamConfig,
 };
 
 use crate::status::*;
 use crate::types::*;
 use crate::TVMD_MAX_AGENTS;
 
-/// The parts a controller is built from.
+/// The parts a controller is built from; the allocator as a checked choice, made in place
+/// when the controller is built (it can be kilobytes).
 pub(crate) struct Blueprint {
     pub(crate) team: TeamConfig<f32, TVMD_MAX_AGENTS>,
     pub(crate) settings: ControllerSettings<f32>,
-    pub(crate) allocator: AnyAllocator<f32, TVMD_MAX_AGENTS>,
+    pub(crate) allocator: AllocatorChoice<f32, TVMD_MAX_AGENTS>,
 }
 
 impl Blueprint {
@@ -118,7 +118,7 @@ unsafe fn settings(
 #[inline(never)]
 unsafe fn allocator(
     config: &TvmdConfig,
-    at: *mut AnyAllocator<f32, TVMD_MAX_AGENTS>,
+    at: *mut AllocatorChoice<f32, TVMD_MAX_AGENTS>,
 ) -> Result<(), ConvertError> {
     let name = match config.allocator {
         TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE => REDISTRIBUTED_PSEUDO_INVERSE,
@@ -140,6 +140,6 @@ unsafe fn allocator(
     if config.allocator_max_rounds != 0 {
         options.max_rounds = Some(config.allocator_max_rounds);
     }
-    at.write(AnyAllocator::from_name(name, &options)?);
+    at.write(AllocatorChoice::new(name, &options)?);
     Ok(())
 }

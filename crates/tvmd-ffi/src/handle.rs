@@ -20,7 +20,14 @@ pub(crate) type FfiController =
     Controller<f32, TVMD_MAX_AGENTS, AnyAllocator<f32, TVMD_MAX_AGENTS>>;
 
 /// Bytes of a [`TvmdController`]: at least the controller's size on every supported target
-/// (checked at compile time), with room for the core to grow within one ABI version.
+/// (checked at compile time), with room for the core to grow within one ABI version. 8,192 at
+/// the 16-agent capacity (the controller keeps its allocator's working set, so no entry point
+/// holds it on the stack), 4,096 at the 4-agent one.
+#[cfg(not(feature = "capacity-4"))]
+pub const TVMD_CONTROLLER_SIZE: usize = 8192;
+
+/// Bytes of a [`TvmdController`] at the 4-agent capacity (feature `capacity-4`).
+#[cfg(feature = "capacity-4")]
 pub const TVMD_CONTROLLER_SIZE: usize = 4096;
 
 /// `TVMD_CONTROLLER_SIZE` in 8-byte words (the storage's element type gives the alignment in C
@@ -167,15 +174,12 @@ pub unsafe extern "C" fn tvmd_create(
         Ok(b) => b,
         Err(e) => return e.status(),
     };
-    // Built in place: a controller on the stack would cost a small-stack caller 4 KB more.
+    // Built in place: a controller on the stack would cost a small-stack caller its size again.
     let slot =
         &mut *core::ptr::addr_of_mut!((*inner).controller).cast::<MaybeUninit<FfiController>>();
-    match Controller::init_in(
-        slot,
-        &blueprint.team,
-        &blueprint.settings,
-        blueprint.allocator.clone(),
-    ) {
+    match Controller::init_in(slot, &blueprint.team, &blueprint.settings, || {
+        AnyAllocator::from_choice(blueprint.allocator.clone())
+    }) {
         Ok(_) => {
             core::ptr::addr_of_mut!((*inner).magic).write(MAGIC);
             storage

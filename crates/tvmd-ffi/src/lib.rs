@@ -62,8 +62,9 @@ pub const TVMD_MAX_AGENTS: usize = 16;
 pub const TVMD_MAX_AGENTS: usize = 4;
 
 /// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
-/// of `TvmdConfig` and the compensation of `TvmdOutput`).
-pub const TVMD_ABI_VERSION: u32 = 3;
+/// of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
+/// the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`).
+pub const TVMD_ABI_VERSION: u32 = 4;
 
 /// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
 #[no_mangle]

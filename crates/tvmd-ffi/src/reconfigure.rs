@@ -4,7 +4,7 @@
 //! `tvmd_set_gains`, `tvmd_set_relaxation`, `tvmd_set_rate_limits`, and `tvmd_seed_commands`
 //! for a mode switch.
 
-use tvmd_core::{AgentCommand, RateLimits, Relaxation};
+use tvmd_core::{AgentCommand, AnyAllocator, RateLimits, Relaxation};
 
 use core::mem::MaybeUninit;
 
@@ -69,8 +69,9 @@ pub unsafe extern "C" fn tvmd_reconfigure(
     };
     match inner
         .controller
-        .reconfigure(&next.team, &next.settings, next.allocator.clone())
-    {
+        .reconfigure(&next.team, &next.settings, || {
+            AnyAllocator::from_choice(next.allocator.clone())
+        }) {
         Ok(()) => TVMD_OK,
         Err(e) => config_status(&e),
     }

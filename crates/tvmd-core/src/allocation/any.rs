@@ -1,17 +1,20 @@
 //! Run-time choice of allocator (for configuration files and bindings), and the one table of
 //! allocator names.
 
+use super::choice::{AllocatorChoice, AllocatorOptions, Choice};
 use super::{
     Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, ConfigField};
+use crate::error::ConfigError;
 use crate::real::Real;
 
+#[cfg(feature = "clarabel")]
+use super::names::{CLARABEL, CLARABEL_SEQUENTIAL};
 use super::names::{
-    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
-    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+    EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
+    WEIGHTED_PSEUDO_INVERSE,
 };
 
 #[cfg(feature = "clarabel")]
@@ -30,33 +33,6 @@ const NAMES: &[&str] = &[
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
 ];
-
-/// Options of [`AnyAllocator::from_name`]; each applies to one allocator only.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AllocatorOptions<T: Real, const N: usize> {
-    /// Per-agent weights `w_i` of [`WeightedPseudoInverse`] (default: all 1).
-    pub agent_weights: Option<[T; N]>,
-    /// Wrench weights `W` of `ClarabelAllocator` and `SequentialConvexAllocator` (default:
-    /// identity).
-    pub wrench_weights: Option<[T; 6]>,
-    /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`) and
-    /// `SequentialConvexAllocator` (default `0`).
-    pub regularization: Option<T>,
-    /// Round cap of [`ExactBoundaryRedistribution::with_max_rounds`] (default: none, the walk's
-    /// own `2 n + 4`): bounds the allocator's work per period, see `docs/allocation-benchmark.md`.
-    pub max_rounds: Option<u32>,
-}
-
-impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
-    fn default() -> Self {
-        Self {
-            agent_weights: None,
-            wrench_weights: None,
-            regularization: None,
-            max_rounds: None,
-        }
-    }
-}
 
 /// One of the crate's allocators, chosen at run time.
 ///
@@ -104,103 +80,25 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
     /// `"clarabel"` and `"clarabel-sequential"` without the feature; [`ConfigError::UnusedOption`] for an option the
     /// allocator does not take; the allocator's own validation errors.
     pub fn from_name(name: &str, options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
-        let refuse = |given: bool, field| {
-            if given {
-                Err(ConfigError::UnusedOption { field })
-            } else {
-                Ok(())
-            }
-        };
-        let no_clarabel_options = || {
-            refuse(
-                options.wrench_weights.is_some(),
-                ConfigField::ClarabelWeights,
-            )?;
-            refuse(
-                options.regularization.is_some(),
-                ConfigField::ClarabelLambda,
-            )
-        };
-        match name {
-            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE | EXACT_BOUNDARY_REDISTRIBUTION => {
-                refuse(
-                    options.agent_weights.is_some(),
-                    ConfigField::AllocatorWeights,
-                )?;
-                no_clarabel_options()?;
-                refuse(
-                    options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
-                    ConfigField::AllocatorMaxRounds,
-                )?;
-                Ok(match name {
-                    PSEUDO_INVERSE => Self::PseudoInverse(PseudoInverse),
-                    REDISTRIBUTED_PSEUDO_INVERSE => {
-                        Self::RedistributedPseudoInverse(RedistributedPseudoInverse)
-                    }
-                    _ => Self::ExactBoundaryRedistribution(
-                        ExactBoundaryRedistribution::new().with_max_rounds(options.max_rounds),
-                    ),
-                })
-            }
-            WEIGHTED_PSEUDO_INVERSE => {
-                no_clarabel_options()?;
-                refuse(
-                    options.max_rounds.is_some(),
-                    ConfigField::AllocatorMaxRounds,
-                )?;
-                let weights = options.agent_weights.unwrap_or([T::one(); N]);
-                Ok(Self::WeightedPseudoInverse(WeightedPseudoInverse::new(
-                    weights,
-                )?))
-            }
-            CLARABEL | CLARABEL_SEQUENTIAL => {
-                refuse(
-                    options.agent_weights.is_some(),
-                    ConfigField::AllocatorWeights,
-                )?;
-                refuse(
-                    options.max_rounds.is_some(),
-                    ConfigField::AllocatorMaxRounds,
-                )?;
-                if name == CLARABEL {
-                    Self::clarabel(options)
-                } else {
-                    Self::clarabel_sequential(options)
-                }
-            }
-            _ => Err(ConfigError::UnknownAllocator),
+        Ok(Self::from_choice(AllocatorChoice::new(name, options)?))
+    }
+
+    /// The allocator of a checked choice (with no previous forces): [`Self::from_name`] in two
+    /// steps, for a caller that checks a configuration first and makes the allocator in place
+    /// later ([`crate::Controller::init_in`]).
+    pub fn from_choice(choice: AllocatorChoice<T, N>) -> Self {
+        match choice.into_inner() {
+            Choice::PseudoInverse => Self::PseudoInverse(PseudoInverse),
+            Choice::Redistributed => Self::RedistributedPseudoInverse(RedistributedPseudoInverse),
+            Choice::ExactBoundary { max_rounds } => Self::ExactBoundaryRedistribution(
+                ExactBoundaryRedistribution::new().with_max_rounds(max_rounds),
+            ),
+            Choice::Weighted(a) => Self::WeightedPseudoInverse(a),
+            #[cfg(feature = "clarabel")]
+            Choice::Clarabel(a) => Self::Clarabel(a),
+            #[cfg(feature = "clarabel")]
+            Choice::Sequential(a) => Self::ClarabelSequential(a),
         }
-    }
-
-    #[cfg(feature = "clarabel")]
-    fn clarabel(options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
-        let lambda = options
-            .regularization
-            .unwrap_or_else(|| super::ClarabelAllocator::<T, N>::default().lambda());
-        Ok(Self::Clarabel(super::ClarabelAllocator::new(
-            lambda,
-            options.wrench_weights,
-        )?))
-    }
-
-    #[cfg(not(feature = "clarabel"))]
-    fn clarabel(_options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
-        Err(ConfigError::AllocatorUnavailable { name: CLARABEL })
-    }
-
-    #[cfg(feature = "clarabel")]
-    fn clarabel_sequential(options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
-        let lambda = options.regularization.unwrap_or_else(T::zero);
-        Ok(Self::ClarabelSequential(
-            super::SequentialConvexAllocator::new(lambda, options.wrench_weights)?,
-        ))
-    }
-
-    #[cfg(not(feature = "clarabel"))]
-    fn clarabel_sequential(_options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
-        Err(ConfigError::AllocatorUnavailable {
-            name: CLARABEL_SEQUENTIAL,
-        })
     }
 
     /// The allocator's name, one of [`Self::NAMES`].

@@ -6,6 +6,7 @@
 //! downstream never has to clamp more than round-off.
 
 mod any;
+mod choice;
 #[cfg(feature = "clarabel")]
 mod clarabel;
 mod exact_boundary;
@@ -14,7 +15,8 @@ mod null_space;
 mod pseudo_inverse;
 mod redistributed;
 
-pub use any::{AllocatorOptions, AnyAllocator};
+pub use any::AnyAllocator;
+pub use choice::{AllocatorChoice, AllocatorOptions};
 #[cfg(feature = "clarabel")]
 pub use clarabel::{
     ClarabelAllocator, ClarabelStatus, FallbackReason, SequentialConvexAllocator, SequentialReport,

@@ -83,8 +83,9 @@ impl<T: Real, const N: usize> Parts<T, N> {
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Builds the controller of [`Self::new`] in `slot`, part by part, and returns it there:
     /// the same checks, errors and controller, without the whole controller on the stack (for
-    /// storage of the caller's, such as the C interface's handle). On an error `slot` is not
-    /// written.
+    /// storage of the caller's, such as the C interface's handle). `allocator` makes the
+    /// allocator, called once all checks passed, so that it is made where it lives. On an
+    /// error `slot` is not written.
     ///
     /// ```
     /// use core::mem::MaybeUninit;
@@ -95,7 +96,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     ///     &mut slot,
     ///     &team,
     ///     &ControllerSettings::default(),
-    ///     ExactBoundaryRedistribution::new(),
+    ///     ExactBoundaryRedistribution::new,
     /// )?;
     /// assert!(controller.hover_capability().capable);
     /// # Ok::<(), tvmd_core::ConfigError>(())
@@ -104,7 +105,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         slot: &'s mut MaybeUninit<Self>,
         team: &TeamConfig<T, N>,
         settings: &ControllerSettings<T>,
-        allocator: A,
+        allocator: impl FnOnce() -> A,
     ) -> Result<&'s mut Self, ConfigError> {
         // SAFETY: `slot` is valid for writes and aligned; `build_at` initializes every field
         // when it returns `Ok`.
@@ -143,13 +144,14 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// rebuilt in place with the running one's failure mask, landed flag, held commands (when
     /// they are admissible for the new team, agent by agent; otherwise idle) and offset-free
     /// estimate (when both run the same kind of action, clamped onto the new bounds). On an
-    /// error the running controller is untouched and steps exactly as before.
+    /// error the running controller is untouched and steps exactly as before. `allocator`
+    /// makes the new allocator, in place, once all checks passed.
     #[inline(never)]
     pub fn reconfigure(
         &mut self,
         team: &TeamConfig<T, N>,
         settings: &ControllerSettings<T>,
-        allocator: A,
+        allocator: impl FnOnce() -> A,
     ) -> Result<(), ConfigError> {
         let (failures, offset_free, previous) = (self.failures, self.offset_free, self.previous);
         let this: *mut Self = self;
@@ -197,18 +199,31 @@ unsafe fn build_at<T: Real, const N: usize, A: Allocator<T, N>>(
     this: *mut Controller<T, N, A>,
     team: &TeamConfig<T, N>,
     settings: &ControllerSettings<T>,
-    allocator: A,
+    allocator: impl FnOnce() -> A,
     failures: FailureMask<N>,
 ) -> Result<(), ConfigError> {
     let mut parts = MaybeUninit::uninit();
     let parts = Parts::write_in(&mut parts, team, settings, failures)?;
-    write(this, team, settings, allocator, parts);
+    write(this, team, settings, parts);
+    let slot = addr_of_mut!((*this).allocator);
+    make_at(slot, allocator);
+    (*slot).configure(&*addr_of_mut!((*this).effectiveness));
     Ok(())
 }
 
-/// Writes every field of the controller of `team`, `settings`, `allocator` and `parts` at
-/// `this`, the effectiveness model in place; the hover classification is a placeholder until
-/// `classify_hover`. What `this` held is overwritten, not dropped.
+/// Writes what `make` returns at `at`, its temporary on this function's own frame. With the
+/// exact-boundary redistribution's workspace an allocator can be kilobytes.
+///
+/// # Safety
+/// `at` is valid for writes and aligned; what it held is overwritten, not dropped.
+#[inline(never)]
+unsafe fn make_at<A>(at: *mut A, make: impl FnOnce() -> A) {
+    at.write(make());
+}
+
+/// Writes every field of the controller of `team`, `settings` and `parts` at `this` but the
+/// allocator, the effectiveness model in place; the hover classification is a placeholder
+/// until `classify_hover`. What `this` held is overwritten, not dropped.
 ///
 /// # Safety
 /// `this` is valid for writes and aligned.
@@ -217,7 +232,6 @@ unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
     this: *mut Controller<T, N, A>,
     team: &TeamConfig<T, N>,
     settings: &ControllerSettings<T>,
-    allocator: A,
     parts: &Parts<T, N>,
 ) {
     let &Parts {
@@ -256,7 +270,4 @@ unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
         limit: HoverLimit::MaxThrust,
         weight: plant.weight(),
     });
-    let slot = addr_of_mut!((*this).allocator);
-    slot.write(allocator);
-    (*slot).configure(&*effectiveness);
 }

@@ -33,6 +33,16 @@ pub(in crate::allocation) struct Constraint<T: Real> {
 }
 
 impl<T: Real> Constraint<T> {
+    /// `g = 0` everywhere: a placeholder until a set's constraints are built.
+    pub(super) fn placeholder() -> Self {
+        Self {
+            c: Vector3::zeros(),
+            s: T::zero(),
+            k: T::zero(),
+            lipschitz: T::zero(),
+        }
+    }
+
     /// `g(f)`, overflow-safe (the norm does not square).
     pub(in crate::allocation) fn value(&self, f: &Vector3<T>) -> T {
         self.c.dot(f) + self.s * norm(f) + self.k

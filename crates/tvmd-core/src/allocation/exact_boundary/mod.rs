@@ -6,13 +6,14 @@ pub(super) mod active;
 pub(super) mod constraint;
 mod cost;
 mod walk;
+mod workspace;
 
 use nalgebra::{Vector3, Vector6};
 
-use self::active::ActiveSet;
-use self::constraint::{constraints, regular};
+use self::constraint::regular;
 pub use self::cost::WalkCost;
-use self::walk::{offset, on_boundary, Walk};
+use self::walk::{on_boundary, Walk};
+use self::workspace::Workspace;
 use super::{
     outside_fast, redistributed::redistribute, working_mask, Allocation, AllocationRequest,
     Allocator,
@@ -80,6 +81,7 @@ pub struct ExactBoundaryRedistribution<T: Real, const N: usize> {
     previous: Option<[Vector3<T>; N]>,
     max_rounds: Option<u32>,
     last: WalkCost,
+    workspace: Workspace<T, N>,
 }
 
 impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
@@ -88,6 +90,7 @@ impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
             previous: None,
             max_rounds: None,
             last: WalkCost::default(),
+            workspace: Workspace::default(),
         }
     }
 }
@@ -237,16 +240,22 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
                 forces = kept;
             }
         }
-        let bounds = per_set(sets, |s| constraints(s));
+        self.workspace.prepare(sets);
+        let Workspace {
+            bounds,
+            offsets,
+            active,
+            ..
+        } = &mut self.workspace;
         let mut walk = Walk {
             effectiveness: e,
             sets,
-            offsets: bounds.each_ref().map(offset),
+            offsets,
             bounds,
             gram: e.gram(),
             working,
             forces,
-            active: [ActiveSet::default(); N],
+            active,
             cost: WalkCost::default(),
         };
         // A kept start that already meets the request stays as it is (a repeated request keeps
@@ -291,7 +300,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         for ((((f, set), b), w), s) in forces
             .iter_mut()
             .zip(sets)
-            .zip(&walk.bounds)
+            .zip(walk.bounds.iter())
             .zip(&working)
             .zip(saturated.iter_mut())
         {

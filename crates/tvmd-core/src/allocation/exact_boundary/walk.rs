@@ -17,14 +17,15 @@ use crate::real::{eps, fmax, sqrt, Real};
 pub(super) struct Walk<'a, T: Real, const N: usize> {
     pub(super) effectiveness: &'a Effectiveness<T, N>,
     pub(super) sets: &'a [AdmissibleSet<T>; N],
-    pub(super) bounds: [[Constraint<T>; CONSTRAINTS]; N],
-    /// Each agent's largest constraint offset `|k|` ([`offset`]), for the line search's rays.
-    pub(super) offsets: [T; N],
+    /// Each agent's constraints and their largest offset `|k|` ([`offset`], for the line
+    /// search's rays), in the allocator's workspace.
+    pub(super) bounds: &'a [[Constraint<T>; CONSTRAINTS]; N],
+    pub(super) offsets: &'a [T; N],
     /// `sum_i M_i M_i^T` over the working agents, before any is held.
     pub(super) gram: Matrix6<T>,
     pub(super) working: [bool; N],
     pub(super) forces: [Vector3<T>; N],
-    pub(super) active: [ActiveSet<T>; N],
+    pub(super) active: &'a mut [ActiveSet<T>; N],
     /// The work done so far (solves, releases, line searches; the rounds are the caller's).
     pub(super) cost: WalkCost,
 }
@@ -45,7 +46,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .iter()
             .zip(self.active.iter_mut())
             .zip(&self.forces)
-            .zip(self.working.iter().zip(&self.bounds))
+            .zip(self.working.iter().zip(self.bounds.iter()))
         {
             if let (Some(block), true) = (block, *w) {
                 a.update(b, f);
@@ -79,7 +80,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         if release && self.release_one(&delta) {
             return self.direction(r, false);
         }
-        for ((d, a), w) in delta.iter_mut().zip(&self.active).zip(&self.working) {
+        for ((d, a), w) in delta.iter_mut().zip(self.active.iter()).zip(&self.working) {
             if *w {
                 *d = a.project(d);
             }
@@ -97,9 +98,9 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
         let mut worst: Option<(usize, usize, T)> = None;
         for (i, (((free, a), f), (w, b))) in free
             .iter()
-            .zip(&self.active)
+            .zip(self.active.iter())
             .zip(&self.forces)
-            .zip(self.working.iter().zip(&self.bounds))
+            .zip(self.working.iter().zip(self.bounds.iter()))
             .enumerate()
         {
             if !*w || !a.any_releasable() {
@@ -141,8 +142,8 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .forces
             .iter()
             .zip(delta)
-            .zip(self.bounds.iter().zip(&self.offsets))
-            .zip(&self.active)
+            .zip(self.bounds.iter().zip(self.offsets.iter()))
+            .zip(self.active.iter())
             .zip(self.working.iter().zip(at_once.iter_mut()))
             .enumerate()
         {
@@ -186,8 +187,8 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .iter_mut()
             .zip(delta)
             .zip(self.sets.iter().zip(&self.working))
-            .zip(&self.active)
-            .zip(&self.bounds)
+            .zip(self.active.iter())
+            .zip(self.bounds.iter())
         {
             if *w {
                 *f += d * tau;

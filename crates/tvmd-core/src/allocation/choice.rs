@@ -1,0 +1,180 @@
+//! An allocator chosen by name and options and checked, but not made yet: small (the
+//! exact-boundary redistribution's workspace is kilobytes), so a caller with little stack can
+//! check a configuration first and make the allocator in place afterwards
+//! ([`crate::Controller::init_in`]).
+
+use super::names::{
+    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+};
+use super::WeightedPseudoInverse;
+use crate::error::{ConfigError, ConfigField};
+use crate::real::Real;
+
+/// Options of [`super::AnyAllocator::from_name`]; each applies to one allocator only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AllocatorOptions<T: Real, const N: usize> {
+    /// Per-agent weights `w_i` of [`WeightedPseudoInverse`] (default: all 1).
+    pub agent_weights: Option<[T; N]>,
+    /// Wrench weights `W` of `ClarabelAllocator` and `SequentialConvexAllocator` (default:
+    /// identity).
+    pub wrench_weights: Option<[T; 6]>,
+    /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`) and
+    /// `SequentialConvexAllocator` (default `0`).
+    pub regularization: Option<T>,
+    /// Round cap of [`super::ExactBoundaryRedistribution::with_max_rounds`] (default: none,
+    /// the walk's own `2 n + 4`): bounds the allocator's work per period, see
+    /// `docs/allocation-benchmark.md`.
+    pub max_rounds: Option<u32>,
+}
+
+impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
+    fn default() -> Self {
+        Self {
+            agent_weights: None,
+            wrench_weights: None,
+            regularization: None,
+            max_rounds: None,
+        }
+    }
+}
+
+/// A checked allocator choice: [`super::AnyAllocator::from_name`] is
+/// `AnyAllocator::from_choice(AllocatorChoice::new(name, options)?)`.
+///
+/// ```
+/// use tvmd_core::allocation::{AllocatorChoice, AllocatorOptions};
+/// let choice = AllocatorChoice::<f32, 16>::new(
+///     "exact-boundary-redistribution",
+///     &AllocatorOptions::default(),
+/// )?;
+/// assert!(core::mem::size_of_val(&choice) < 256);
+/// let allocator = tvmd_core::AnyAllocator::from_choice(choice);
+/// assert_eq!(allocator.name(), "exact-boundary-redistribution");
+/// # Ok::<(), tvmd_core::ConfigError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct AllocatorChoice<T: Real, const N: usize>(Choice<T, N>);
+
+/// The allocator a choice makes ([`super::AnyAllocator::from_choice`]).
+#[derive(Clone, Debug)]
+pub(super) enum Choice<T: Real, const N: usize> {
+    PseudoInverse,
+    Redistributed,
+    ExactBoundary {
+        max_rounds: Option<u32>,
+    },
+    Weighted(WeightedPseudoInverse<T, N>),
+    #[cfg(feature = "clarabel")]
+    Clarabel(super::ClarabelAllocator<T, N>),
+    #[cfg(feature = "clarabel")]
+    Sequential(super::SequentialConvexAllocator<T, N>),
+}
+
+impl<T: Real, const N: usize> AllocatorChoice<T, N> {
+    /// The allocator named `name` (one of [`super::AnyAllocator::NAMES`]) with `options`,
+    /// checked.
+    ///
+    /// Errors: as [`super::AnyAllocator::from_name`].
+    pub fn new(name: &str, options: &AllocatorOptions<T, N>) -> Result<Self, ConfigError> {
+        let refuse = |given: bool, field| {
+            if given {
+                Err(ConfigError::UnusedOption { field })
+            } else {
+                Ok(())
+            }
+        };
+        let no_clarabel_options = || {
+            refuse(
+                options.wrench_weights.is_some(),
+                ConfigField::ClarabelWeights,
+            )?;
+            refuse(
+                options.regularization.is_some(),
+                ConfigField::ClarabelLambda,
+            )
+        };
+        let choice = match name {
+            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE | EXACT_BOUNDARY_REDISTRIBUTION => {
+                refuse(
+                    options.agent_weights.is_some(),
+                    ConfigField::AllocatorWeights,
+                )?;
+                no_clarabel_options()?;
+                refuse(
+                    options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
+                    ConfigField::AllocatorMaxRounds,
+                )?;
+                match name {
+                    PSEUDO_INVERSE => Choice::PseudoInverse,
+                    REDISTRIBUTED_PSEUDO_INVERSE => Choice::Redistributed,
+                    _ => Choice::ExactBoundary {
+                        max_rounds: options.max_rounds,
+                    },
+                }
+            }
+            WEIGHTED_PSEUDO_INVERSE => {
+                no_clarabel_options()?;
+                refuse(
+                    options.max_rounds.is_some(),
+                    ConfigField::AllocatorMaxRounds,
+                )?;
+                let weights = options.agent_weights.unwrap_or([T::one(); N]);
+                Choice::Weighted(WeightedPseudoInverse::new(weights)?)
+            }
+            CLARABEL | CLARABEL_SEQUENTIAL => {
+                refuse(
+                    options.agent_weights.is_some(),
+                    ConfigField::AllocatorWeights,
+                )?;
+                refuse(
+                    options.max_rounds.is_some(),
+                    ConfigField::AllocatorMaxRounds,
+                )?;
+                clarabel(name, options)?
+            }
+            _ => return Err(ConfigError::UnknownAllocator),
+        };
+        Ok(Self(choice))
+    }
+
+    pub(super) fn into_inner(self) -> Choice<T, N> {
+        self.0
+    }
+}
+
+#[cfg(feature = "clarabel")]
+fn clarabel<T: Real, const N: usize>(
+    name: &str,
+    options: &AllocatorOptions<T, N>,
+) -> Result<Choice<T, N>, ConfigError> {
+    if name == CLARABEL {
+        let lambda = options
+            .regularization
+            .unwrap_or_else(|| super::ClarabelAllocator::<T, N>::default().lambda());
+        Ok(Choice::Clarabel(super::ClarabelAllocator::new(
+            lambda,
+            options.wrench_weights,
+        )?))
+    } else {
+        let lambda = options.regularization.unwrap_or_else(T::zero);
+        Ok(Choice::Sequential(super::SequentialConvexAllocator::new(
+            lambda,
+            options.wrench_weights,
+        )?))
+    }
+}
+
+#[cfg(not(feature = "clarabel"))]
+fn clarabel<T: Real, const N: usize>(
+    name: &str,
+    _options: &AllocatorOptions<T, N>,
+) -> Result<Choice<T, N>, ConfigError> {
+    Err(ConfigError::AllocatorUnavailable {
+        name: if name == CLARABEL {
+            CLARABEL
+        } else {
+            CLARABEL_SEQUENTIAL
+        },
+    })
+}
