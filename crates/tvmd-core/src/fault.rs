@@ -127,6 +127,11 @@ impl FaultState {
         Self::default()
     }
 
+    /// The candidate held (through ambiguous periods too), if any.
+    pub fn candidate(&self) -> Option<usize> {
+        self.candidate.map(usize::from)
+    }
+
     /// Forgets the candidate.
     pub fn reset(&mut self) {
         *self = Self::default();
@@ -444,12 +449,15 @@ mod tests {
         let rep = s.update(&blind, &full, &blocks, &f, &none);
         assert_eq!(rep.verdict, FaultVerdict::Unexplained, "{rep:?}");
         assert!(rep.best_misfit <= rep.threshold && rep.runner_up_misfit <= rep.threshold);
+        // The ambiguous period holds the candidate (the controller's loss share reads it).
+        assert_eq!(s.candidate(), Some(0));
         assert_eq!(periods(s.update(&d, &full, &blocks, &f, &none)), Some(2));
         let quiet = Vector6::zeros();
         assert_eq!(
             s.update(&d, &quiet, &blocks, &f, &none).verdict,
             FaultVerdict::Nominal
         );
+        assert_eq!(s.candidate(), None);
         assert_eq!(periods(s.update(&d, &full, &blocks, &f, &none)), Some(1));
     }
 

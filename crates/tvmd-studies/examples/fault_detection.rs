@@ -98,6 +98,10 @@ struct FaultRun {
     agent: usize,
     fault: FaultSummary,
     t_f: f64,
+    /// The largest statistic over the first second after the fault, in units of `k`: what
+    /// the fault put in the residual within the second (below 1, no detector at this
+    /// threshold could see it).
+    first_second: f64,
 }
 
 impl FaultRun {
@@ -139,6 +143,14 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
             controller_informed: false,
         }];
         let r = run_scenario(&s, None, None).ok()?;
+        let first_second = r
+            .samples
+            .iter()
+            .filter(|x| x.t >= t_f && x.t <= t_f + 1.0)
+            .filter_map(|x| x.fault.as_ref())
+            .map(|f| f.statistic / f.threshold.max(1e-9))
+            .filter(|x| x.is_finite())
+            .fold(0.0, f64::max);
         Some(FaultRun {
             team,
             kind,
@@ -146,6 +158,7 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
             agent,
             fault: r.summary.fault.unwrap_or_default(),
             t_f,
+            first_second,
         })
     })
 }
@@ -160,8 +173,8 @@ fn quantiles(mut v: Vec<f64>) -> String {
 }
 
 fn fault_table(runs: &[FaultRun]) {
-    println!("| team | fault | phase | flights | suspected (right agent) | delay median / worst (s) | confirmed (right agent) | delay median / worst (s) | loss confirmed, masked | delay median / worst (s) | wrong agent |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| team | fault | phase | flights | suspected (right agent) | delay median / worst (s) | confirmed (right agent) | delay median / worst (s) | loss confirmed, masked | delay median / worst (s) | wrong agent | largest statistic / k in the first second: smallest / median / largest |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for team in TEAMS {
         for kind in [
             FailureKind::NoThrust,
@@ -188,8 +201,14 @@ fn fault_table(runs: &[FaultRun]) {
                 let (ns, ds) = column(&|r| r.fault.first_suspected);
                 let (nc, dc) = column(&|r| r.fault.first_confirmed);
                 let (nm, dm) = column(&|r| r.fault.masked);
+                let mut peaks: Vec<f64> = group.iter().map(|r| r.first_second).collect();
+                peaks.sort_by(f64::total_cmp);
+                let peak = match (peaks.first(), peaks.get(peaks.len() / 2), peaks.last()) {
+                    (Some(s), Some(m), Some(l)) => format!("{s:.2} / {m:.2} / {l:.2}"),
+                    _ => "-".into(),
+                };
                 println!(
-                    "| {team} | {} | {} | {} | {ns} | {ds} | {nc} | {dc} | {nm} | {dm} | {wrong} |",
+                    "| {team} | {} | {} | {} | {ns} | {ds} | {nc} | {dc} | {nm} | {dm} | {wrong} | {peak} |",
                     kind_name(kind),
                     phase.name(),
                     group.len()

@@ -64,6 +64,11 @@ pub(super) struct FaultMonitor<T: Real> {
     /// The candidate's lost share `c` from the unfiltered measurements (a running mean over
     /// its periods, [`crate::fault`]'s loss hypothesis).
     raw_share: T,
+    /// The periods in that mean: every period the candidate is held, the ambiguous ones too.
+    /// A mean over the periods that named it only (those whose residual leaned its way) read a
+    /// half-thrust agent hard to tell from its neighbours as a loss. A `u8` (the C handle has
+    /// no room for more): saturated, the mean becomes a running average over about 255 periods.
+    share_periods: u8,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
 }
@@ -98,6 +103,7 @@ impl<T: Real> FaultMonitor<T> {
             wrench: Vector6::zeros(),
             delivered: Vector6::zeros(),
             raw_share: T::zero(),
+            share_periods: 0,
             report: None,
             masked: None,
         }))
@@ -111,6 +117,7 @@ impl<T: Real> FaultMonitor<T> {
         self.wrench = Vector6::zeros();
         self.delivered = Vector6::zeros();
         self.raw_share = T::zero();
+        self.share_periods = 0;
         self.report = None;
     }
 
@@ -197,32 +204,43 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         // A loss's share from the unfiltered measurements since the candidate appeared: the
         // filtered residual reaches a step's full size only after the filter's ramp, the
         // unfiltered measurement at once (noisier: averaged over the candidate's periods).
-        let (agent, kind, periods) = match &mut report.verdict {
-            FaultVerdict::Suspected {
-                agent,
-                kind,
-                periods,
-            } => (*agent, Some(kind), *periods),
-            FaultVerdict::Confirmed { agent, kind } => (*agent, Some(kind), detector.persistence()),
-            _ => (0, None, 0),
-        };
-        if let (Some(kind), Some(raw), Some(Some(m)), Some(c)) = (
-            kind,
-            raw,
-            blocks.get(agent),
-            self.previous.get(agent).map(command_force),
-        ) {
-            if !matches!(kind, FaultKind::StuckGimbal) {
-                if let Some(share) = lost_share(&detector, &(raw - monitor.baseline), m, &c) {
-                    let n = T::from_u32(periods.max(1)).unwrap_or_else(T::one);
-                    monitor.raw_share = if periods <= 1 {
-                        share
-                    } else {
-                        monitor.raw_share + (share - monitor.raw_share) / n
-                    };
-                    *kind = loss_kind(monitor.raw_share);
-                }
+        // The candidacy goes on unless this period named the candidate for the first time;
+        // an ambiguous period that holds it adds to a mean already started.
+        let fresh = matches!(report.verdict, FaultVerdict::Suspected { periods: 1, .. });
+        let continuing = !fresh && monitor.share_periods > 0;
+        let kind = match &mut report.verdict {
+            FaultVerdict::Suspected { kind, .. } | FaultVerdict::Confirmed { kind, .. } => {
+                Some(kind)
             }
+            _ => None,
+        };
+        let candidate = monitor.state.candidate();
+        let stuck = matches!(kind, Some(FaultKind::StuckGimbal));
+        let share = match (candidate, raw) {
+            (Some(i), Some(raw)) if !stuck => blocks.get(i).and_then(|m| {
+                let c = self.previous.get(i).map(command_force)?;
+                lost_share(&detector, &(raw - monitor.baseline), m.as_ref()?, &c)
+            }),
+            _ => None,
+        };
+        let periods = match share {
+            Some(_) if continuing => monitor.share_periods.saturating_add(1),
+            Some(_) if kind.is_some() => 1,
+            _ => 0,
+        };
+        if let Some(share) = share.filter(|_| periods > 0) {
+            let n = T::from_u8(periods).unwrap_or_else(T::one);
+            monitor.raw_share = if periods <= 1 {
+                share
+            } else {
+                monitor.raw_share + (share - monitor.raw_share) / n
+            };
+        }
+        monitor.share_periods = periods;
+        if let Some(kind) = kind.filter(|_| periods > 0) {
+            // The mean is clamped, not each period's share: clamped shares of a loss (about 1,
+            // half of them above) average under 1 and read as a partial loss.
+            *kind = loss_kind(monitor.raw_share.max(T::zero()).min(T::one()));
         }
         monitor.report = Some(report);
         // The baseline follows the slow model error, not a fault: held above half the threshold.
@@ -308,9 +326,9 @@ fn command_force<T: Real>(c: &AgentCommand<T>) -> Vector3<T> {
     Vector3::new(cx * sy, -sx, cx * cy) * c.thrust
 }
 
-/// The share `c` in `[0, 1]` of agent `i`'s commanded wrench `M_i f` that `residual` lacks
-/// (`residual = -c M_i f`, weighted by the detector's stated noise): the loss hypothesis' one
-/// parameter. `None` for an agent with no command to lose.
+/// The share `c` of agent `i`'s commanded wrench `M_i f` that `residual` lacks (`residual = -c
+/// M_i f`, weighted by the detector's stated noise): the loss hypothesis' one parameter, not
+/// clamped to `[0, 1]` (a mean of shares is). `None` for an agent with no command to lose.
 fn lost_share<T: Real>(
     detector: &FaultDetector<T>,
     residual: &Vector6<T>,
@@ -321,5 +339,35 @@ fn lost_share<T: Real>(
     let lost = (m * f).component_mul(&w);
     let ll = lost.dot(&lost);
     let c = -residual.component_mul(&w).dot(&lost) / ll;
-    (ll > T::zero() && c.is_finite()).then(|| c.max(T::zero()).min(T::one()))
+    (ll > T::zero() && c.is_finite()).then_some(c)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+
+    #[test]
+    fn a_period_share_is_not_clamped_so_a_mean_of_a_loss_stays_at_one() {
+        let d = FaultDetector::<f64>::new(0.2, 0.02, 5.0, 5).unwrap();
+        let mut m = Matrix6x3::<f64>::zeros();
+        m.fixed_view_mut::<3, 3>(3, 0).fill_with_identity();
+        let f = Vector3::new(0.0, 0.0, 7.0);
+        let lost = -(m * f);
+        // A loss read with noise either way: 1.6 and 0.4 of the lost wrench.
+        let (hi, lo) = (
+            lost_share(&d, &(lost * 1.6), &m, &f).unwrap(),
+            lost_share(&d, &(lost * 0.4), &m, &f).unwrap(),
+        );
+        assert!((hi - 1.6).abs() < 1e-12 && (lo - 0.4).abs() < 1e-12);
+        // Their mean is a loss; the mean of the clamped shares (0.7) was a partial loss.
+        let mean: f64 = (hi + lo) / 2.0;
+        assert_eq!(loss_kind(mean.min(1.0)), FaultKind::Loss);
+        assert!(matches!(
+            loss_kind((hi.min(1.0) + lo) / 2.0),
+            FaultKind::PartialLoss { .. }
+        ));
+        // No command, no share.
+        assert!(lost_share(&d, &lost, &m, &Vector3::zeros()).is_none());
+    }
 }
