@@ -32,7 +32,8 @@ impl<T: Real, const N: usize> Default for Workspace<T, N> {
 }
 
 /// Scratch, not state: two allocators equal in everything else allocate alike whatever their
-/// workspaces hold (every allocation rebuilds what it reads), so workspaces compare equal.
+/// workspaces hold (an allocation rebuilds what it reads, or reuses constraints built from an
+/// equal set), so workspaces compare equal.
 impl<T: Real, const N: usize> PartialEq for Workspace<T, N> {
     fn eq(&self, _: &Self) -> bool {
         true
@@ -44,23 +45,31 @@ impl<T: Real, const N: usize> Workspace<T, N> {
     /// that changed, and copied from the previous agent when it has the same set: the agents
     /// usually share one, and the constraints cost trigonometry), nothing held.
     pub(super) fn prepare(&mut self, sets: &[AdmissibleSet<T>; N]) {
-        let mut previous: Option<(&AdmissibleSet<T>, [Constraint<T>; CONSTRAINTS])> = None;
-        for (((set, built), bounds), (offset_of, active)) in sets
-            .iter()
-            .zip(self.built_from.iter_mut())
-            .zip(self.bounds.iter_mut())
-            .zip(self.offsets.iter_mut().zip(self.active.iter_mut()))
-        {
-            *active = ActiveSet::default();
-            if built.as_ref() != Some(set) {
-                *bounds = match previous {
-                    Some((s, b)) if s == set => b,
-                    _ => constraints(set),
-                };
-                *offset_of = offset(bounds);
-                *built = Some(*set);
+        for i in 0..N {
+            if let Some(active) = self.active.get_mut(i) {
+                *active = ActiveSet::default();
             }
-            previous = Some((set, *bounds));
+            let (Some(set), Some(built)) = (sets.get(i), self.built_from.get(i)) else {
+                continue;
+            };
+            if built.as_ref() == Some(set) {
+                continue;
+            }
+            // The previous agent's constraints are already this period's.
+            let bounds = i
+                .checked_sub(1)
+                .filter(|&j| sets.get(j) == Some(set))
+                .and_then(|j| self.bounds.get(j).copied())
+                .unwrap_or_else(|| constraints(set));
+            if let (Some(b), Some(o), Some(f)) = (
+                self.bounds.get_mut(i),
+                self.offsets.get_mut(i),
+                self.built_from.get_mut(i),
+            ) {
+                *b = bounds;
+                *o = offset(&bounds);
+                *f = Some(*set);
+            }
         }
     }
 }
