@@ -120,6 +120,19 @@ impl<T: Real> AdmissibleSet<T> {
             && self.thrust.contains(cmd.thrust, tol * self.thrust.hi)
     }
 
+    /// How far a command lies outside the set in the units of [`Self::contains`]'s tolerance
+    /// (0 inside): the largest of the angle excesses (rad) and the thrust excess over the
+    /// largest thrust. For a finite command, `contains(cmd, tol)` exactly when
+    /// `excess(cmd) <= tol` (up to the round-off of the widened bounds). Unlike
+    /// [`Self::violation`] it stays meaningful on a range of zero width, where one ulp of an
+    /// angle is a round-off, not a violation of the whole range.
+    pub fn excess(&self, cmd: &GimbalCommand<T>) -> T {
+        fmax(
+            fmax(self.eta_x.excess(cmd.eta_x), self.eta_y.excess(cmd.eta_y)),
+            self.thrust.excess(cmd.thrust) / fmax(self.thrust.hi, T::default_epsilon()),
+        )
+    }
+
     /// Normalized distance outside the set (0 inside): the largest of the angle excesses over
     /// their range widths and the thrust excess over the thrust range.
     pub fn violation(&self, cmd: &GimbalCommand<T>) -> T {

@@ -55,7 +55,8 @@ pub fn command_tolerance<T: Real>() -> T {
 }
 
 /// Inverts an agent-frame force into a command inside `set`. Returns the command and the clamp
-/// it needed (normalized as [`AdmissibleSet::violation`]). Non-finite forces give the clamped
+/// it needed ([`AdmissibleSet::excess`]: rad for the angles, relative to the largest thrust for
+/// the thrust). Non-finite forces give the clamped
 /// idle command; a zero force, zero thrust with the gimbal clamped from centre into the set (no
 /// clamp counted for the angles, which a zero force does not have).
 pub fn invert<T: Real>(
@@ -69,12 +70,12 @@ pub fn invert<T: Real>(
     // taken inside the set (a rate window need not hold the centred gimbal) and only the thrust
     // counts as a clamp.
     let clamp = if raw.thrust == T::zero() {
-        set.violation(&GimbalCommand {
+        set.excess(&GimbalCommand {
             thrust: raw.thrust,
             ..g
         })
     } else {
-        set.violation(&raw)
+        set.excess(&raw)
     };
     (
         AgentCommand {

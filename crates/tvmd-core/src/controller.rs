@@ -59,7 +59,8 @@ pub struct ControlOutput<T: Real, const N: usize> {
     pub null_space: NullSpaceReport<T>,
     /// Per-agent commands inside `E_f` (idle for failed agents and unused slots).
     pub commands: [AgentCommand<T>; N],
-    /// Largest clamp the inversion applied (normalized; at most
+    /// Largest clamp the inversion applied ([`crate::admissible::AdmissibleSet::excess`]: rad,
+    /// or relative to the largest thrust; at most
     /// [`crate::command::command_tolerance`] when the allocator keeps its contract).
     pub command_clamp: T,
 }

@@ -49,7 +49,7 @@ record! {
         allocation => PyAllocation { inner: o.allocation.clone() },
         /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
         commands => commands_array(py, &o.out.commands, o.n)?,
-        /// Largest clamp of the command inversion (normalized).
+        /// Largest clamp of the command inversion (rad, or relative to the largest thrust).
         command_clamp => o.out.command_clamp,
         /// What the null-space stage changed.
         null_space => PyNullSpaceReport { inner: o.out.null_space },
@@ -127,7 +127,7 @@ record! {
         torque_error => o.stage.torque_error,
         /// (n, 4) commands, columns `eta_x, eta_y, thrust, omega`.
         commands => commands_array(py, &o.stage.commands, o.n)?,
-        /// Largest clamp of the command inversion (normalized).
+        /// Largest clamp of the command inversion (rad, or relative to the largest thrust).
         command_clamp => o.stage.command_clamp,
         /// What the null-space stage changed.
         null_space => PyNullSpaceReport { inner: o.stage.null_space },

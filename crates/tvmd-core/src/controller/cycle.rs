@@ -50,7 +50,8 @@ pub struct AllocationStage<T: Real, const N: usize> {
     pub torque_error: T,
     /// Per-agent commands inside `E_f` (idle for failed agents and unused slots).
     pub commands: [AgentCommand<T>; N],
-    /// Largest clamp the inversion applied (normalized).
+    /// Largest clamp the inversion applied ([`crate::admissible::AdmissibleSet::excess`]: rad,
+    /// or relative to the largest thrust).
     pub command_clamp: T,
 }
 

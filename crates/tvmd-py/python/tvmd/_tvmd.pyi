@@ -1215,7 +1215,7 @@ class AllocationStage:
 
     Attributes:
         allocation: Allocation (``e_f`` is the force error). torque_error: N m.
-        commands: (n, 4). command_clamp: normalized. null_space: NullSpaceReport.
+        commands: (n, 4). command_clamp: rad, or relative to the largest thrust. null_space: NullSpaceReport.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -1230,7 +1230,7 @@ class AllocationStage:
         """(n, 4) commands, columns ``eta_x, eta_y, thrust, omega``."""
     @property
     def command_clamp(self) -> float:
-        """Largest clamp of the command inversion (normalized)."""
+        """Largest clamp of the command inversion (rad, or relative to the largest thrust)."""
     @property
     def null_space(self) -> "NullSpaceReport":
         """What the null-space stage changed."""
@@ -1250,7 +1250,8 @@ class StepOutput:
         allocation: Allocation (``forces``, ``wrench`` = ``M f``, ``e_f``, ``wrench_error``, ``rounds``,
             ``saturated``, ``fallback``, ``method``, ``report``).
         commands: (n, 4) columns ``eta_x, eta_y, thrust, omega`` (idle for failed agents).
-        command_clamp: the largest clamp the command inversion applied (normalized).
+        command_clamp: the largest clamp the command inversion applied (rad, or
+            relative to the largest thrust).
         null_space: NullSpaceReport of the null-space stage (``ran`` False without one).
     """
 
@@ -1275,7 +1276,7 @@ class StepOutput:
         """(n, 4) commands, columns ``eta_x, eta_y, thrust, omega``."""
     @property
     def command_clamp(self) -> float:
-        """Largest clamp of the command inversion (normalized)."""
+        """Largest clamp of the command inversion (rad, or relative to the largest thrust)."""
     @property
     def null_space(self) -> "NullSpaceReport":
         """What the null-space stage changed."""
