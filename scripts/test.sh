@@ -9,6 +9,11 @@ step() { printf '\n==> %s\n' "$*"; }
 # tvmd-py is a Python extension: never link it against libpython in plain cargo builds.
 export PYO3_BUILD_EXTENSION_MODULE=1
 
+# Property tests draw from one seed here, so that a run of the test command is repeatable (a
+# failure reproduces by the same command). `cargo test` on its own draws fresh cases each run;
+# a case it finds goes into the test's `.proptest-regressions` file, which every run replays.
+export PROPTEST_RNG_SEED="${PROPTEST_RNG_SEED:-20261206}"
+
 step "self-contained: no tracked file refers to a directory beside the checkout"
 # Bracketed patterns, so that this file does not match itself.
 outside='\.\./shar[e]d|TVMD_SHAR[E]D'

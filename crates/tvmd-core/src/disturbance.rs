@@ -22,6 +22,7 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 use crate::anti_windup::{guarded, Saturation};
 use crate::error::{positive, ConfigError, ConfigField};
 use crate::law::{Plant, RigidState};
+use crate::linalg::wrench_parts;
 use crate::real::Real;
 
 /// Observer bandwidths `L_f`, `L_tau` (rad/s) and the bound on the torque estimate (N m).
@@ -219,8 +220,7 @@ impl<T: Real> ObserverState<T> {
     ) {
         let (momentum, angular_momentum) =
             self.momenta.take().unwrap_or_else(|| momenta(plant, state));
-        let u_tau = wrench.fixed_rows::<3>(0).into_owned();
-        let u_f = wrench.fixed_rows::<3>(3).into_owned();
+        let (u_tau, u_f) = wrench_parts(wrench);
         let weight = Vector3::new(T::zero(), T::zero(), plant.weight());
         let omega = state.angular_velocity;
         self.last = Some(Sample {

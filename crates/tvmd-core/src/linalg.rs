@@ -5,9 +5,23 @@
 #![allow(clippy::indexing_slicing, clippy::needless_range_loop)]
 
 use nalgebra::storage::Storage;
-use nalgebra::{Dim, Matrix, Matrix6, Matrix6x3, SVector, Vector6};
+use nalgebra::{Dim, Matrix, Matrix3, Matrix6, Matrix6x3, SVector, Vector3, Vector6};
 
 use crate::real::{eps, fmax, lit, sqrt, Real};
+
+/// The torque part `u_tau` (rows 0-2) and the force part `u_f` (rows 3-5) of a wrench
+/// `u = [u_tau; u_f]`, by destructuring the storage: a view's `into_owned` keeps a length
+/// assertion that survives a size-optimized (`opt-level = "z"`) link.
+pub(crate) fn wrench_parts<T: Real>(u: &Vector6<T>) -> (Vector3<T>, Vector3<T>) {
+    let [[t0, t1, t2, f0, f1, f2]] = u.data.0;
+    (Vector3::new(t0, t1, t2), Vector3::new(f0, f1, f2))
+}
+
+/// The columns of a 3x3 matrix (of a rotation: its body axes), without a length assertion
+/// (see [`wrench_parts`]).
+pub(crate) fn columns<T: Real>(m: &Matrix3<T>) -> [Vector3<T>; 3] {
+    m.data.0.map(Vector3::from)
+}
 
 /// `||v||` without overflow or underflow (hand-written: nalgebra's `norm()` squares the
 /// components, which overflows above `sqrt(MAX)` and underflows below `sqrt(MIN_POSITIVE)`).

@@ -6,7 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
 use crate::error::{ConfigError, ConfigField, InputError};
 use crate::linalg::EuclideanNorm;
-use crate::linalg::{norm, normalize};
+use crate::linalg::{columns, norm, normalize};
 use crate::real::{eps, lit, sqrt, Real};
 use crate::rotation::validate_rotation;
 
@@ -221,7 +221,7 @@ impl<T: Real> AttitudePlanner<T> {
         // bracketed by the membership test. Invariant: `lo` infeasible, `hi` feasible; `hi` is
         // returned.
         let (mut lo, mut hi, mut r_hi) = (T::zero(), tilt.theta_max, end);
-        let (mut z_lo, mut z_hi) = (tilt.b_zr, end.column(2).into_owned());
+        let (mut z_lo, mut z_hi) = (tilt.b_zr, columns(&end)[2]);
         let (mut phi_lo, mut phi_hi) = (phi_r, phi_end);
         // Which end moved last: a second move of the same end scales the other end's phi by
         // `1 - phi_new / phi_old` (Anderson-Bjorck; by 1/2, the Illinois factor, when that is
@@ -336,11 +336,7 @@ struct Tilt<T: Real> {
 
 impl<T: Real> Tilt<T> {
     fn new(r_r: &Matrix3<T>, f_r: &Vector3<T>) -> Self {
-        let (b_xr, b_yr, b_zr) = (
-            r_r.column(0).into_owned(),
-            r_r.column(1).into_owned(),
-            r_r.column(2).into_owned(),
-        );
+        let [b_xr, b_yr, b_zr] = columns(r_r);
         // The direction of f_r only: scaled so a huge or tiny f_r neither overflows nor underflows.
         let f_hat = normalize(f_r);
         let cross = b_zr.cross(&f_hat);

@@ -38,7 +38,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
-use crate::linalg::{max_abs, norm, solve_gram, weighted_gram, GramSolver};
+use crate::linalg::{max_abs, norm, solve_gram, weighted_gram, wrench_parts, GramSolver};
 use crate::real::Real;
 
 /// What an allocator is asked to do.
@@ -87,7 +87,7 @@ impl<T: Real, const N: usize> Allocation<T, N> {
         Self {
             forces,
             wrench,
-            e_f: norm(&error.fixed_rows::<3>(3).into_owned()),
+            e_f: norm(&wrench_parts(&error).1),
             wrench_error: norm(&error),
             rounds,
             saturated,

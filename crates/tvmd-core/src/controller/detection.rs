@@ -23,6 +23,7 @@ use crate::fault_detection::{
 };
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
+use crate::linalg::wrench_parts;
 use crate::offset_free::OffsetFree;
 use crate::real::{lit, sin_cos, Real};
 use crate::team::TeamConfig;
@@ -269,8 +270,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let mut mask = self.failures;
         let hover = mask.set(agent, true).and_then(|()| self.set_failures(mask));
         if hover.is_ok() {
-            let force = state.attitude * baseline.fixed_rows::<3>(3);
-            let torque = baseline.fixed_rows::<3>(0).into_owned();
+            let (torque, force) = wrench_parts(&baseline);
+            let force = state.attitude * force;
             self.offset_free.reseed(force, torque);
         }
         if let Some(monitor) = self.fault.as_mut() {
