@@ -6,7 +6,7 @@
 use nalgebra::Vector3;
 
 use crate::linalg::clamp_norm;
-use crate::real::Real;
+use crate::real::{sqrt, Real};
 
 /// Which parts of the requested wrench the team could not deliver in one period.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -37,7 +37,7 @@ impl Saturation {
         wrench_error: T,
         wrench_norm: T,
     ) -> Self {
-        let tolerance = T::default_epsilon().sqrt() * wrench_norm.max(T::one());
+        let tolerance = sqrt(T::default_epsilon()) * wrench_norm.max(T::one());
         // A NaN error counts as short.
         let short = wrench_error > tolerance || !wrench_error.is_finite();
         Self {

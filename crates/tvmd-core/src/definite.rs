@@ -7,7 +7,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 
 /// `true` if `j` is finite, symmetric (to `64 eps` of its largest entry) and positive
 /// semi-definite: every principal minor `>= -64 eps` after scaling (Sylvester's criterion on
@@ -33,7 +33,7 @@ pub(crate) fn is_symmetric_pd<T: Real>(j: &Matrix3<T>) -> bool {
     if !d.iter().all(|x| *x > T::zero()) {
         return false;
     }
-    let inv_sqrt = d.map(|x| T::one() / x.sqrt());
+    let inv_sqrt = d.map(|x| T::one() / sqrt(x));
     if !inv_sqrt.iter().all(|x| x.is_finite()) {
         return false;
     }

@@ -37,6 +37,7 @@ use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use crate::error::{positive, ConfigError, ConfigField};
 use crate::failure::FailureMask;
+use crate::linalg::EuclideanNorm;
 use crate::real::{lit, Real};
 
 mod verdict;
@@ -166,7 +167,7 @@ impl FaultState {
     ) -> FaultReport<T> {
         let w = detector.weights();
         let r = residual.component_mul(&w);
-        let statistic = r.norm();
+        let statistic = r.euclidean_norm();
         let mut report = FaultReport {
             verdict: FaultVerdict::Nominal,
             statistic,
@@ -281,7 +282,7 @@ fn fit<T: Real>(
         return None;
     }
     let c = (-r.dot(&lost) / ll).max(T::zero()).min(T::one());
-    let loss = (r + lost * c).norm();
+    let loss = (r + lost * c).euclidean_norm();
     let loss_kind = loss_kind(c);
     // Two directions across `f`: `f x e_k` (`e_k` the axis along its smallest component) and
     // `f x (f x e_k)`.
@@ -300,7 +301,7 @@ fn fit<T: Real>(
     let det = g11 * g22 - g12 * g12;
     let stuck = if det > T::zero() && det.is_finite() {
         let (x1, x2) = ((g22 * y1 - g12 * y2) / det, (g11 * y2 - g12 * y1) / det);
-        (r - b1 * x1 - b2 * x2).norm()
+        (r - b1 * x1 - b2 * x2).euclidean_norm()
     } else {
         none()
     };
@@ -374,7 +375,7 @@ mod tests {
         }
         // Agent 1's force tilted by 0.1 rad about its y axis, the same thrust (the stuck
         // hypothesis is the small-angle one: the force change across the command).
-        let t = f[1].norm();
+        let t = f[1].euclidean_norm();
         let stuck = Vector3::new(t * 0.1f64.sin(), 0.0, t * 0.1f64.cos());
         let r = blocks[1].unwrap() * (stuck - f[1]);
         let rep = FaultState::new().update(&d, &r, &blocks, &f, &FailureMask::none());

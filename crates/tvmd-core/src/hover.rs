@@ -25,7 +25,7 @@ use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::linalg::EuclideanNorm;
 use crate::linalg::GramSolver;
-use crate::real::{eps, lit, Real};
+use crate::real::{eps, lit, sqrt, Real};
 
 /// Reweighting rounds of the certifying allocation (Lawson's iteration for the minimax slack).
 pub const HOVER_ITERATIONS: usize = 24;
@@ -33,7 +33,7 @@ pub const HOVER_ITERATIONS: usize = 24;
 /// Margins at or below this are "not hover-capable": `sqrt(eps)` (`1.5e-8` in f64, `3.5e-4` in
 /// f32), above the rounding of an allocation that touches a bound exactly.
 pub fn hover_margin_tolerance<T: Real>() -> T {
-    eps::<T>().sqrt()
+    sqrt(eps::<T>())
 }
 
 /// Which bound of an agent's admissible set limits the margin.

@@ -367,18 +367,21 @@ impl<T: Real> Tilt<T> {
     /// `b_zd(theta) = rot(b_zr, k, theta)`.
     fn direction(&self, theta: T) -> Vector3<T> {
         let (s, c) = crate::real::sin_cos(theta);
-        (self.b_zr * c + self.k_cross_bz * s).normalize()
+        // `v / ||v||` as nalgebra's `normalize`, the same bits, with the FPU's square root.
+        let v = self.b_zr * c + self.k_cross_bz * s;
+        v / v.euclidean_norm()
     }
 
     /// `R_d = [b_xd b_yd b_zd]` completed from `b_zd` as in [`Self::attitude`].
     fn frame(&self, b_zd: Vector3<T>) -> Matrix3<T> {
         let y = b_zd.cross(&self.b_xr);
         let y_norm = y.euclidean_norm();
-        let (b_xd, b_yd) = if y_norm > eps::<T>().sqrt() {
+        let (b_xd, b_yd) = if y_norm > sqrt(eps::<T>()) {
             let b_yd = y * (T::one() / y_norm);
             (b_yd.cross(&b_zd), b_yd)
         } else {
-            let b_xd = self.b_yr.cross(&b_zd).normalize();
+            let x = self.b_yr.cross(&b_zd);
+            let b_xd = x / x.euclidean_norm();
             (b_xd, b_zd.cross(&b_xd))
         };
         Matrix3::from_columns(&[b_xd, b_yd, b_zd])

@@ -39,7 +39,7 @@ use crate::admissible::AdmissibleSet;
 use crate::effectiveness::Effectiveness;
 use crate::gimbal::GimbalCommand;
 use crate::linalg::{max_abs, norm, solve_gram, weighted_gram, wrench_parts, GramSolver};
-use crate::real::Real;
+use crate::real::{sqrt, Real};
 
 /// What an allocator is asked to do.
 #[derive(Clone, Copy, Debug)]
@@ -156,7 +156,7 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
 /// that large saturates every agent it loads anyway. The allocation's errors are still taken
 /// against the full request.
 fn bounded_rhs<T: Real>(rhs: &Vector6<T>) -> Vector6<T> {
-    let cap = T::max_value().unwrap_or_else(T::one).sqrt();
+    let cap = sqrt(T::max_value().unwrap_or_else(T::one));
     let m = max_abs(rhs);
     if m > cap && m.is_finite() {
         rhs * (cap / m)

@@ -24,6 +24,7 @@ use crate::fault_detection::{
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
 use crate::linalg::wrench_parts;
+use crate::linalg::EuclideanNorm;
 use crate::offset_free::OffsetFree;
 use crate::real::{lit, sin_cos, Real};
 use crate::team::TeamConfig;
@@ -70,6 +71,12 @@ pub(super) struct FaultMonitor<T: Real> {
     /// half-thrust agent hard to tell from its neighbours as a loss. A `u8` (the C handle has
     /// no room for more): saturated, the mean becomes a running average over about 255 periods.
     share_periods: u8,
+    /// The share of a gap the actuators' lag closes in a period, `1 - e^(-dt/tau)`, and the
+    /// share of it they leave undelivered on average over the period,
+    /// `tau / dt (1 - e^(-dt/tau))` ([`FAULT_ACTUATOR_LAG`]); the period is fixed for the
+    /// monitor's life (a reconfiguration builds a new one), so they are computed once.
+    closed: T,
+    undelivered: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
 }
@@ -94,7 +101,9 @@ impl<T: Real> FaultMonitor<T> {
         let arm = team
             .agents()
             .iter()
-            .fold(T::zero(), |a, s| a.max(s.position.norm()));
+            .fold(T::zero(), |a, s| a.max(s.position.euclidean_norm()));
+        let period = settings.period;
+        let closed = T::one() - (-(period / lit(FAULT_ACTUATOR_LAG))).exp();
         Ok(Some(Self {
             response: detection.response(),
             detector: detection.detector(weight, arm)?,
@@ -105,6 +114,8 @@ impl<T: Real> FaultMonitor<T> {
             delivered: Vector6::zeros(),
             raw_share: T::zero(),
             share_periods: 0,
+            closed,
+            undelivered: lit::<T>(FAULT_ACTUATOR_LAG) / period * closed,
             report: None,
             masked: None,
         }))
@@ -167,8 +178,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         // the gap to the commanded wrench they did not deliver on average over the period
         // (`tau / dt (1 - e^(-dt/tau))`), added back to the measurement, and the gap they close.
         let gap = monitor.wrench - monitor.delivered;
-        let closed = T::one() - (-(period / lit(FAULT_ACTUATOR_LAG))).exp();
-        let undelivered = lit::<T>(FAULT_ACTUATOR_LAG) / period * closed;
+        let (closed, undelivered) = (monitor.closed, monitor.undelivered);
         let lag = gap * undelivered;
         let raw = match (measurement, gains) {
             (Some((d_f, d_tau)), Some(gains)) => {
@@ -183,8 +193,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let d = &monitor.detector;
         let share = lit::<T>(FAULT_JUMP_SHARE);
         let (j_tau, j_f) = (
-            gap.fixed_rows::<3>(0).norm() * share,
-            gap.fixed_rows::<3>(3).norm() * share,
+            gap.fixed_rows::<3>(0).euclidean_norm() * share,
+            gap.fixed_rows::<3>(3).euclidean_norm() * share,
         );
         let detector = FaultDetector::new(
             d.force_noise() + j_f,

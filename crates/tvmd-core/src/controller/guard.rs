@@ -8,7 +8,7 @@ use crate::allocation::Allocation;
 use crate::command::AgentCommand;
 use crate::error::InputError;
 use crate::law::{Gains, Reference, RigidState};
-use crate::real::{count, lit, to_f64, Real};
+use crate::real::{count, lit, sqrt, to_f64, Real};
 use crate::team::TeamConfig;
 
 /// [`InputError::OutOfRange`] for the first vector input with a component beyond `limit`
@@ -68,7 +68,7 @@ pub(super) fn input_limit<T: Real, const N: usize>(
     .iter()
     .fold(T::one(), |m, x| m.max(*x));
     let max = T::max_value().unwrap_or_else(T::one);
-    (max / linear).min((max / quadratic).sqrt()) / lit(64.0)
+    (max / linear).min(sqrt(max / quadratic)) / lit(64.0)
 }
 
 /// The first output field with a non-finite number (the cycle's safety net). Cheap: each part
