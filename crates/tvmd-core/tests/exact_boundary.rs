@@ -335,6 +335,47 @@ fn f32_agrees_with_f64_on_attainable_requests() {
     assert!(exact >= 170, "{exact}/200");
 }
 
+/// A rate window of zero width (the previous command beyond the gimbal limit, so the window is
+/// the limit itself): one ulp of the inverse's round-off is a clamp of one ulp, in the units of
+/// `contains`, not half the window (CI's case of `f32_forces_invert_without_clamping`).
+#[test]
+fn a_zero_width_window_clamps_round_off_only() {
+    let team = team_by_index::<f32>(1);
+    let e = team.effectiveness(&FailureMask::none());
+    let mut sets = [AdmissibleSet::from_limits(team.limits()); CAP];
+    let previous = GimbalCommand {
+        thrust: 2.0,
+        eta_x: 0.0,
+        eta_y: 0.997_158_35 * 0.8,
+    };
+    narrow(&mut sets, &previous, 0.001);
+    let eta_y = sets[0].eta_y();
+    assert_eq!(eta_y.lo, eta_y.hi, "the window is a point");
+    let wrench = Vector6::new(0.353_033_07, 0.0, 0.0, 0.0, 0.0, -0.917_253_85);
+    let a = ExactBoundaryRedistribution::new().allocate(&AllocationRequest {
+        effectiveness: &e,
+        sets: &sets,
+        wrench,
+    });
+    let tol = tvmd_core::command::command_tolerance::<f32>();
+    for (f, set) in a.forces.iter().zip(&sets).take(team.len()) {
+        let (_, clamp) = tvmd_core::command::invert(f, set, team.limits());
+        let raw = GimbalCommand::from_force(f);
+        assert!(clamp <= tol, "clamp {clamp} of {f:?}");
+        assert_eq!(set.contains(&raw, tol), set.excess(&raw) <= tol);
+    }
+    // One ulp past the point: an excess of that ulp, where the width-relative violation reads
+    // half the (floored) width.
+    let past = GimbalCommand {
+        thrust: 1.0,
+        eta_x: 0.0,
+        eta_y: f32::from_bits(eta_y.hi.to_bits() + 1),
+    };
+    let ulp = past.eta_y - eta_y.hi;
+    assert_eq!(sets[0].excess(&past), ulp);
+    assert!(sets[0].violation(&past) > 0.4);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
