@@ -28,7 +28,8 @@
 //!   passes) does not. A period that does not tell the candidate from its runner-up, while the
 //!   candidate is still the best explanation within the noise, holds the count.
 //!
-//! Proven: with exact `M_i f_i` and no noise, a loss of agent `i` gives misfit 0 for `i` and,
+//! Proven: with exact `M_i f_i` and no noise, a loss of agent `i` gives misfit 0 for `i` (up to
+//! the closed form's round-off, about `sqrt(eps) ||r||`: `fault/fit.rs`) and,
 //! when `w_i` is neither along another agent's `w_j` nor in the span of its block across `f_j`,
 //! a positive misfit for every other agent (linear algebra of the fits); the statistic is scale-free in the stated noise. Measured,
 //! not proven: detection delays and false alarms in flight (the simulator's tables).
