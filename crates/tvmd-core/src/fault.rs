@@ -43,7 +43,7 @@ use crate::real::{lit, Real};
 
 mod fit;
 mod verdict;
-use fit::{fit, none, WeightedResidual};
+use fit::{fit, none, Fit, WeightedResidual};
 pub use verdict::{FaultKind, FaultReport, FaultVerdict};
 
 /// A fault detector's settings: the residual's stated noise, the threshold in units of it, and
@@ -137,7 +137,9 @@ impl FaultState {
 
     /// One period: `residual` (`[r_tau; r_f]`, body frame), the agents' blocks `M_i` and their
     /// forces `f_i` of the period the residual measures, the failure mask in force (masked
-    /// agents are not candidates). A non-finite input gives `Nominal` with a NaN statistic and
+    /// agents are not candidates). The blocks are [`crate::Effectiveness::blocks`]': each
+    /// `[[p_i]x R_i; R_i]` with `R_i` a rotation, which the fits' closed form relies on
+    /// (another matrix gives meaningless misfits). A non-finite input gives `Nominal` with a NaN statistic and
     /// forgets the candidate (never a confirmation from garbage).
     pub fn update<T: Real, const N: usize>(
         &mut self,
@@ -177,7 +179,7 @@ impl FaultState {
             return report;
         }
         let weighted = WeightedResidual::new(&r, &w);
-        let mut best: Option<(usize, fit::Fit<T>)> = None;
+        let mut best: Option<(usize, Fit<T>)> = None;
         for (i, block) in blocks.iter().enumerate() {
             let (Some(m), false) = (block, failures.is_failed(i)) else {
                 continue;

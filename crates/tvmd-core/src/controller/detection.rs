@@ -23,8 +23,7 @@ use crate::fault_detection::{
 };
 use crate::hover::HoverCapability;
 use crate::law::RigidState;
-use crate::linalg::wrench_parts;
-use crate::linalg::EuclideanNorm;
+use crate::linalg::{wrench_parts, EuclideanNorm};
 use crate::offset_free::OffsetFree;
 use crate::real::{lit, sin_cos, Real};
 use crate::team::TeamConfig;
