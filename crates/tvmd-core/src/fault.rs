@@ -38,8 +38,7 @@ use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use crate::error::{positive, ConfigError, ConfigField};
 use crate::failure::FailureMask;
-use crate::linalg::EuclideanNorm;
-use crate::real::{lit, Real};
+use crate::real::{lit, sqrt, Real};
 
 mod fit;
 mod verdict;
@@ -166,7 +165,8 @@ impl FaultState {
     ) -> FaultReport<T> {
         let w = detector.weights();
         let r = residual.component_mul(&w);
-        let statistic = r.euclidean_norm();
+        let rr = r.norm_squared();
+        let statistic = sqrt(rr);
         let mut report = FaultReport {
             verdict: FaultVerdict::Nominal,
             statistic,
@@ -178,7 +178,7 @@ impl FaultState {
             self.reset();
             return report;
         }
-        let weighted = WeightedResidual::new(&r, &w);
+        let weighted = WeightedResidual::new(&r, rr, &w);
         let mut best: Option<(usize, Fit<T>)> = None;
         for (i, block) in blocks.iter().enumerate() {
             let (Some(m), false) = (block, failures.is_failed(i)) else {
@@ -315,7 +315,7 @@ mod tests {
         }
         // Agent 1's force tilted by 0.1 rad about its y axis, the same thrust (the stuck
         // hypothesis is the small-angle one: the force change across the command).
-        let t = f[1].euclidean_norm();
+        let t = f[1].norm();
         let stuck = Vector3::new(t * 0.1f64.sin(), 0.0, t * 0.1f64.cos());
         let r = blocks[1].unwrap() * (stuck - f[1]);
         let rep = FaultState::new().update(&d, &r, &blocks, &f, &FailureMask::none());

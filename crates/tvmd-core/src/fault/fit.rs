@@ -40,12 +40,13 @@ pub(super) struct WeightedResidual<T: Real> {
 }
 
 impl<T: Real> WeightedResidual<T> {
-    /// From the weighted residual `r = W residual` and the weights `w` (torque first).
-    pub(super) fn new(r: &Vector6<T>, w: &Vector6<T>) -> Self {
+    /// From the weighted residual `r = W residual`, its `r.r` and the weights `w` (torque
+    /// first).
+    pub(super) fn new(r: &Vector6<T>, rr: T, w: &Vector6<T>) -> Self {
         let [[tau, _, _, force, _, _]] = w.data.0;
         let (tau2, force2) = (tau * tau, force * force);
         Self {
-            rr: r.dot(r),
+            rr,
             wr: r.component_mul(w),
             tau2,
             force2,
@@ -179,7 +180,7 @@ mod tests {
                 noise * 10.0
             };
             let (loss, stuck) = direct(&r, &w, &m, &f);
-            let got = fit(&WeightedResidual::new(&r, &w), &m, &f).unwrap();
+            let got = fit(&WeightedResidual::new(&r, r.norm_squared(), &w), &m, &f).unwrap();
             let scale = r.euclidean_norm().max(1.0);
             let (expected, kind_stuck) = if stuck < loss {
                 (stuck, true)
@@ -202,7 +203,7 @@ mod tests {
         let m = agent_block(&Vector3::new(0.5, 0.0, 0.0), 1);
         let w = Vector6::repeat(2.0);
         let r = Vector6::repeat(1.0);
-        let res = WeightedResidual::new(&r, &w);
+        let res = WeightedResidual::new(&r, r.norm_squared(), &w);
         assert!(fit(&res, &m, &Vector3::zeros()).is_none());
         assert!(fit(&res, &m, &Vector3::new(f64::NAN, 0.0, 1.0)).is_none());
         assert!(fit(&res, &m, &Vector3::new(0.0, 0.0, 1.0)).is_some());
