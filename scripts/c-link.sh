@@ -10,6 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 source scripts/lib/require.sh
+source scripts/lib/qemu.sh
 require arm-none-eabi-gcc gcc-arm-none-eabi
 arm-none-eabi-gcc --version | head -n 1
 
@@ -28,8 +29,4 @@ arm-none-eabi-gcc "${flags[@]}" -Iinclude -T embedded/c-link/link.ld \
   -Wl,--gc-sections -Wl,-z,noexecstack embedded/c-link/main.c "$lib" -lgcc -o "$elf"
 python3 scripts/elf_size.py "$elf"
 
-for machine in mps2-an386 mps2-an500; do
-  echo "==> $machine: the C program hovers with tvmd"
-  timeout 60 qemu-system-arm -machine "$machine" -nographic -monitor none \
-    -semihosting-config enable=on,target=native -kernel "$elf"
-done
+run_on_boards "the C program hovers with tvmd" "$elf" "the C program failed"

@@ -9,6 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 source scripts/lib/require.sh
+source scripts/lib/qemu.sh
 require qemu-system-arm qemu-system-arm
 qemu-system-arm --version | head -n 1
 
@@ -18,40 +19,15 @@ target_dir=${CARGO_TARGET_DIR:-embedded/target-tests/target}
 elf="$target_dir/thumbv7em-none-eabihf/release/tvmd-target-tests"
 
 status=0
-for machine in mps2-an386 mps2-an500; do
-  echo "==> $machine"
-  # The firmware runs in well under a second (faults and panics exit with failure); the timeout
-  # only catches a hang.
-  rc=0
-  timeout 120 qemu-system-arm -machine "$machine" -nographic -monitor none \
-    -semihosting-config enable=on,target=native -kernel "$elf" || rc=$?
-  if [ "$rc" -eq 124 ]; then
-    echo "error: $machine timed out (the firmware hung)" >&2
-    status=1
-  elif [ "$rc" -ne 0 ]; then
-    echo "error: $machine: target tests failed (exit status $rc)" >&2
-    status=1
-  fi
-done
+run_on_boards "target tests" "$elf" "target tests failed" || status=1
 
 # On-target cost (BENCHMARKS.md): instructions per f32 control cycle, counted with
 # `-icount shift=0` (one instruction = 1 ns of virtual time, read through the SysTick and
 # calibrated on nop loops by the firmware), and the cycle's peak stack (painted).
 cost_elf="$target_dir/thumbv7em-none-eabihf/release/cost"
-for machine in mps2-an386 mps2-an500; do
-  echo "==> $machine: on-target cost (-icount shift=0)"
-  rc=0
-  timeout 120 qemu-system-arm -machine "$machine" -nographic -monitor none -icount shift=0 \
-    -semihosting-config enable=on,target=native -kernel "$cost_elf" || rc=$?
-  if [ "$rc" -ne 0 ]; then
-    echo "error: $machine: the cost measurement failed (exit status $rc)" >&2
-    status=1
-  fi
-done
+run_on_boards "on-target cost (-icount shift=0)" "$cost_elf" "the cost measurement failed" \
+  -icount shift=0 || status=1
 
-# Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
-# tvmd-pil firmware, built above with the target tests) on both boards, compared with the
-# in-process f32 flight (crates/tvmd-sim/tests/pil/main.rs, #[ignore]d in plain cargo test).
 ffi_stack_elf="$target_dir/thumbv7em-none-eabihf/release/ffi_stack"
 # Painted stack of every C entry point at the 16-agent capacity (built above), then at the
 # 4-agent one (feature capacity-4: within issue 45's 4 KB in flight); each run fails past its
@@ -61,18 +37,13 @@ for capacity in 16 4; do
     cargo build --release --locked --manifest-path embedded/target-tests/Cargo.toml \
       --target thumbv7em-none-eabihf --bin ffi_stack --features capacity-4
   fi
-  for machine in mps2-an386 mps2-an500; do
-    echo "==> $machine: painted stack of every C entry point (tvmd-ffi, capacity $capacity)"
-    rc=0
-    timeout 120 qemu-system-arm -machine "$machine" -nographic -monitor none \
-      -semihosting-config enable=on,target=native -kernel "$ffi_stack_elf" || rc=$?
-    if [ "$rc" -ne 0 ]; then
-      echo "error: $machine: a C entry point's stack grew past its bound (capacity $capacity, exit status $rc)" >&2
-      status=1
-    fi
-  done
+  run_on_boards "painted stack of every C entry point (tvmd-ffi, capacity $capacity)" \
+    "$ffi_stack_elf" "a C entry point's stack grew past its bound (capacity $capacity)" || status=1
 done
 
+# Processor in the loop: paper-tilt flown by tvmd-sim with the f32 controller in QEMU (the
+# tvmd-pil firmware, built above with the target tests) on both boards, compared with the
+# in-process f32 flight (crates/tvmd-sim/tests/pil/main.rs, #[ignore]d in plain cargo test).
 echo "==> processor in the loop (tvmd-sim --pil cortex-m4, cortex-m7)"
 pil_elf=$(realpath "$target_dir/thumbv7em-none-eabihf/release/tvmd-pil")
 TVMD_PIL_FIRMWARE="$pil_elf" cargo test --locked -p tvmd-sim --test pil -- --ignored --nocapture || {
