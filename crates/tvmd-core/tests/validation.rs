@@ -311,6 +311,67 @@ fn errors_name_their_field() {
     assert_message(e, "gains.k_r");
 }
 
+/// Each allocator option is refused by every allocator but its own, as `UnusedOption` naming it;
+/// an unknown name is unknown whatever the options.
+#[test]
+fn every_option_is_refused_by_the_allocators_it_is_not_for() {
+    type Any = AnyAllocator<f64, 4>;
+    let with = |field| {
+        let mut o = AllocatorOptions::<f64, 4>::default();
+        match field {
+            ConfigField::AllocatorWeights => o.agent_weights = Some([1.0; 4]),
+            ConfigField::ClarabelWeights => o.wrench_weights = Some([1.0; 6]),
+            ConfigField::ClarabelLambda => o.regularization = Some(1e-6),
+            _ => o.max_rounds = Some(3),
+        }
+        o
+    };
+    let owners: [(ConfigField, &[&str]); 4] = [
+        (ConfigField::AllocatorWeights, &["weighted-pseudo-inverse"]),
+        (
+            ConfigField::ClarabelWeights,
+            &["clarabel", "clarabel-sequential"],
+        ),
+        (
+            ConfigField::ClarabelLambda,
+            &["clarabel", "clarabel-sequential"],
+        ),
+        (
+            ConfigField::AllocatorMaxRounds,
+            &["exact-boundary-redistribution"],
+        ),
+    ];
+    let names = [
+        "pseudo-inverse",
+        "redistributed-pseudo-inverse",
+        "exact-boundary-redistribution",
+        "weighted-pseudo-inverse",
+        "clarabel",
+        "clarabel-sequential",
+    ];
+    for (field, own) in owners {
+        let options = with(field);
+        for name in names {
+            let result = Any::from_name(name, &options);
+            if own.contains(&name) {
+                if cfg!(feature = "clarabel") || !name.starts_with("clarabel") {
+                    assert!(result.is_ok(), "{name} with its own {field:?}: {result:?}");
+                }
+            } else {
+                assert_eq!(
+                    result.unwrap_err(),
+                    ConfigError::UnusedOption { field },
+                    "{name} with {field:?}"
+                );
+            }
+        }
+        assert_eq!(
+            Any::from_name("magic", &options).unwrap_err(),
+            ConfigError::UnknownAllocator
+        );
+    }
+}
+
 #[test]
 fn allocators_by_name() {
     type Any = AnyAllocator<f64, 4>;

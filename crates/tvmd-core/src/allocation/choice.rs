@@ -85,7 +85,24 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
                 Ok(())
             }
         };
-        let no_clarabel_options = || {
+        let solver = matches!(name, CLARABEL | CLARABEL_SEQUENTIAL);
+        if !solver
+            && !matches!(
+                name,
+                PSEUDO_INVERSE
+                    | REDISTRIBUTED_PSEUDO_INVERSE
+                    | EXACT_BOUNDARY_REDISTRIBUTION
+                    | WEIGHTED_PSEUDO_INVERSE
+            )
+        {
+            return Err(ConfigError::UnknownAllocator);
+        }
+        // Each option is refused by every allocator but its own, checked in one order.
+        refuse(
+            options.agent_weights.is_some() && name != WEIGHTED_PSEUDO_INVERSE,
+            ConfigField::AllocatorWeights,
+        )?;
+        if !solver {
             refuse(
                 options.wrench_weights.is_some(),
                 ConfigField::ClarabelWeights,
@@ -93,48 +110,23 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
             refuse(
                 options.regularization.is_some(),
                 ConfigField::ClarabelLambda,
-            )
-        };
+            )?;
+        }
+        refuse(
+            options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
+            ConfigField::AllocatorMaxRounds,
+        )?;
         let choice = match name {
-            PSEUDO_INVERSE | REDISTRIBUTED_PSEUDO_INVERSE | EXACT_BOUNDARY_REDISTRIBUTION => {
-                refuse(
-                    options.agent_weights.is_some(),
-                    ConfigField::AllocatorWeights,
-                )?;
-                no_clarabel_options()?;
-                refuse(
-                    options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
-                    ConfigField::AllocatorMaxRounds,
-                )?;
-                match name {
-                    PSEUDO_INVERSE => Choice::PseudoInverse,
-                    REDISTRIBUTED_PSEUDO_INVERSE => Choice::Redistributed,
-                    _ => Choice::ExactBoundary {
-                        max_rounds: options.max_rounds,
-                    },
-                }
-            }
+            PSEUDO_INVERSE => Choice::PseudoInverse,
+            REDISTRIBUTED_PSEUDO_INVERSE => Choice::Redistributed,
+            EXACT_BOUNDARY_REDISTRIBUTION => Choice::ExactBoundary {
+                max_rounds: options.max_rounds,
+            },
             WEIGHTED_PSEUDO_INVERSE => {
-                no_clarabel_options()?;
-                refuse(
-                    options.max_rounds.is_some(),
-                    ConfigField::AllocatorMaxRounds,
-                )?;
                 let weights = options.agent_weights.unwrap_or([T::one(); N]);
                 Choice::Weighted(WeightedPseudoInverse::new(weights)?)
             }
-            CLARABEL | CLARABEL_SEQUENTIAL => {
-                refuse(
-                    options.agent_weights.is_some(),
-                    ConfigField::AllocatorWeights,
-                )?;
-                refuse(
-                    options.max_rounds.is_some(),
-                    ConfigField::AllocatorMaxRounds,
-                )?;
-                clarabel(name, options)?
-            }
-            _ => return Err(ConfigError::UnknownAllocator),
+            _ => clarabel(name, options)?,
         };
         Ok(Self(choice))
     }
