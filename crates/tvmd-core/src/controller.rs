@@ -102,7 +102,7 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     /// The planned-rate filter (`None` when `settings.attitude_rate` is).
     attitude_rate: Option<AttitudeRateState<T>>,
     /// The fault detector (`None` when `settings.fault_detection` is).
-    fault: Option<detection::FaultMonitor<T>>,
+    fault: Option<detection::FaultMonitor<T, N>>,
     /// What the offset-free state records once the law stage's wrench is allocated.
     pending: Option<(RigidState<T>, cycle::PendingRecord<T>)>,
     plant: Plant<T>,

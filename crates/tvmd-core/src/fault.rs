@@ -42,7 +42,7 @@ use crate::real::{lit, sqrt, Real};
 
 mod fit;
 mod verdict;
-use fit::{fit, none, Fit, WeightedResidual};
+use fit::{fit, none, share, unsquare, Fit, WeightedResidual};
 pub use verdict::{FaultKind, FaultReport, FaultVerdict};
 
 /// A fault detector's settings: the residual's stated noise, the threshold in units of it, and
@@ -180,6 +180,8 @@ impl FaultState {
         }
         let weighted = WeightedResidual::new(&r, rr, &w);
         let mut best: Option<(usize, Fit<T>)> = None;
+        // The runner-up's squared misfit.
+        let mut runner_up: T = none();
         for (i, block) in blocks.iter().enumerate() {
             let (Some(m), false) = (block, failures.is_failed(i)) else {
                 continue;
@@ -188,32 +190,36 @@ impl FaultState {
                 continue;
             };
             match &best {
-                Some((_, b)) if fit.misfit >= b.misfit => {
-                    report.runner_up_misfit = report.runner_up_misfit.min(fit.misfit);
+                Some((_, b)) if fit.misfit2 >= b.misfit2 => {
+                    // Finite squares: a comparison, not `min` (a `libm` call on a Cortex-M4F).
+                    if fit.misfit2 < runner_up {
+                        runner_up = fit.misfit2;
+                    }
                 }
                 _ => {
                     if let Some((_, b)) = &best {
-                        report.runner_up_misfit = b.misfit;
+                        runner_up = b.misfit2;
                     }
-                    report.best_misfit = fit.misfit;
                     best = Some((i, fit));
                 }
             }
         }
+        report.runner_up_misfit = unsquare(runner_up);
+        if let Some((_, b)) = &best {
+            report.best_misfit = unsquare(b.misfit2);
+        }
         // The runner-up is rejected against the best by the likelihood ratio of the two
         // hypotheses (`runner_up^2 - best^2`) at half the detection's `k^2`.
-        let k = detector.threshold;
-        let runner_up = report.runner_up_misfit;
-        let explained = best.as_ref().filter(|(_, b)| {
-            let ratio = runner_up * runner_up - b.misfit * b.misfit;
-            b.misfit <= k && ratio > k * k * lit(0.5)
-        });
+        let k2 = detector.threshold * detector.threshold;
+        let explained = best
+            .as_ref()
+            .filter(|(_, b)| b.misfit2 <= k2 && runner_up - b.misfit2 > k2 * lit(0.5));
         let Some((agent, b)) = explained else {
             // A period that does not tell the candidate from its runner-up, while the candidate
             // is still the best explanation, holds the count; anything else forgets it.
             let still_best = best
                 .as_ref()
-                .is_some_and(|(i, b)| b.misfit <= k && self.candidate == u16::try_from(*i).ok());
+                .is_some_and(|(i, b)| b.misfit2 <= k2 && self.candidate == u16::try_from(*i).ok());
             if !still_best {
                 self.reset();
             }
@@ -239,6 +245,26 @@ impl FaultState {
         };
         report
     }
+}
+
+/// The share `c` of agent `i`'s commanded wrench `M_i f` that `residual` lacks (`residual = -c
+/// M_i f` in least squares, weighted by the detector's stated noise): the loss hypothesis' one
+/// parameter, not clamped to `[0, 1]` (a mean of shares is). `None` for an agent with no
+/// command to lose. `m` is a block of [`crate::Effectiveness::blocks`] (the structure
+/// [`FaultState::update_with`] relies on).
+pub(crate) fn lost_share<T: Real>(
+    detector: &FaultDetector<T>,
+    residual: &Vector6<T>,
+    m: &Matrix6x3<T>,
+    f: &Vector3<T>,
+) -> Option<T> {
+    let w = detector.weights();
+    // `r.r` is for the misfits, not read by the share.
+    share(
+        &WeightedResidual::new(&residual.component_mul(&w), T::zero(), &w),
+        m,
+        f,
+    )
 }
 
 /// The kind of a loss of share `c` of the command: a loss when the efficiency `1 - c` is at

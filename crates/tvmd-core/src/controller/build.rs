@@ -35,7 +35,7 @@ struct Parts<T: Real, const N: usize> {
     offset_free: OffsetFreeState<T>,
     attitude_rate: Option<AttitudeRateState<T>>,
     admissible: AdmissibleSet<T>,
-    fault: Option<FaultMonitor<T>>,
+    fault: Option<FaultMonitor<T, N>>,
 }
 
 impl<T: Real, const N: usize> Parts<T, N> {
@@ -168,6 +168,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.classify_hover();
         self.offset_free.carry_over(&offset_free);
         self.previous = self.held_from(&previous);
+        self.note_held_commands();
         Ok(())
     }
 

@@ -152,7 +152,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(field) = checked {
             return Err(self.reject(InputError::Overflow { field }));
         }
-        self.note_wrench(&stage.allocation.wrench);
+        self.note_allocation(&stage.allocation);
         self.previous = stage.commands;
         if let Some((state, pending)) = self.pending.take() {
             self.finish_offset_free(&state, pending, &stage.allocation);
@@ -221,7 +221,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if let Some(error) = error {
             return Err(self.reject(error));
         }
-        self.note_wrench(&output.allocation.wrench);
+        self.note_allocation(&output.allocation);
         self.previous = output.commands;
         if let Some(pending) = pending {
             self.finish_offset_free(state, pending, &output.allocation);

@@ -11,13 +11,15 @@
 //! The settings ([`crate::FaultDetection`]) and how their noise is resolved for the team are in
 //! [`crate::fault_detection`].
 
-use nalgebra::{Matrix6x3, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
-use crate::allocation::Allocator;
+use crate::allocation::{Allocation, Allocator};
 use crate::command::AgentCommand;
 use crate::error::{ConfigError, ConfigField};
-use crate::fault::{loss_kind, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
+use crate::fault::{
+    loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
+};
 use crate::fault_detection::{
     FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
 };
@@ -48,7 +50,7 @@ struct Masked {
 
 /// The detector's state inside a controller.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct FaultMonitor<T: Real> {
+pub(super) struct FaultMonitor<T: Real, const N: usize> {
     response: FaultResponse,
     detector: FaultDetector<T>,
     state: FaultState,
@@ -59,6 +61,11 @@ pub(super) struct FaultMonitor<T: Real> {
     baseline: Vector6<T>,
     /// The wrench `M f` allocated for the coming period.
     wrench: Vector6<T>,
+    /// The agent-frame forces `f_i` of the held commands, which the next residual measures:
+    /// the allocation's when its commands are sent (their inversion moves them by round-off
+    /// only), else the commands' own ([`command_force`]). Kept so that isolating a fault needs
+    /// no trigonometry per agent and period.
+    forces: [Vector3<T>; N],
     /// The wrench the actuators delivered at the end of the last period, modelled as a
     /// first-order lag ([`FAULT_ACTUATOR_LAG`]) of the allocated one.
     delivered: Vector6<T>,
@@ -80,11 +87,11 @@ pub(super) struct FaultMonitor<T: Real> {
     masked: Option<Masked>,
 }
 
-impl<T: Real> FaultMonitor<T> {
+impl<T: Real, const N: usize> FaultMonitor<T, N> {
     /// The monitor of `settings` for `team` (`None` when detection is off). Errors when
     /// detection is on without the disturbance observer ([`ConfigField::FaultResidual`]) or
     /// the team's noise cannot be resolved.
-    pub(super) fn new<const N: usize>(
+    pub(super) fn new(
         settings: &ControllerSettings<T>,
         team: &TeamConfig<T, N>,
         weight: T,
@@ -110,6 +117,7 @@ impl<T: Real> FaultMonitor<T> {
             residual: Vector6::zeros(),
             baseline: Vector6::zeros(),
             wrench: Vector6::zeros(),
+            forces: [Vector3::zeros(); N],
             delivered: Vector6::zeros(),
             raw_share: T::zero(),
             share_periods: 0,
@@ -126,6 +134,7 @@ impl<T: Real> FaultMonitor<T> {
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
         self.wrench = Vector6::zeros();
+        self.forces = [Vector3::zeros(); N];
         self.delivered = Vector6::zeros();
         self.raw_share = T::zero();
         self.share_periods = 0;
@@ -202,10 +211,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             d.persistence(),
         )
         .unwrap_or(*d);
-        // The forces of the commands held over the period the residual measures, computed
-        // only when the statistic crosses the threshold (f32 trigonometry in f32).
-        let previous = &self.previous;
-        let force_of = |i: usize| previous.get(i).map_or_else(Vector3::zeros, command_force);
+        // The forces of the commands held over the period the residual measures.
+        let forces = &monitor.forces;
+        let force_of = |i: usize| forces.get(i).copied().unwrap_or_else(Vector3::zeros);
         let blocks = self.effectiveness.blocks();
         let mut report =
             monitor
@@ -228,8 +236,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let stuck = matches!(kind, Some(FaultKind::StuckGimbal));
         let share = match (candidate, raw) {
             (Some(i), Some(raw)) if !stuck => blocks.get(i).and_then(|m| {
-                let c = self.previous.get(i).map(command_force)?;
-                lost_share(&detector, &(raw - monitor.baseline), m.as_ref()?, &c)
+                let c = monitor.forces.get(i)?;
+                lost_share(&detector, &(raw - monitor.baseline), m.as_ref()?, c)
             }),
             _ => None,
         };
@@ -296,10 +304,11 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         }
     }
 
-    /// The wrench `M f` allocated for the coming period, for the next period's detection
-    /// (nothing without detection).
-    pub(super) fn note_wrench(&mut self, wrench: &Vector6<T>) {
+    /// The allocation whose commands are sent for the coming period (its wrench `M f` and
+    /// forces), for the next period's detection (nothing without detection).
+    pub(super) fn note_allocation(&mut self, allocation: &Allocation<T, N>) {
         if let Some(monitor) = self.fault.as_mut() {
+            let wrench = &allocation.wrench;
             // A non-finite wrench (refused before it is sent) is not recorded.
             if wrench.iter().all(|x| x.is_finite()) {
                 if monitor.wrench == Vector6::zeros() {
@@ -307,6 +316,17 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
                     monitor.delivered = *wrench;
                 }
                 monitor.wrench = *wrench;
+                monitor.forces = allocation.forces;
+            }
+        }
+    }
+
+    /// The held commands changed without an allocation (seeded, or kept across a
+    /// reconfiguration): the detector reads their forces from now on.
+    pub(super) fn note_held_commands(&mut self) {
+        if let Some(monitor) = self.fault.as_mut() {
+            for (f, c) in monitor.forces.iter_mut().zip(&self.previous) {
+                *f = command_force(c);
             }
         }
     }
@@ -336,26 +356,52 @@ fn command_force<T: Real>(c: &AgentCommand<T>) -> Vector3<T> {
     Vector3::new(cx * sy, -sx, cx * cy) * c.thrust
 }
 
-/// The share `c` of agent `i`'s commanded wrench `M_i f` that `residual` lacks (`residual = -c
-/// M_i f`, weighted by the detector's stated noise): the loss hypothesis' one parameter, not
-/// clamped to `[0, 1]` (a mean of shares is). `None` for an agent with no command to lose.
-fn lost_share<T: Real>(
-    detector: &FaultDetector<T>,
-    residual: &Vector6<T>,
-    m: &Matrix6x3<T>,
-    f: &Vector3<T>,
-) -> Option<T> {
-    let w = detector.weights();
-    let lost = (m * f).component_mul(&w);
-    let ll = lost.dot(&lost);
-    let c = -residual.component_mul(&w).dot(&lost) / ll;
-    (ll > T::zero() && c.is_finite()).then_some(c)
-}
-
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
+    use nalgebra::Matrix6x3;
+
+    #[test]
+    fn the_detector_reads_the_forces_of_the_held_commands() {
+        use crate::team::presets;
+        use crate::{FaultDetection, RedistributedPseudoInverse, Reference};
+        type C = Controller<f64, 4, RedistributedPseudoInverse>;
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let settings = ControllerSettings {
+            fault_detection: Some(FaultDetection::recommended(FaultResponse::Report)),
+            ..ControllerSettings::offset_free_law()
+        };
+        let mut c = C::new(team, settings, RedistributedPseudoInverse).unwrap();
+        let forces = |c: &C| c.fault.as_ref().unwrap().forces;
+        let of_commands = |c: &C| c.previous.map(|cmd| command_force(&cmd));
+        let close = |a: [Vector3<f64>; 4], b: [Vector3<f64>; 4]| {
+            a.iter()
+                .zip(&b)
+                .all(|(a, b)| (a - b).norm() <= 1e-6 * b.norm().max(1.0))
+        };
+        assert_eq!(forces(&c), [Vector3::zeros(); 4]);
+        let at = Vector3::new(0.0, 0.0, 1.5);
+        let mut reference = Reference::hover(at);
+        reference.attitude = crate::rotation::roll(0.3);
+        let out = c.step(&RigidState::at_rest(at), &reference).unwrap();
+        // The allocation's forces, which the sent commands carry up to the inversion's
+        // round-off.
+        assert_eq!(forces(&c), out.allocation.forces);
+        assert!(forces(&c).iter().any(|f| f.norm() > 1.0));
+        assert!(close(forces(&c), of_commands(&c)));
+        // A reset forgets them with the commands; seeded commands bring their own.
+        c.reset();
+        assert_eq!(forces(&c), [Vector3::zeros(); 4]);
+        c.seed_commands(&out.commands).unwrap();
+        assert_eq!(forces(&c), of_commands(&c));
+        assert!(close(forces(&c), out.allocation.forces));
+        // A reconfiguration keeps the held commands, and the detector their forces.
+        c.reconfigure(&team, &settings, || RedistributedPseudoInverse)
+            .unwrap();
+        assert_eq!(c.previous, out.commands);
+        assert_eq!(forces(&c), of_commands(&c));
+    }
 
     #[test]
     fn a_period_share_is_not_clamped_so_a_mean_of_a_loss_stays_at_one() {

@@ -64,6 +64,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             }
         }
         self.previous = *commands;
+        self.note_held_commands();
         self.allocator.reset();
         Ok(())
     }

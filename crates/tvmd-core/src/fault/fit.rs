@@ -57,13 +57,68 @@ impl<T: Real> WeightedResidual<T> {
 
 /// One agent's fit of the residual.
 pub(super) struct Fit<T: Real> {
-    pub(super) misfit: T,
+    /// The squared misfit (agents are ranked by it; only the best two are rooted).
+    pub(super) misfit2: T,
     pub(super) kind: FaultKind<T>,
 }
 
 /// A misfit no agent reached: the largest finite value of `T`.
 pub(super) fn none<T: Real>() -> T {
     T::max_value().unwrap_or_else(T::one)
+}
+
+/// The weighted residual read against one agent's block and force: `q = A^T r`, the axial
+/// vector `p'`, `f^T P f` and `f.q`.
+struct Projection<T: Real> {
+    q: Vector3<T>,
+    p: Vector3<T>,
+    /// `f^T P f = ||A f||^2`, positive and finite.
+    ll: T,
+    /// `f.q = (A f).r`.
+    rl: T,
+}
+
+impl<T: Real> Projection<T> {
+    /// `None` for an agent with no command to lose (zero or non-finite force).
+    #[inline(always)]
+    fn new(res: &WeightedResidual<T>, m: &Matrix6x3<T>, f: &Vector3<T>) -> Option<Self> {
+        // The block's columns, rows `[torque; force]`.
+        let [[a0, a1, a2, a3, a4, a5], [b0, b1, b2, b3, b4, b5], [d0, d1, d2, d3, d4, d5]] =
+            m.data.0;
+        let [[z0, z1, z2, z3, z4, z5]] = res.wr.data.0;
+        let q = Vector3::new(
+            a0 * z0 + a1 * z1 + a2 * z2 + a3 * z3 + a4 * z4 + a5 * z5,
+            b0 * z0 + b1 * z1 + b2 * z2 + b3 * z3 + b4 * z4 + b5 * z5,
+            d0 * z0 + d1 * z1 + d2 * z2 + d3 * z3 + d4 * z4 + d5 * z5,
+        );
+        // `[p']x = M_f^T M_tau`: its entries (2,1), (0,2), (1,0).
+        let p = Vector3::new(
+            d3 * b0 + d4 * b1 + d5 * b2,
+            a3 * d0 + a4 * d1 + a5 * d2,
+            b3 * a0 + b4 * a1 + b5 * a2,
+        );
+        // `f^T P f = w_tau^2 |p' x f|^2 + w_f^2 |f|^2` (a sum, no cancellation).
+        let ll = res.tau2 * p.cross(f).norm_squared() + res.force2 * f.dot(f);
+        (ll > T::zero() && ll.is_finite()).then(|| Self {
+            rl: q.dot(f),
+            q,
+            p,
+            ll,
+        })
+    }
+}
+
+/// The share `c` of agent `i`'s commanded wrench that the residual lacks, `r = -c A f` in
+/// least squares: the loss hypothesis' parameter, not clamped to `[0, 1]` (a mean of shares
+/// is). `None` for an agent with no command to lose.
+pub(super) fn share<T: Real>(
+    res: &WeightedResidual<T>,
+    m: &Matrix6x3<T>,
+    f: &Vector3<T>,
+) -> Option<T> {
+    let x = Projection::new(res, m, f)?;
+    let c = -x.rl / x.ll;
+    c.is_finite().then_some(c)
 }
 
 /// Agent `i`'s explanation of the weighted residual (`m`: its block `M_i`, `f`: its commanded
@@ -82,50 +137,39 @@ pub(super) fn fit<T: Real>(
     m: &Matrix6x3<T>,
     f: &Vector3<T>,
 ) -> Option<Fit<T>> {
-    // The block's columns, rows `[torque; force]`.
-    let [[a0, a1, a2, a3, a4, a5], [b0, b1, b2, b3, b4, b5], [d0, d1, d2, d3, d4, d5]] = m.data.0;
-    let [[z0, z1, z2, z3, z4, z5]] = res.wr.data.0;
-    let q = Vector3::new(
-        a0 * z0 + a1 * z1 + a2 * z2 + a3 * z3 + a4 * z4 + a5 * z5,
-        b0 * z0 + b1 * z1 + b2 * z2 + b3 * z3 + b4 * z4 + b5 * z5,
-        d0 * z0 + d1 * z1 + d2 * z2 + d3 * z3 + d4 * z4 + d5 * z5,
-    );
-    // `[p']x = M_f^T M_tau`: its entries (2,1), (0,2), (1,0).
-    let p = Vector3::new(
-        d3 * b0 + d4 * b1 + d5 * b2,
-        a3 * d0 + a4 * d1 + a5 * d2,
-        b3 * a0 + b4 * a1 + b5 * a2,
-    );
+    let Projection { q, p, ll, rl } = Projection::new(res, m, f)?;
     let scale = res.tau2 * p.dot(&p) + res.force2;
-    // `f^T P f = w_tau^2 |p' x f|^2 + w_f^2 |f|^2` (a sum, no cancellation).
-    let (ff, pf) = (f.dot(f), p.dot(f));
-    let ll = res.tau2 * p.cross(f).norm_squared() + res.force2 * ff;
-    if !(ll > T::zero() && ll.is_finite()) {
-        return None;
-    }
-    let (rl, pq) = (q.dot(f), p.dot(&q));
+    let (ff, pf, pq) = (f.dot(f), p.dot(f), p.dot(&q));
     let c = fmin(fmax(-rl / ll, T::zero()), T::one());
-    let loss = root(res.rr + c * (rl + rl + c * ll));
+    let loss = fmax(res.rr + c * (rl + rl + c * ll), T::zero());
     // `x^T P^-1 y = (x.y + (w_tau^2 / w_f^2) (p'.x) (p'.y)) / scale`.
     let inverse = |xy: T, px: T, py: T| (xy + res.ratio * px * py) / scale;
     let ff_inv = inverse(ff, pf, pf);
     let stuck = if ff_inv > T::zero() && ff_inv.is_finite() {
         let fq_inv = inverse(rl, pf, pq);
-        root(res.rr - inverse(q.dot(&q), pq, pq) + fq_inv * fq_inv / ff_inv)
+        fmax(
+            res.rr - inverse(q.dot(&q), pq, pq) + fq_inv * fq_inv / ff_inv,
+            T::zero(),
+        )
     } else {
         none()
     };
-    let (misfit, kind) = if stuck < loss {
+    // A squared misfit from differences may round just below zero: floored.
+    let (misfit2, kind) = if stuck < loss {
         (stuck, FaultKind::StuckGimbal)
     } else {
         (loss, super::loss_kind(c))
     };
-    misfit.is_finite().then_some(Fit { misfit, kind })
+    misfit2.is_finite().then_some(Fit { misfit2, kind })
 }
 
-/// `sqrt(max(x, 0))`: a squared misfit from differences may round just below zero.
-fn root<T: Real>(x: T) -> T {
-    sqrt(fmax(x, T::zero()))
+/// A misfit from its square, [`none`] kept as is.
+pub(super) fn unsquare<T: Real>(misfit2: T) -> T {
+    if misfit2 < none() {
+        sqrt(misfit2)
+    } else {
+        none()
+    }
 }
 
 #[cfg(test)]
@@ -180,17 +224,22 @@ mod tests {
                 noise * 10.0
             };
             let (loss, stuck) = direct(&r, &w, &m, &f);
-            let got = fit(&WeightedResidual::new(&r, r.norm_squared(), &w), &m, &f).unwrap();
+            let res = WeightedResidual::new(&r, r.norm_squared(), &w);
+            let got = fit(&res, &m, &f).unwrap();
+            // The share is the loss's least-squares coefficient, unclamped.
+            let lost = (m * f).component_mul(&w);
+            let c = -r.dot(&lost) / lost.dot(&lost);
+            assert!((share(&res, &m, &f).unwrap() - c).abs() <= 1e-9 * c.abs().max(1.0));
             let scale = r.euclidean_norm().max(1.0);
             let (expected, kind_stuck) = if stuck < loss {
                 (stuck, true)
             } else {
                 (loss, false)
             };
+            let misfit = unsquare(got.misfit2);
             assert!(
-                (got.misfit - expected).abs() <= 1e-9 * scale,
-                "misfit {} against {expected} (loss {loss}, stuck {stuck})",
-                got.misfit
+                (misfit - expected).abs() <= 1e-9 * scale,
+                "misfit {misfit} against {expected} (loss {loss}, stuck {stuck})"
             );
             if (stuck - loss).abs() > 1e-6 * scale {
                 assert_eq!(matches!(got.kind, FaultKind::StuckGimbal), kind_stuck);
@@ -199,7 +248,7 @@ mod tests {
     }
 
     #[test]
-    fn no_command_no_fit() {
+    fn no_command_no_fit_and_no_share() {
         let m = agent_block(&Vector3::new(0.5, 0.0, 0.0), 1);
         let w = Vector6::repeat(2.0);
         let r = Vector6::repeat(1.0);
@@ -207,5 +256,7 @@ mod tests {
         assert!(fit(&res, &m, &Vector3::zeros()).is_none());
         assert!(fit(&res, &m, &Vector3::new(f64::NAN, 0.0, 1.0)).is_none());
         assert!(fit(&res, &m, &Vector3::new(0.0, 0.0, 1.0)).is_some());
+        assert!(share(&res, &m, &Vector3::zeros()).is_none());
+        assert!(share(&res, &m, &Vector3::new(f64::NAN, 0.0, 1.0)).is_none());
     }
 }
