@@ -116,6 +116,7 @@ impl Scenario {
                     time: 5.0,
                     kind: FailureKind::NoThrust,
                     controller_informed: true,
+                    informed_after: 0.0,
                 }];
                 with(
                     s,
@@ -135,6 +136,7 @@ impl Scenario {
                     time: 5.0,
                     kind: FailureKind::NoThrust,
                     controller_informed: true,
+                    informed_after: 0.0,
                 }];
                 with(
                     s,

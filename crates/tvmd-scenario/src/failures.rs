@@ -16,6 +16,11 @@ pub struct Failure {
     /// Whether the controller is told (through the `failed` flags); default true.
     #[serde(default = "default_true")]
     pub controller_informed: bool,
+    /// How long after the failure an informed controller is told (s, at least 0; default 0):
+    /// the latency of whatever reports it (an agent's own telemetry over the team's network,
+    /// a detector). Until then the controller flies the failed agent as working.
+    #[serde(default)]
+    pub informed_after: f64,
 }
 
 fn default_true() -> bool {

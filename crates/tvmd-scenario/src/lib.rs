@@ -50,8 +50,9 @@
 //! [[failures]]
 //! agent = 0
 //! time = 5.0
-//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal"
+//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal", "half-thrust"
 //! controller_informed = true
+//! informed_after = 0.0        # s; told this long after the failure (telemetry or detector latency)
 //!
 //! [failure_response]
 //! on_hover_loss = "land"     # default "continue"; "land": fall level to the ground when the

@@ -226,6 +226,10 @@ impl Scenario {
                 ));
             }
             check_nonneg(&format!("failures[{i}].time"), &[f.time])?;
+            check_nonneg(
+                &format!("failures[{i}].informed_after"),
+                &[f.informed_after],
+            )?;
         }
         check_magnitude("disturbances.wind", &self.disturbances.wind, MAX_EXTERNAL)?;
         if let Some(w) = &self.disturbances.external_wrench {
@@ -317,5 +321,17 @@ mod tests {
             Scenario::from_toml_str("[[failures]]\nagent = 7\ntime = 1.0\nkind = \"no-thrust\"\n")
                 .unwrap_err();
         assert!(e.to_string().contains("failures[0].agent"), "{e}");
+        for bad in ["-0.01", "nan", "inf"] {
+            let e = Scenario::from_toml_str(&format!(
+                "[[failures]]\nagent = 0\ntime = 1.0\nkind = \"no-thrust\"\ninformed_after = {bad}\n"
+            ))
+            .unwrap_err();
+            assert!(e.to_string().contains("failures[0].informed_after"), "{e}");
+        }
+        let s = Scenario::from_toml_str(
+            "[[failures]]\nagent = 0\ntime = 1.0\nkind = \"no-thrust\"\ninformed_after = 0.05\n",
+        )
+        .unwrap();
+        assert_eq!(s.failures[0].informed_after, 0.05);
     }
 }

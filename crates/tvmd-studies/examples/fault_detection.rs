@@ -141,6 +141,7 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
             time: t_f,
             kind,
             controller_informed: false,
+            informed_after: 0.0,
         }];
         let r = run_scenario(&s, None, None).ok()?;
         let first_second = r
@@ -324,6 +325,47 @@ fn outcomes() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// The flight targets against the delay of an informed controller: the offset-free law told
+/// `informed_after` seconds after the failure (no detection), as if a detector or the agent's
+/// telemetry named it that late.
+fn informed_late() -> Result<(), Box<dyn std::error::Error>> {
+    const DELAYS: [f64; 10] = [0.0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.07, 0.1, 0.15, 0.2];
+    print!("| flight |");
+    for d in DELAYS {
+        print!(" {d:.2} s |");
+    }
+    println!();
+    println!("|---|{}", "---|".repeat(DELAYS.len()));
+    for (name, land) in [("a6-agent-failure", false), ("agent-failure", true)] {
+        let runs = DELAYS.map(|d| -> Result<(f64, f64), Box<dyn std::error::Error>> {
+            let mut s = Scenario::builtin(name)?;
+            s.law = LawConfig::default();
+            for f in &mut s.failures {
+                f.informed_after = d;
+            }
+            if land {
+                s.failure_response.on_hover_loss = OnHoverLoss::Land;
+            }
+            let t_f = s.failures[0].time;
+            Ok(after(&run_scenario(&s, None, None)?, t_f))
+        });
+        let (quantity, pick): (&str, fn(&(f64, f64)) -> f64) = if land {
+            ("max tilt (rad)", |r| r.1)
+        } else {
+            ("peak position error (m)", |r| r.0)
+        };
+        print!(
+            "| {name}{}: {quantity} |",
+            if land { " (land)" } else { "" }
+        );
+        for r in runs {
+            print!(" {:.3} |", pick(&r?));
+        }
+        println!();
+    }
+    Ok(())
+}
+
 /// `f(k, item)` on `jobs` threads, the results in order (failed flights dropped).
 fn map<T: Sync, R: Send>(
     items: &[T],
@@ -343,6 +385,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let jobs: usize = args.next().map_or(Ok(2), |a| a.parse())?;
     println!("## Flight outcome, controller informed or not\n");
     outcomes()?;
+    println!(
+        "\n## The same flights, the controller informed late (offset-free law, no detection)\n"
+    );
+    informed_late()?;
     println!("\n## Detection and isolation delays (fault at t_f, not informed)\n");
     fault_table(&fault_runs(jobs));
     println!("\n## False alarms over {flights} nominal flights\n");

@@ -278,7 +278,8 @@ impl Simulation {
         }
     }
 
-    /// Applies the failures whose time has come; true if any was applied now.
+    /// Applies the failures whose time has come and tells the controller those whose
+    /// `informed_after` has passed; true if any was applied now.
     fn apply_failures(&mut self, t: f64) -> bool {
         let mut any = false;
         for (k, f) in self.failures.iter().enumerate() {
@@ -287,9 +288,9 @@ impl Simulation {
                 self.applied[k] = true;
                 self.actuators.fail(f.agent, f.kind);
                 self.failed_true[f.agent] = true;
-                if f.controller_informed {
-                    self.failed_told[f.agent] = true;
-                }
+            }
+            if self.applied[k] && f.controller_informed && f.time + f.informed_after <= t + 1e-12 {
+                self.failed_told[f.agent] = true;
             }
         }
         any

@@ -153,13 +153,14 @@ fn controller_runs_at_its_period_with_zero_order_hold() {
     }
 }
 
-fn failure_flags_seen(informed: bool) -> Vec<(f64, bool, f64)> {
+fn failure_flags_seen(informed: bool, informed_after: f64) -> Vec<(f64, bool, f64)> {
     let mut s = hover_scenario(0.0, 0.2);
     s.failures = vec![Failure {
         agent: 2,
         time: 0.1,
         kind: FailureKind::NoThrust,
         controller_informed: informed,
+        informed_after,
     }];
     let mut sim = Simulation::new(&s).unwrap();
     let log = Rc::new(RefCell::new(Vec::new()));
@@ -190,18 +191,29 @@ fn failure_flags_seen(informed: bool) -> Vec<(f64, bool, f64)> {
 
 #[test]
 fn failures_are_reported_only_when_the_controller_is_informed() {
-    for (t, f, thrust) in failure_flags_seen(true) {
+    for (t, f, thrust) in failure_flags_seen(true, 0.0) {
         assert_eq!(f, t >= 0.1 - 1e-12, "t = {t}");
         if t > 0.1 + 1e-9 {
             assert_eq!(thrust, 0.0);
         }
     }
-    for (t, f, thrust) in failure_flags_seen(false) {
+    for (t, f, thrust) in failure_flags_seen(false, 0.0) {
         assert!(!f);
         if t > 0.1 + 1e-9 {
             assert_eq!(thrust, 0.0);
         }
     }
+    // Told late: the agent fails at 0.1 s, the controller learns it at 0.16 s (the first tick
+    // from then on); an uninformed failure stays untold whatever the delay.
+    let late = failure_flags_seen(true, 0.06);
+    assert!(late.iter().any(|(t, f, _)| *t > 0.1 + 1e-9 && !f));
+    for (t, f, thrust) in late {
+        assert_eq!(f, t >= 0.16 - 1e-12, "t = {t}");
+        if t > 0.1 + 1e-9 {
+            assert_eq!(thrust, 0.0);
+        }
+    }
+    assert!(failure_flags_seen(false, 0.06).iter().all(|(_, f, _)| !f));
 }
 
 fn fed_positions(seed: u64) -> Vec<[f64; 3]> {

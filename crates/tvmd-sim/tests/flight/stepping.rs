@@ -273,6 +273,7 @@ fn the_wrench_allocation_idles_an_agent_from_its_failure_tick() {
         time: 0.05,
         kind: FailureKind::NoThrust,
         controller_informed: true,
+        informed_after: 0.0,
     }];
     let mut sim = Simulation::new(&scenario).unwrap();
     let weight = sim.team().mass() * GRAVITY;
