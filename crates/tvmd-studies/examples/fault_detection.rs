@@ -325,6 +325,9 @@ fn outcomes() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// The peak position error (m) and the max tilt (rad) after a failure.
+type PeakAndTilt = (f64, f64);
+
 /// The flight targets against the delay of an informed controller: the offset-free law told
 /// `informed_after` seconds after the failure (no detection), as if a detector or the agent's
 /// telemetry named it that late.
@@ -337,7 +340,7 @@ fn informed_late() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     println!("|---|{}", "---|".repeat(DELAYS.len()));
     for (name, land) in [("a6-agent-failure", false), ("agent-failure", true)] {
-        let runs = DELAYS.map(|d| -> Result<(f64, f64), Box<dyn std::error::Error>> {
+        let runs = DELAYS.map(|d| -> Result<PeakAndTilt, Box<dyn std::error::Error>> {
             let mut s = Scenario::builtin(name)?;
             s.law = LawConfig::default();
             for f in &mut s.failures {
@@ -349,7 +352,7 @@ fn informed_late() -> Result<(), Box<dyn std::error::Error>> {
             let t_f = s.failures[0].time;
             Ok(after(&run_scenario(&s, None, None)?, t_f))
         });
-        let (quantity, pick): (&str, fn(&(f64, f64)) -> f64) = if land {
+        let (quantity, pick): (&str, fn(&PeakAndTilt) -> f64) = if land {
             ("max tilt (rad)", |r| r.1)
         } else {
             ("peak position error (m)", |r| r.0)
