@@ -12,7 +12,7 @@ use tvmd_core::{AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllo
 use tvmd_core::{ConfigError, ConfigField, GimbalCommand, RateLimits};
 
 use crate::convert::{arg, array, check_finite, class_arg, finite, finite_scalar, matrix};
-use crate::convert::{shape_error, shaped, CAPACITY};
+use crate::convert::{shape_error, shaped, Int, CAPACITY};
 use crate::errors::{config_error, ConfigError as PyConfigError, OrRaise};
 use crate::record::record;
 use crate::team::{failure_mask, PyTeam};
@@ -21,15 +21,20 @@ use crate::team::{failure_mask, PyTeam};
 pub(crate) const ALLOCATORS: &[&str] = AnyAllocator::<f64, CAPACITY>::NAMES;
 
 /// The allocator named `method` for a team of `n` agents ([`AnyAllocator::from_name`]).
-/// `weights` are per-agent weights (n,) or wrench weights (6,), depending on the allocator.
+/// `weights` are per-agent weights (n,) or wrench weights (6,), depending on the allocator;
+/// `max_rounds` caps the exact-boundary redistribution's walk (an int >= 0).
 pub(crate) fn make_allocator(
     method: &str,
     weights: Option<&Bound<'_, PyAny>>,
     regularization: Option<f64>,
+    max_rounds: Option<&Int>,
     n: usize,
 ) -> PyResult<AnyAllocator<f64, CAPACITY>> {
     let mut options = AllocatorOptions::<f64, CAPACITY> {
         regularization,
+        max_rounds: max_rounds
+            .map(|k| k.to("max_rounds", 0, u32::MAX.into()))
+            .transpose()?,
         ..Default::default()
     };
     match (method, weights.filter(|w| !w.is_none())) {
@@ -66,6 +71,7 @@ pub(crate) fn make_allocator(
         ConfigError::UnusedOption { field } => {
             let option = match field {
                 ConfigField::ClarabelLambda => "regularization",
+                ConfigField::AllocatorMaxRounds => "max_rounds",
                 _ => "weights",
             };
             PyValueError::new_err(format!("allocator '{method}' takes no `{option}`"))
@@ -125,7 +131,7 @@ pub(crate) fn rate_limits_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option
 
 #[doc = include_str!("../docstrings/tvmd.allocate.txt")]
 #[pyfunction]
-#[pyo3(signature = (team, wrench, method = "exact-boundary-redistribution", weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None))]
+#[pyo3(signature = (team, wrench, method = "exact-boundary-redistribution", weights = None, failed = None, previous = None, rate_limits = None, dt = None, regularization = None, max_rounds = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn allocate(
     team: &Bound<'_, PyAny>,
@@ -137,10 +143,11 @@ pub(crate) fn allocate(
     rate_limits: Option<&Bound<'_, PyAny>>,
     dt: Option<f64>,
     regularization: Option<f64>,
+    max_rounds: Option<Int>,
 ) -> PyResult<PyAllocation> {
     let team = &class_arg::<PyTeam>(team, "team")?.get().inner;
     let n = team.len();
-    let mut allocator = make_allocator(method, weights, regularization, n)?;
+    let mut allocator = make_allocator(method, weights, regularization, max_rounds.as_ref(), n)?;
     let wrench = finite::<6, 1>(wrench, "wrench")?;
     let mask = failure_mask(team, failed)?;
     team.validate_failures(&mask).or_raise()?;

@@ -52,9 +52,9 @@ impl PyController {
     // `law = None` is the offset-free law (a default here must be of the argument's type); the
     // text signature (kept equal to `signature`, checked by stubtest) shows it by its name.
     #[new]
-    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None, law = None, fault_detection = None))]
+    #[pyo3(signature = (team, gains = None, relaxation = None, gravity = 9.81, period = 0.01, allocator = "exact-boundary-redistribution", rate_limits = None, failed = None, weights = None, regularization = None, planner_tolerance = None, planner_max_iterations = None, *, s = None, null_space = None, law = None, fault_detection = None, max_rounds = None))]
     #[pyo3(
-        text_signature = "(team, gains=None, relaxation=None, gravity=9.81, period=0.01, allocator=\"exact-boundary-redistribution\", rate_limits=None, failed=None, weights=None, regularization=None, planner_tolerance=None, planner_max_iterations=None, *, s=None, null_space=None, law=\"offset-free\", fault_detection=None)"
+        text_signature = "(team, gains=None, relaxation=None, gravity=9.81, period=0.01, allocator=\"exact-boundary-redistribution\", rate_limits=None, failed=None, weights=None, regularization=None, planner_tolerance=None, planner_max_iterations=None, *, s=None, null_space=None, law=\"offset-free\", fault_detection=None, max_rounds=None)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -74,6 +74,7 @@ impl PyController {
         null_space: Option<&str>,
         law: Option<&Bound<'_, PyAny>>,
         fault_detection: Option<&Bound<'_, PyAny>>,
+        max_rounds: Option<Int>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
@@ -107,7 +108,13 @@ impl PyController {
             attitude_rate,
             fault_detection,
         };
-        let allocator = make_allocator(allocator, weights, regularization, team.len())?;
+        let allocator = make_allocator(
+            allocator,
+            weights,
+            regularization,
+            max_rounds.as_ref(),
+            team.len(),
+        )?;
         let mask = failure_mask(&team, failed)?;
         let mut inner = Controller::new(team, settings, allocator).or_raise()?;
         inner.set_failures(mask).or_raise()?;

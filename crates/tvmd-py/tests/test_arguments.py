@@ -33,6 +33,7 @@ BIG = 2**200  # beyond every Rust integer type
 
 U64 = r">= 0 and <= 2\*\*64 - 1"
 U32_ITER = r">= 1 and <= 2\*\*32 - 1"
+U32_ROUNDS = r">= 0 and <= 2\*\*32 - 1"
 JOBS = r">= 1 and <= 2\*\*64 - 1"
 
 # (call taking the bad value, the argument's name as the message gives it, its range)
@@ -47,6 +48,8 @@ INTEGER_ARGUMENTS = [
     (lambda v: sim.relaxation_sweep([0.5], "hover", jobs=v), "jobs", JOBS),
     (lambda v: sim.relaxation_sweep([0.5], "hover", max_samples=v), "max_samples", U64),
     (lambda v: tvmd.Controller(A4, planner_max_iterations=v), "planner_max_iterations", U32_ITER),
+    (lambda v: tvmd.Controller(A4, max_rounds=v), "max_rounds", U32_ROUNDS),
+    (lambda v: tvmd.allocate(A4, np.zeros(6), max_rounds=v), "max_rounds", U32_ROUNDS),
     (lambda v: tvmd.AttitudePlanner(0.5, max_iterations=v), "max_iterations", U32_ITER),
     (lambda v: tvmd.AttainableForceSpace(v, 0, 0.5, 0.5, 10.0), "n", U64),
     (lambda v: tvmd.AttainableForceSpace(4, v, 0.5, 0.5, 10.0), "n_x", U64),

@@ -764,6 +764,10 @@ def _team(**changes):
          tvmd.ConfigError, "allocation.weights"),  # fmt: skip
         (lambda: tvmd.allocate(A4, np.zeros(6), method="pseudo-inverse", weights=np.ones(4)), ValueError,
          "takes no `weights`"),  # fmt: skip
+        (lambda: tvmd.allocate(A4, np.zeros(6), method="pseudo-inverse", max_rounds=2), ValueError,
+         "takes no `max_rounds`"),  # fmt: skip
+        (lambda: tvmd.Controller(A4, allocator="redistributed-pseudo-inverse", max_rounds=1), ValueError,
+         "takes no `max_rounds`"),  # fmt: skip
         (lambda: tvmd.allocate(A4, np.zeros(6), previous=np.zeros((4, 4))), ValueError, "only apply with `rate_limits`"),
         (lambda: tvmd.allocate(A4, np.zeros(6), rate_limits=(1.0, 1.0)), ValueError, "`rate_limits` needs `dt`"),
         (lambda: tvmd.allocate(A4, np.zeros(6), rate_limits=(1.0, 0.0), dt=0.01), tvmd.ConfigError, "rate_limits"),

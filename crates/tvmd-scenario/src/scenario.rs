@@ -42,6 +42,13 @@ pub struct Scenario {
     /// `"pseudo-inverse"`, `"weighted-pseudo-inverse"` with unit weights, and `"clarabel"`,
     /// `"clarabel-sequential"` with the `clarabel` feature).
     pub allocator: String,
+    /// Round cap of the exact-boundary redistribution's walk per control period
+    /// (`ExactBoundaryRedistribution::with_max_rounds`: the best forces found so far, inside
+    /// `E_f`, with their true `e_f`), the flight option that bounds its worst case
+    /// (`docs/allocation-benchmark.md`); none by default, the walk's own `2 n + 4`. Refused
+    /// with any other allocator.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub allocator_max_rounds: Option<u32>,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
     /// plant's: give both to model a servo the controller knows about.
@@ -106,6 +113,7 @@ impl Default for Scenario {
             initial_attitude: [0.0; 3],
             relaxation: 0.5,
             allocator: tvmd_core::AnyAllocator::<f64, 1>::DEFAULT_NAME.into(),
+            allocator_max_rounds: None,
             controller_rate_limits: None,
             null_space: None,
             controller_precision: Precision::F64,

@@ -134,6 +134,25 @@ impl Scenario {
                 ),
             ));
         }
+        if self.allocator_max_rounds.is_some() {
+            // The core's rule of which allocator takes the option (the name is checked above).
+            let options = tvmd_core::AllocatorOptions::<f64, 1> {
+                max_rounds: self.allocator_max_rounds,
+                ..Default::default()
+            };
+            if let Err(tvmd_core::ConfigError::UnusedOption { .. }) =
+                tvmd_core::allocation::AllocatorChoice::new(&self.allocator, &options)
+            {
+                return Err(invalid(
+                    "allocator_max_rounds",
+                    format!(
+                        "allocator `{}` takes no round cap (only `{}` does)",
+                        self.allocator,
+                        tvmd_core::allocation::EXACT_BOUNDARY_REDISTRIBUTION
+                    ),
+                ));
+            }
+        }
         if let Some([x, y]) = self.controller_rate_limits {
             check_pos("controller_rate_limits[0]", x)?;
             check_pos("controller_rate_limits[1]", y)?;
@@ -333,5 +352,23 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.failures[0].informed_after, 0.05);
+    }
+
+    #[test]
+    fn the_round_cap_is_for_the_exact_boundary_walk_only() {
+        let s = Scenario::from_toml_str("allocator_max_rounds = 2\n").unwrap();
+        assert_eq!(s.allocator_max_rounds, Some(2));
+        assert_eq!(Scenario::default().allocator_max_rounds, None);
+        for other in ["redistributed-pseudo-inverse", "pseudo-inverse", "clarabel"] {
+            let e = Scenario::from_toml_str(&format!(
+                "allocator = \"{other}\"\nallocator_max_rounds = 2\n"
+            ))
+            .unwrap_err();
+            assert!(
+                e.to_string().contains("allocator_max_rounds"),
+                "{other}: {e}"
+            );
+        }
+        assert!(Scenario::from_toml_str("allocator_max_rounds = -1\n").is_err());
     }
 }

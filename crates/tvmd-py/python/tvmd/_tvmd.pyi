@@ -846,6 +846,7 @@ def allocate(
     rate_limits: Optional[ArrayLike] = None,
     dt: Optional[float] = None,
     regularization: Optional[float] = None,
+    max_rounds: Optional[int] = None,
 ) -> Allocation:
     """Allocates a desired wrench ``u_d`` over the team's working agents: inverts ``u_d = M f``
     (eq. 4) into agent-frame forces inside each agent's admissible set ``E_f`` (eq. 6).
@@ -885,6 +886,10 @@ def allocate(
             ``|eta - eta_prev| <= rate dt``.
         dt: the control period (s), required with ``rate_limits``.
         regularization: ``lambda`` of "clarabel" and "clarabel-sequential".
+        max_rounds: "exact-boundary-redistribution" only: caps its walk at this many rounds
+            (an int >= 0; 0 is its start, the redistributed pseudo-inverse's forces or better).
+            A capped call returns the best forces found so far, inside ``E_f``, with their true
+            ``e_f``. Default None: the walk's own cap, ``2 n + 4`` rounds.
 
     Returns:
         Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
@@ -955,6 +960,9 @@ class Controller:
             ``[fault_detection]`` table (``model_error``, ``threshold``, ``persistence``,
             ``response``). It reads the disturbance observer's residual, so it needs the
             offset-free law's observer. ``fault_report()`` gives each period's verdict.
+        max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
+            (keyword only; see ``tvmd.allocate``): bounds its worst-case cost, the flight option
+            of docs/allocation-benchmark.md. Default None: no cap.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
@@ -987,6 +995,7 @@ class Controller:
         null_space: Optional[str] = None,
         law: _LawArg = "offset-free",
         fault_detection: Union[str, Mapping[str, Any], None] = None,
+        max_rounds: Optional[int] = None,
     ) -> "Controller": ...
     def fault_report(self) -> Optional[Dict[str, Any]]:
         """The fault detector's report of the last period, or None (detection off, or no period

@@ -4,7 +4,7 @@
 
 use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
-    AgentLimits, AgentSpec, AnyAllocator, AttitudeRateFilter, ControllerSettings,
+    AgentLimits, AgentSpec, AllocatorOptions, AnyAllocator, AttitudeRateFilter, ControllerSettings,
     DisturbanceObserver, FailureMask, FaultDetection, FaultResponse, GainSchedule, Gains,
     IntegralAction, NaturalGains, Navigator, OffsetFree, RateLimits, Relaxation, TeamConfig,
 };
@@ -236,9 +236,17 @@ pub fn law_settings<T: CoreFloat>(
     Ok((gain_schedule, offset_free, attitude_rate))
 }
 
-/// The allocator named by `scenario.allocator`, in `T`.
-pub fn allocator<T: CoreFloat>(name: &str) -> Result<AnyAllocator<T, MAX_AGENTS>, SimError> {
-    AnyAllocator::from_name(name, &Default::default()).map_err(|e| match e {
+/// The allocator named by `scenario.allocator`, in `T`, with the round cap
+/// `scenario.allocator_max_rounds`.
+pub fn allocator<T: CoreFloat>(
+    name: &str,
+    max_rounds: Option<u32>,
+) -> Result<AnyAllocator<T, MAX_AGENTS>, SimError> {
+    let options = AllocatorOptions {
+        max_rounds,
+        ..Default::default()
+    };
+    AnyAllocator::from_name(name, &options).map_err(|e| match e {
         ConfigError::UnknownAllocator => invalid(
             "allocator",
             format!(
@@ -282,9 +290,16 @@ pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimErro
              recording yet: fly it in process",
         ));
     }
+    if scenario.allocator_max_rounds.is_some() {
+        return Err(invalid(
+            "allocator_max_rounds",
+            "the allocator's round cap is not carried to an emulated target (PIL) or into a \
+             cycle recording yet: fly it in process",
+        ));
+    }
     team_config::<f32>(scenario)?;
     let settings = controller_settings::<f32>(scenario)?;
-    allocator::<f32>(&scenario.allocator)?;
+    allocator::<f32>(&scenario.allocator, None)?;
     let body = scenario.team_body()?;
     let mut agents = [([0.0f32; 3], 0, 0.0f32); AGENTS];
     for (slot, a) in agents.iter_mut().zip(&body.agents) {

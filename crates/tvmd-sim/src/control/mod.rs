@@ -72,7 +72,7 @@ pub fn core_of_scenario<T: CoreFloat>(
 ) -> Result<(CoreController<T>, usize), SimError> {
     let team = config::team_config::<T>(scenario)?;
     let settings = config::controller_settings::<T>(scenario)?;
-    let alloc = config::allocator::<T>(&scenario.allocator)?;
+    let alloc = config::allocator::<T>(&scenario.allocator, scenario.allocator_max_rounds)?;
     let n = team.len();
     let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
     Ok((inner, n))

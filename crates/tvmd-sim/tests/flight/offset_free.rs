@@ -150,3 +150,22 @@ fn the_wire_configuration_carries_the_law() {
     words.law.offset_free = 7;
     assert!(words.build().is_err());
 }
+
+/// The scenario's round cap reaches the allocator in process; the words do not carry it yet,
+/// so PIL and the recorder refuse it rather than fly without it.
+#[test]
+fn the_allocators_round_cap_is_flown_in_process_and_refused_by_the_words() {
+    use tvmd_core::AnyAllocator;
+    use tvmd_sim::control::{core_of_scenario, wire_config};
+    let mut s = Scenario::default();
+    s.allocator_max_rounds = Some(2);
+    let (controller, _) = core_of_scenario::<f32>(&s).unwrap();
+    let AnyAllocator::ExactBoundaryRedistribution(a) = controller.allocator() else {
+        panic!("the default allocator is the exact-boundary redistribution");
+    };
+    assert_eq!(a.max_rounds(), Some(2));
+    let e = wire_config(&s).unwrap_err();
+    assert!(e.to_string().contains("allocator_max_rounds"), "{e}");
+    s.allocator_max_rounds = None;
+    assert!(wire_config(&s).is_ok());
+}
