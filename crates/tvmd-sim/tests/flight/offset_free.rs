@@ -157,8 +157,10 @@ fn the_wire_configuration_carries_the_law() {
 fn the_allocators_round_cap_is_flown_in_process_and_refused_by_the_words() {
     use tvmd_core::AnyAllocator;
     use tvmd_sim::control::{core_of_scenario, wire_config};
-    let mut s = Scenario::default();
-    s.allocator_max_rounds = Some(2);
+    let mut s = Scenario {
+        allocator_max_rounds: Some(2),
+        ..Scenario::default()
+    };
     let (controller, _) = core_of_scenario::<f32>(&s).unwrap();
     let AnyAllocator::ExactBoundaryRedistribution(a) = controller.allocator() else {
         panic!("the default allocator is the exact-boundary redistribution");
