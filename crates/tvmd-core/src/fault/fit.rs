@@ -68,10 +68,12 @@ pub(super) fn none<T: Real>() -> T {
 }
 
 /// The weighted residual read against one agent's block and force: `q = A^T r`, the axial
-/// vector `p'`, `f^T P f` and `f.q`.
+/// vector `p'`, `f.f`, `f^T P f` and `f.q`.
 struct Projection<T: Real> {
     q: Vector3<T>,
     p: Vector3<T>,
+    /// `f.f`.
+    ff: T,
     /// `f^T P f = ||A f||^2`, positive and finite.
     ll: T,
     /// `f.q = (A f).r`.
@@ -98,11 +100,13 @@ impl<T: Real> Projection<T> {
             b3 * a0 + b4 * a1 + b5 * a2,
         );
         // `f^T P f = w_tau^2 |p' x f|^2 + w_f^2 |f|^2` (a sum, no cancellation).
-        let ll = res.tau2 * p.cross(f).norm_squared() + res.force2 * f.dot(f);
+        let ff = f.dot(f);
+        let ll = res.tau2 * p.cross(f).norm_squared() + res.force2 * ff;
         (ll > T::zero() && ll.is_finite()).then(|| Self {
             rl: q.dot(f),
             q,
             p,
+            ff,
             ll,
         })
     }
@@ -137,9 +141,9 @@ pub(super) fn fit<T: Real>(
     m: &Matrix6x3<T>,
     f: &Vector3<T>,
 ) -> Option<Fit<T>> {
-    let Projection { q, p, ll, rl } = Projection::new(res, m, f)?;
+    let Projection { q, p, ff, ll, rl } = Projection::new(res, m, f)?;
     let scale = res.tau2 * p.dot(&p) + res.force2;
-    let (ff, pf, pq) = (f.dot(f), p.dot(f), p.dot(&q));
+    let (pf, pq) = (p.dot(f), p.dot(&q));
     let c = fmin(fmax(-rl / ll, T::zero()), T::one());
     let loss = fmax(res.rr + c * (rl + rl + c * ll), T::zero());
     // `x^T P^-1 y = (x.y + (w_tau^2 / w_f^2) (p'.x) (p'.y)) / scale`.
