@@ -282,19 +282,26 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 /// [`tvmd_wire::LawWords`] of the f32 settings.
 pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
     use tvmd_wire::{CoreConfig, LawWords, AGENTS, ALLOCATOR_NAME_BYTES};
-    if scenario.fault_detection.is_some() {
-        // Refused rather than flown without it: the words carry no detector yet.
-        return Err(invalid(
+    // Refused rather than flown without them: the words do not carry these settings yet.
+    let uncarried = [
+        (
+            scenario.fault_detection.is_some(),
             "fault_detection",
-            "the fault detector is not carried to an emulated target (PIL) or into a cycle \
-             recording yet: fly it in process",
-        ));
-    }
-    if scenario.allocator_max_rounds.is_some() {
-        return Err(invalid(
+            "the fault detector",
+        ),
+        (
+            scenario.allocator_max_rounds.is_some(),
             "allocator_max_rounds",
-            "the allocator's round cap is not carried to an emulated target (PIL) or into a \
-             cycle recording yet: fly it in process",
+            "the allocator's round cap",
+        ),
+    ];
+    if let Some((_, field, what)) = uncarried.iter().find(|(given, ..)| *given) {
+        return Err(invalid(
+            field,
+            format!(
+                "{what} is not carried to an emulated target (PIL) or into a cycle recording \
+                 yet: fly it in process"
+            ),
         ));
     }
     team_config::<f32>(scenario)?;
