@@ -8,21 +8,18 @@
 
 use std::time::{Duration, Instant};
 
-use mavlink::dialects::common::MavCmd;
 use nalgebra::Vector3;
 use tvmd_sim::{BoxedError, FlightController, FlightInput, FlightOutput};
 
-use crate::flight::{main_mode, Action, FlightPlan};
+use crate::flight::FlightPlan;
 use crate::gcs::GcsLink;
 use crate::link::{Received, SimLink};
 use crate::mapping::{ControlMapping, CONTROLS};
 use crate::measure::FlightRecord;
 use crate::messages::{controls_of, hil_gps, hil_sensor, hil_state, time_usec};
+use crate::script::Script;
 use crate::sensors::SensorModel;
 use crate::Px4Error;
-
-/// Stick input is sent at this rate (Hz).
-const STICK_RATE: f64 = 50.0;
 
 /// Timing of the bridge.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,8 +55,7 @@ pub struct Bridge {
     mapping: ControlMapping,
     plan: FlightPlan,
     timing: BridgeTiming,
-    next_step: usize,
-    sticks: Option<[f64; 4]>,
+    script: Script,
     tick: u64,
     last_velocity: Option<Vector3<f64>>,
     controls: [f32; CONTROLS],
@@ -83,14 +79,17 @@ impl Bridge {
         let sensors = SensorModel::new(plan.sensors, plan.home)?;
         let every = |rate: f64| ((1.0 / (rate * timing.period)).round() as u64).max(1);
         let c = sensors.config();
-        let every = [every(c.mag_baro_rate), every(c.gps_rate), every(c.truth_rate)];
+        let every = [
+            every(c.mag_baro_rate),
+            every(c.gps_rate),
+            every(c.truth_rate),
+        ];
         Ok(Self {
             link,
             gcs,
             mapping,
             timing,
-            next_step: 0,
-            sticks: None,
+            script: Script::new(&plan),
             tick: 0,
             last_velocity: None,
             controls: [0.0; CONTROLS],
@@ -132,7 +131,9 @@ impl Bridge {
         };
         self.last_velocity = Some(state.velocity);
         let time = time_usec(t);
-        let imu = self.sensors.imu(state, &accel, self.tick % self.every[0] == 0);
+        let imu = self
+            .sensors
+            .imu(state, &accel, self.tick % self.every[0] == 0);
         self.link.send(&hil_sensor(time, &imu))?;
         if self.tick % self.every[1] == 0 {
             let gps = self.sensors.gps(state);
@@ -146,93 +147,15 @@ impl Bridge {
     }
 
     fn run_script(&mut self, t: f64) -> Result<(), Px4Error> {
-        let period = self.timing.period;
-        let every = |rate: f64| ((1.0 / (rate * period)).round() as u64).max(1);
-        if self.tick % every(1.0) == 0 {
-            self.gcs.heartbeat()?;
-        }
-        while let Some(step) = self.plan.step.get(self.next_step).filter(|s| s.at <= t + 1e-9) {
-            let action = step.action.clone();
-            self.next_step += 1;
-            self.act(t, &action)?;
-        }
-        if let Some([roll, pitch, yaw, throttle]) = self.sticks {
-            if self.tick % every(STICK_RATE) == 0 {
-                self.gcs.manual(roll, pitch, yaw, throttle)?;
-            }
-        }
+        self.script.advance(t, &mut self.gcs)?;
         for message in self.gcs.poll()? {
             self.record.telemetry(t, message);
         }
         let s = self.gcs.state();
         self.heard |= s.heartbeats > 0;
-        self.record.px4_state(t, s.armed, s.landed_state, self.heard);
+        self.record
+            .px4_state(t, s.armed, s.landed_state, self.heard);
         Ok(())
-    }
-
-    fn act(&mut self, t: f64, action: &Action) -> Result<(), Px4Error> {
-        let home = *self.sensors.home();
-        let nan = f32::NAN;
-        match action {
-            Action::Arm => self
-                .gcs
-                .command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            Action::Disarm => self
-                .gcs
-                .command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7]),
-            Action::Takeoff { altitude } => {
-                self.gcs.command(
-                    MavCmd::MAV_CMD_NAV_TAKEOFF,
-                    [nan, 0.0, 0.0, nan, nan, nan, (home.altitude + altitude) as f32],
-                )
-            }
-            Action::Goto {
-                north,
-                east,
-                altitude,
-            } => {
-                let (lat, lon) = home.reproject(*north, *east);
-                self.gcs.command_global(
-                    MavCmd::MAV_CMD_DO_REPOSITION,
-                    // Ground speed default, change to hold mode, no radius, keep the yaw.
-                    [-1.0, 1.0, 0.0, nan],
-                    [(lat * 1e7).round() as i32, (lon * 1e7).round() as i32],
-                    (home.altitude + altitude) as f32,
-                )
-            }
-            Action::Land => self.gcs.command(
-                MavCmd::MAV_CMD_NAV_LAND,
-                [nan, 0.0, 0.0, nan, nan, nan, nan],
-            ),
-            Action::Mode { mode } => {
-                let (main, sub) = main_mode(mode).ok_or_else(|| Px4Error::Script {
-                    t,
-                    reason: format!("unknown mode `{mode}`"),
-                })?;
-                self.gcs.command(
-                    MavCmd::MAV_CMD_DO_SET_MODE,
-                    [1.0, f32::from(main), f32::from(sub), 0.0, 0.0, 0.0, 0.0],
-                )
-            }
-            Action::Param {
-                name,
-                value,
-                integer,
-            } => self.gcs.set_param(name, *value, *integer),
-            Action::Sticks {
-                roll,
-                pitch,
-                yaw,
-                throttle,
-            } => {
-                self.sticks = Some([*roll, *pitch, *yaw, *throttle]);
-                Ok(())
-            }
-            Action::Release => {
-                self.sticks = None;
-                Ok(())
-            }
-        }
     }
 
     /// Waits for PX4's controls of `t`: at wall pace (returning the last controls) until PX4
@@ -311,6 +234,7 @@ impl Bridge {
 
 impl FlightController for Bridge {
     fn step(&mut self, input: &FlightInput<'_>) -> Result<FlightOutput, BoxedError> {
-        self.step_inner(input).map_err(|e| Box::new(e) as BoxedError)
+        self.step_inner(input)
+            .map_err(|e| Box::new(e) as BoxedError)
     }
 }

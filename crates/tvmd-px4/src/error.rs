@@ -24,8 +24,10 @@ pub enum Px4Error {
     },
     /// The simulator port cannot be opened (in use by another simulator, another tvmd-sim, or
     /// PX4's own SIH).
-    #[error("cannot listen for PX4 on TCP port {port}: {source} (another simulator running? \
-             choose another instance with --instance N: PX4 then connects to 4560 + N)")]
+    #[error(
+        "cannot listen for PX4 on TCP port {port}: {source} (another simulator running? \
+             choose another instance with --instance N: PX4 then connects to 4560 + N)"
+    )]
     Bind {
         /// The port.
         port: u16,
@@ -33,9 +35,11 @@ pub enum Px4Error {
         source: std::io::Error,
     },
     /// PX4 never connected to the simulator port.
-    #[error("PX4 did not connect to TCP port {port} within {waited:.0} s of wall time (is PX4 \
+    #[error(
+        "PX4 did not connect to TCP port {port} within {waited:.0} s of wall time (is PX4 \
              SITL running with simulator_mavlink on this port? `PX4_SYS_AUTOSTART=... \
-             build/px4_sitl_default/bin/px4` connects to 4560 + its instance)")]
+             build/px4_sitl_default/bin/px4` connects to 4560 + its instance)"
+    )]
     NeverConnected {
         /// The port.
         port: u16,
@@ -43,8 +47,10 @@ pub enum Px4Error {
         waited: f64,
     },
     /// PX4 stopped answering the sensors with actuator controls.
-    #[error("PX4 stalled: no HIL_ACTUATOR_CONTROLS for the sensors of t = {t:.3} s within \
-             {waited:.1} s of wall time (lockstep waits for PX4; is it stuck or stopped?)")]
+    #[error(
+        "PX4 stalled: no HIL_ACTUATOR_CONTROLS for the sensors of t = {t:.3} s within \
+             {waited:.1} s of wall time (lockstep waits for PX4; is it stuck or stopped?)"
+    )]
     Stalled {
         /// Simulation time of the unanswered sensors (s).
         t: f64,

@@ -181,7 +181,10 @@ impl FlightPlan {
             if !(s.at.is_finite() && s.at >= last) {
                 return Err(bad(
                     format!("step[{i}].at"),
-                    format!("{} must be finite and not before the step above ({last})", s.at),
+                    format!(
+                        "{} must be finite and not before the step above ({last})",
+                        s.at
+                    ),
                 ));
             }
             last = s.at;
@@ -262,7 +265,12 @@ mod tests {
         assert_eq!(plan.step[1].action, Action::Takeoff { altitude: 1.5 });
         assert_eq!(
             plan.step[2].action,
-            Action::Sticks { roll: 0.2, pitch: 0.0, yaw: 0.0, throttle: 0.5 }
+            Action::Sticks {
+                roll: 0.2,
+                pitch: 0.0,
+                yaw: 0.0,
+                throttle: 0.5
+            }
         );
         assert_eq!(plan.window[0].settle_band, 0.1);
     }
@@ -270,9 +278,13 @@ mod tests {
     #[test]
     fn bad_flight_files_are_refused_by_field() {
         let err = |t: &str| FlightPlan::from_toml_str(t).unwrap_err().to_string();
-        assert!(err("[[step]]\nat = 2.0\naction = \"arm\"\n[[step]]\nat = 1.0\naction = \"land\"")
-            .contains("step[1].at"));
-        assert!(err("[[step]]\nat = 1.0\naction = \"mode\"\nmode = \"acro\"").contains("unknown mode"));
+        assert!(
+            err("[[step]]\nat = 2.0\naction = \"arm\"\n[[step]]\nat = 1.0\naction = \"land\"")
+                .contains("step[1].at")
+        );
+        assert!(
+            err("[[step]]\nat = 1.0\naction = \"mode\"\nmode = \"acro\"").contains("unknown mode")
+        );
         assert!(err("[[step]]\nat = 1.0\naction = \"fly\"").contains("flight file"));
         assert!(err("[[window]]\nname = \"w\"\nfrom = 2.0\nto = 1.0").contains("window[0]"));
         assert!(err("[[step]]\nat = 1.0\naction = \"sticks\"\nroll = 2.0").contains("sticks"));

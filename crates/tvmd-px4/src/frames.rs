@@ -55,7 +55,10 @@ mod tests {
 
     #[test]
     fn level_attitude_is_px4_identity() {
-        assert!(close(&quaternion_ned_frd(&Matrix3::identity()), &[1.0, 0.0, 0.0, 0.0]));
+        assert!(close(
+            &quaternion_ned_frd(&Matrix3::identity()),
+            &[1.0, 0.0, 0.0, 0.0]
+        ));
     }
 
     #[test]
@@ -91,7 +94,8 @@ mod tests {
         // A body vector rotated in tvmd, then flipped, equals the flipped vector rotated by
         // PX4's quaternion.
         let v = Vector3::new(0.3, -1.2, 2.0);
-        let px4 = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
+        let px4 =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
         assert!((flip(&(r * v)) - px4 * flip(&v)).norm() < 1e-12);
     }
 }

@@ -225,7 +225,10 @@ impl GcsLink {
         }
         // PX4 reads an INT32 parameter's bytes from the float field (MAVLink's bytewise encoding).
         let (param_value, param_type) = if integer {
-            (f32::from_bits(value as i32 as u32), MavParamType::MAV_PARAM_TYPE_INT32)
+            (
+                f32::from_bits(value as i32 as u32),
+                MavParamType::MAV_PARAM_TYPE_INT32,
+            )
         } else {
             (value as f32, MavParamType::MAV_PARAM_TYPE_REAL32)
         };
@@ -239,7 +242,13 @@ impl GcsLink {
     }
 
     /// MANUAL_CONTROL: sticks in `[-1, 1]` (roll, pitch, yaw) and throttle in `[0, 1]`.
-    pub fn manual(&mut self, roll: f64, pitch: f64, yaw: f64, throttle: f64) -> Result<(), Px4Error> {
+    pub fn manual(
+        &mut self,
+        roll: f64,
+        pitch: f64,
+        yaw: f64,
+        throttle: f64,
+    ) -> Result<(), Px4Error> {
         let s = |v: f64| (v.clamp(-1.0, 1.0) * 1000.0).round() as i16;
         self.send(&MavMessage::MANUAL_CONTROL(MANUAL_CONTROL_DATA {
             target: self.system,
@@ -287,7 +296,9 @@ impl GcsLink {
         let q = |q: [f32; 4]| q.map(f64::from);
         match message {
             MavMessage::HEARTBEAT(h) if component == 1 => {
-                self.state.armed = h.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+                self.state.armed = h
+                    .base_mode
+                    .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
                 self.state.main_mode = ((h.custom_mode >> 16) & 0xff) as u8;
                 self.state.heartbeats += 1;
                 None
@@ -315,7 +326,12 @@ impl GcsLink {
             }),
             MavMessage::STATUSTEXT(s) => Some(Telemetry::Text {
                 severity: s.severity as u8,
-                text: s.text.to_str().unwrap_or_default().trim_end_matches('\0').to_string(),
+                text: s
+                    .text
+                    .to_str()
+                    .unwrap_or_default()
+                    .trim_end_matches('\0')
+                    .to_string(),
             }),
             MavMessage::COMMAND_ACK(a) => Some(Telemetry::Ack {
                 command: a.command as u16,

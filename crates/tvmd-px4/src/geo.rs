@@ -99,7 +99,10 @@ mod tests {
         for (n, e) in [(0.0, 0.0), (1.0, 0.0), (0.0, -1.0), (123.4, -56.7)] {
             let (lat, lon) = home.reproject(n, e);
             let (n2, e2) = home.project(lat, lon);
-            assert!((n - n2).abs() < 1e-3 && (e - e2).abs() < 1e-3, "{n} {e} -> {n2} {e2}");
+            assert!(
+                (n - n2).abs() < 1e-3 && (e - e2).abs() < 1e-3,
+                "{n} {e} -> {n2} {e2}"
+            );
         }
         // One metre north is 1/R rad of latitude.
         let (lat, lon) = home.reproject(1.0, 0.0);

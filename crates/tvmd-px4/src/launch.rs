@@ -30,6 +30,18 @@ pub struct Px4Launch {
     pub work_dir: PathBuf,
     /// PX4's instance (simulator port 4560 + instance, GCS port 18570 + instance).
     pub instance: u8,
+    /// PX4's simulator: tvmd-sim over `simulator_mavlink`, or PX4's own SIH (for comparison).
+    pub simulator: Simulator,
+}
+
+/// Which simulator PX4 flies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Simulator {
+    /// tvmd-sim over `simulator_mavlink` (`PX4_SIMULATOR=mavlink`).
+    Tvmd,
+    /// PX4's simulation-in-hardware quadcopter (`PX4_SIMULATOR=sihsim`, model `sihsim_quadx`),
+    /// in real time.
+    Sih,
 }
 
 /// The PX4 binary of `tree`, or a clear error: no such directory, not a PX4 tree, not built.
@@ -103,8 +115,20 @@ impl Px4Process {
             .env("PATH", format!("{}:{path}", hooks.display()))
             .env("PX4_SYS_AUTOSTART", launch.autostart.to_string())
             // An external simulator on simulator_mavlink: neither SIH nor Gazebo.
-            .env("PX4_SIMULATOR", "mavlink")
-            .env("PX4_SIM_MODEL", "tvmd")
+            .env(
+                "PX4_SIMULATOR",
+                match launch.simulator {
+                    Simulator::Tvmd => "mavlink",
+                    Simulator::Sih => "sihsim",
+                },
+            )
+            .env(
+                "PX4_SIM_MODEL",
+                match launch.simulator {
+                    Simulator::Tvmd => "tvmd",
+                    Simulator::Sih => "sihsim_quadx",
+                },
+            )
             .env("HEADLESS", "1")
             .stdin(Stdio::null())
             .stdout(console.try_clone().map_err(io("console"))?)
@@ -134,8 +158,19 @@ impl Px4Process {
         }
     }
 
-    /// Stops PX4 (SIGKILL: PX4's ulog is written as it goes) and returns its newest ulog.
+    /// Stops PX4 (SIGTERM, which PX4 takes as a shutdown and closes its ulog; SIGKILL after
+    /// 5 s) and returns its newest ulog.
     pub fn stop(mut self) -> Option<PathBuf> {
+        let _ = Command::new("kill")
+            .arg("-TERM")
+            .arg(self.child.id().to_string())
+            .status();
+        let start = std::time::Instant::now();
+        while matches!(self.child.try_wait(), Ok(None))
+            && start.elapsed() < std::time::Duration::from_secs(5)
+        {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
         newest_ulog(&self.work_dir.join("rootfs/log"))
@@ -175,15 +210,23 @@ mod tests {
 
     #[test]
     fn a_missing_tree_and_an_unbuilt_tree_are_named() {
-        let e = px4_binary(Path::new("/nonexistent/px4")).unwrap_err().to_string();
-        assert!(e.contains("/nonexistent/px4") && e.contains("no such directory"), "{e}");
+        let e = px4_binary(Path::new("/nonexistent/px4"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/nonexistent/px4") && e.contains("no such directory"),
+            "{e}"
+        );
         let dir = std::env::temp_dir().join(format!("tvmd-px4-tree-{}", std::process::id()));
         std::fs::create_dir_all(dir.join("ROMFS/px4fmu_common/init.d-posix")).unwrap();
         let e = px4_binary(&dir).unwrap_err().to_string();
         assert!(e.contains("not a PX4 source tree"), "{e}");
         std::fs::write(dir.join("ROMFS/px4fmu_common/init.d-posix/rcS"), "").unwrap();
         let e = px4_binary(&dir).unwrap_err().to_string();
-        assert!(e.contains("not built") && e.contains("make px4_sitl_default"), "{e}");
+        assert!(
+            e.contains("not built") && e.contains("make px4_sitl_default"),
+            "{e}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -30,6 +30,7 @@ pub mod mapping;
 pub mod measure;
 pub mod messages;
 pub mod run;
+pub mod script;
 pub mod sensors;
 
 pub use error::Px4Error;

@@ -36,7 +36,8 @@ impl Listener {
     /// or refused ([`Px4Error::Bind`]).
     pub fn bind(port: u16) -> Result<Self, Px4Error> {
         let address = SocketAddr::from((Ipv4Addr::LOCALHOST, port));
-        let listener = TcpListener::bind(address).map_err(|source| Px4Error::Bind { port, source })?;
+        let listener =
+            TcpListener::bind(address).map_err(|source| Px4Error::Bind { port, source })?;
         let port = listener
             .local_addr()
             .map_err(|source| Px4Error::Bind { port, source })?

@@ -103,7 +103,10 @@ impl ControlMapping {
         match (&config.channels, config.layout.as_deref()) {
             (Some(channels), _) => {
                 if channels.len() > CONTROLS {
-                    return Err(bad(format!("{} channels, at most {CONTROLS}", channels.len())));
+                    return Err(bad(format!(
+                        "{} channels, at most {CONTROLS}",
+                        channels.len()
+                    )));
                 }
                 for (role, text) in roles.iter_mut().zip(channels) {
                     *role = text.parse().map_err(bad)?;
@@ -155,10 +158,14 @@ impl ControlMapping {
             .gimbal_range
             .unwrap_or([30f64.to_radians(), 90f64.to_radians()]);
         if !(rotor_thrust.is_finite() && rotor_thrust > 0.0) {
-            return Err(bad(format!("rotor_thrust must be > 0 N, got {rotor_thrust}")));
+            return Err(bad(format!(
+                "rotor_thrust must be > 0 N, got {rotor_thrust}"
+            )));
         }
         if !gimbal_range.iter().all(|r| r.is_finite() && *r > 0.0) {
-            return Err(bad(format!("gimbal_range must be > 0 rad, got {gimbal_range:?}")));
+            return Err(bad(format!(
+                "gimbal_range must be > 0 rad, got {gimbal_range:?}"
+            )));
         }
         Ok(Self {
             roles,

@@ -133,7 +133,11 @@ impl FlightRecord {
             euler: euler_ned(&state.rotation),
         });
         self.recent.push_back((t, *state));
-        while self.recent.front().is_some_and(|(t0, _)| t - t0 > TRUTH_MEMORY) {
+        while self
+            .recent
+            .front()
+            .is_some_and(|(t0, _)| t - t0 > TRUTH_MEMORY)
+        {
             self.recent.pop_front();
         }
     }
@@ -284,7 +288,10 @@ impl FlightRecord {
             planned_roll_max: max(&planned.iter().map(|r| r.abs()).collect::<Vec<_>>()),
             planned_roll_mean: mean(&planned),
             pitch_max: truth.iter().map(|s| s.euler[1].abs()).fold(0.0, f64::max),
-            height_max: truth.iter().map(|s| s.position.z).fold(f64::NEG_INFINITY, f64::max),
+            height_max: truth
+                .iter()
+                .map(|s| s.position.z)
+                .fold(f64::NEG_INFINITY, f64::max),
             samples: truth.len(),
         }
     }
@@ -322,7 +329,13 @@ mod tests {
         // North from 0 to 1 m: 0.0 .. 1.2 (overshoot) .. back to 1.0 from t = 2.
         for k in 0..=300 {
             let t = k as f64 * 0.01;
-            let north = if t < 1.0 { 1.2 * t } else if t < 2.0 { 1.2 - 0.2 * (t - 1.0) } else { 1.0 };
+            let north = if t < 1.0 {
+                1.2 * t
+            } else if t < 2.0 {
+                1.2 - 0.2 * (t - 1.0)
+            } else {
+                1.0
+            };
             // tvmd x is north, z up.
             r.truth(t, &PlantState::at_rest(Vector3::new(north, 0.0, 1.5)));
         }
@@ -340,13 +353,39 @@ mod tests {
         let mut r = FlightRecord::new(home);
         // The estimator's origin 2 m north of home and 1 m up; the team 3 m north, 1.5 m up.
         let (lat, lon) = home.reproject(2.0, 0.0);
-        r.telemetry(0.0, Telemetry::Origin { latitude: lat, longitude: lon, altitude: home.altitude + 1.0 });
+        r.telemetry(
+            0.0,
+            Telemetry::Origin {
+                latitude: lat,
+                longitude: lon,
+                altitude: home.altitude + 1.0,
+            },
+        );
         r.truth(1.0, &PlantState::at_rest(Vector3::new(3.0, 0.0, 1.5)));
         // PX4 says 1.05 m north and 0.5 m up of its origin: 5 cm off.
-        r.telemetry(1.0, Telemetry::LocalPosition { t: 1.0, position: [1.05, 0.0, -0.5] });
-        r.telemetry(1.0, Telemetry::Attitude { t: 1.0, q: [1.0, 0.0, 0.0, 0.0] });
-        let w = r.window(&Window { target: None, ..window([0.0; 3]) });
-        assert!((w.ekf_position_max.unwrap() - 0.05).abs() < 1e-6, "{:?}", w.ekf_position_max);
+        r.telemetry(
+            1.0,
+            Telemetry::LocalPosition {
+                t: 1.0,
+                position: [1.05, 0.0, -0.5],
+            },
+        );
+        r.telemetry(
+            1.0,
+            Telemetry::Attitude {
+                t: 1.0,
+                q: [1.0, 0.0, 0.0, 0.0],
+            },
+        );
+        let w = r.window(&Window {
+            target: None,
+            ..window([0.0; 3])
+        });
+        assert!(
+            (w.ekf_position_max.unwrap() - 0.05).abs() < 1e-6,
+            "{:?}",
+            w.ekf_position_max
+        );
         assert!(w.ekf_attitude_max.unwrap() < 1e-6);
     }
 
@@ -359,6 +398,9 @@ mod tests {
         r.px4_state(9.0, true, 1, true);
         r.px4_state(10.0, false, 1, true);
         let e = r.events();
-        assert_eq!((e.armed, e.airborne, e.landed, e.disarmed), (Some(2.0), Some(3.0), Some(9.0), Some(10.0)));
+        assert_eq!(
+            (e.armed, e.airborne, e.landed, e.disarmed),
+            (Some(2.0), Some(3.0), Some(9.0), Some(10.0))
+        );
     }
 }

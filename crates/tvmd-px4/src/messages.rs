@@ -107,7 +107,9 @@ pub fn controls_of(message: &MavMessage) -> Option<Controls> {
             time_usec: m.time_usec,
             controls: m.controls,
             armed: m.mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED),
-            lockstep: m.flags.contains(HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP),
+            lockstep: m
+                .flags
+                .contains(HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP),
         }),
         _ => None,
     }
@@ -130,19 +132,23 @@ mod tests {
         let m = MavMessage::HIL_ACTUATOR_CONTROLS(HIL_ACTUATOR_CONTROLS_DATA {
             time_usec: 42,
             controls: [0.5; CONTROLS],
-            mode: MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            mode: MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED
+                | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
             flags: HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP,
         });
         let c = controls_of(&m).unwrap();
         assert!(c.armed && c.lockstep && c.time_usec == 42 && c.controls[15] == 0.5);
-        assert!(controls_of(&hil_gps(1, &GpsReading {
-            lat: 0,
-            lon: 0,
-            alt: 0,
-            vel_ned: [0; 3],
-            speed: 0,
-            cog: 0
-        }))
+        assert!(controls_of(&hil_gps(
+            1,
+            &GpsReading {
+                lat: 0,
+                lon: 0,
+                alt: 0,
+                vel_ned: [0; 3],
+                speed: 0,
+                cog: 0
+            }
+        ))
         .is_none());
     }
 }

@@ -9,7 +9,7 @@ use tvmd_log::RunLog;
 use tvmd_scenario::Scenario;
 use tvmd_sim::load::write_result_metadata;
 use tvmd_sim::runner::write_scenario_metadata;
-use tvmd_sim::{McapSink, RunSummary, Simulation, SimOptions, SampleRetention, TickSink, Verdict};
+use tvmd_sim::{McapSink, RunSummary, SampleRetention, SimOptions, Simulation, TickSink, Verdict};
 
 use crate::bridge::{Bridge, BridgeTiming, LockstepStats};
 use crate::flight::FlightPlan;
@@ -67,8 +67,8 @@ pub struct Px4Report {
     pub sim_time: f64,
     /// Wall time of the flight from PX4's connection (s).
     pub wall_time: f64,
-    /// The run's summary (truth against the scenario's reference).
-    pub summary: RunSummary,
+    /// The run's summary (truth against the scenario's reference); none on SIH.
+    pub summary: Option<RunSummary>,
     /// The MCAP log.
     pub log: Option<String>,
     /// PX4's ulog, copied beside the MCAP log.
@@ -144,8 +144,8 @@ pub fn fly_px4(
     result.summary.error = error.as_ref().map(ToString::to_string);
     result.summary.verdict = Verdict::judge(&result.summary, &scenario.success);
     if let Some(l) = log.as_mut() {
-        let written = write_result_metadata(l, &result)
-            .and(l.finish().map_err(tvmd_sim::SimError::from));
+        let written =
+            write_result_metadata(l, &result).and(l.finish().map_err(tvmd_sim::SimError::from));
         if let (Err(e), None) = (written, error.as_ref()) {
             error = Some(e.into());
         }
@@ -158,7 +158,12 @@ pub fn fly_px4(
     });
     let stats = bridge.stats();
     let record = bridge.record();
-    let windows = flight.plan.window.iter().map(|w| record.window(w)).collect();
+    let windows = flight
+        .plan
+        .window
+        .iter()
+        .map(|w| record.window(w))
+        .collect();
     let texts = record.texts().to_vec();
     let failsafe_texts = texts
         .iter()
@@ -180,7 +185,7 @@ pub fn fly_px4(
         lockstep: stats,
         sim_time: result.summary.time,
         wall_time,
-        summary: result.summary,
+        summary: Some(result.summary),
         log: flight.log.as_ref().map(|p| p.display().to_string()),
         ulog,
         error: error.as_ref().map(ToString::to_string),
@@ -208,4 +213,80 @@ pub fn write_report(path: &Path, report: &Px4Report) -> Result<(), Px4Error> {
     })? + "\n";
     tvmd_log::paths::write_file(path, "write the PX4 flight report", text.as_bytes())
         .map_err(|e| Px4Error::Sim(e.into()))
+}
+
+/// Flies `plan`'s script on PX4's own simulator (SIH, real time) for `duration` seconds of
+/// PX4's time: the comparison flight of a PX4 airframe without tvmd-sim. No truth reaches the
+/// bridge: the flight is measured from its ulog (PX4's ground truth topics). Returns PX4's
+/// events, texts and the ulog copied to `ulog`.
+pub fn fly_sih(
+    plan: &FlightPlan,
+    launch: &Px4Launch,
+    duration: f64,
+    ulog: &Path,
+) -> Result<Px4Report, Px4Error> {
+    let mut px4 = Px4Process::start(launch)?;
+    let mut gcs = GcsLink::new(launch.instance)?;
+    let mut script = crate::script::Script::new(plan);
+    let mut record = crate::measure::FlightRecord::new(plan.home);
+    let start = Instant::now();
+    // PX4's time: the newest time stamp of its messages.
+    let mut t = 0.0f64;
+    let mut heard = false;
+    let limit = Duration::from_secs_f64(duration * 3.0 + 120.0);
+    while t < duration {
+        if start.elapsed() > limit {
+            return Err(Px4Error::Stalled {
+                t,
+                waited: start.elapsed().as_secs_f64(),
+            });
+        }
+        px4.check_running()?;
+        for message in gcs.poll()? {
+            if let crate::gcs::Telemetry::LocalPosition { t: tm, .. }
+            | crate::gcs::Telemetry::Attitude { t: tm, .. } = message
+            {
+                t = t.max(tm);
+            }
+            record.telemetry(t, message);
+        }
+        let s = gcs.state();
+        heard |= s.heartbeats > 0;
+        record.px4_state(t, s.armed, s.landed_state, heard);
+        // Until PX4 streams its time, a heartbeat now and then makes it talk to us.
+        if t == 0.0 {
+            gcs.heartbeat()?;
+        } else {
+            script.advance(t, &mut gcs)?;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let wall_time = start.elapsed().as_secs_f64();
+    let copied = px4.stop().and_then(|u| {
+        std::fs::copy(&u, ulog)
+            .ok()
+            .map(|_| ulog.display().to_string())
+    });
+    let texts = record.texts().to_vec();
+    Ok(Px4Report {
+        scenario: "sih".into(),
+        flight: plan.description.clone(),
+        events: record.events().clone(),
+        windows: Vec::new(),
+        failsafe_texts: texts
+            .iter()
+            .filter(|(_, _, t)| t.to_lowercase().contains("failsafe"))
+            .map(|(t, _, text)| format!("{t:.2} s: {text}"))
+            .collect(),
+        texts,
+        estimator_samples: (0, 0),
+        lockstep: LockstepStats::default(),
+        realtime_factor: Some(t / wall_time),
+        sim_time: t,
+        wall_time,
+        summary: None,
+        log: None,
+        ulog: copied,
+        error: None,
+    })
 }

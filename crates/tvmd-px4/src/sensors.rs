@@ -114,7 +114,10 @@ impl SensorConfig {
                 return Err(bad(name, format!("must be > 0 Hz, got {v}")));
             }
         }
-        for (name, b) in [("gyro_bias", self.gyro_bias), ("accel_bias", self.accel_bias)] {
+        for (name, b) in [
+            ("gyro_bias", self.gyro_bias),
+            ("accel_bias", self.accel_bias),
+        ] {
             if !b.iter().all(|x| x.is_finite()) {
                 return Err(bad(name, format!("must be finite, got {b:?}")));
             }
@@ -218,9 +221,8 @@ impl SensorModel {
         let r = &state.rotation;
         let gravity = Vector3::new(0.0, 0.0, -GRAVITY);
         let specific = flip(&(r.transpose() * (accel - gravity)));
-        let accel_frd = specific
-            + Vector3::from(self.config.accel_bias)
-            + self.noise3(self.config.accel_noise);
+        let accel_frd =
+            specific + Vector3::from(self.config.accel_bias) + self.noise3(self.config.accel_noise);
         let gyro_frd = flip(&state.omega)
             + Vector3::from(self.config.gyro_bias)
             + self.noise3(self.config.gyro_noise);
@@ -235,8 +237,8 @@ impl SensorModel {
         };
         if mag_baro {
             let frd_to_ned: Matrix3<f64> = rotation_ned_frd(r);
-            let mag = frd_to_ned.transpose() * self.home.field_ned()
-                + self.noise3(self.config.mag_noise);
+            let mag =
+                frd_to_ned.transpose() * self.home.field_ned() + self.noise3(self.config.mag_noise);
             let altitude = self.home.altitude + state.position.z;
             let (pressure, temperature) = standard_atmosphere(altitude);
             reading.mag = f32x3(&mag);
@@ -252,7 +254,11 @@ impl SensorModel {
     pub fn gps(&mut self, state: &PlantState) -> GpsReading {
         let h = self.config.gps_horizontal_noise;
         let p_ned = flip(&state.position)
-            + Vector3::new(self.noise(h), self.noise(h), self.noise(self.config.gps_vertical_noise));
+            + Vector3::new(
+                self.noise(h),
+                self.noise(h),
+                self.noise(self.config.gps_vertical_noise),
+            );
         let v_ned = flip(&state.velocity) + self.noise3(self.config.gps_velocity_noise);
         let (lat, lon) = self.home.reproject(p_ned.x, p_ned.y);
         GpsReading {
@@ -335,12 +341,23 @@ mod tests {
     #[test]
     fn resting_level_team_reads_minus_g_down_and_the_field_of_home() {
         let mut s = quiet();
-        let r = s.imu(&PlantState::at_rest(Vector3::zeros()), &Vector3::zeros(), true);
+        let r = s.imu(
+            &PlantState::at_rest(Vector3::zeros()),
+            &Vector3::zeros(),
+            true,
+        );
         assert_eq!(r.accel, [0.0, 0.0, -GRAVITY as f32]);
         assert_eq!(r.gyro, [0.0; 3]);
         let b = Home::default().magnetic_field_ned;
-        assert!(r.mag.iter().zip(b).all(|(m, b)| (f64::from(*m) - b).abs() < 1e-6));
-        assert_eq!(r.fields_updated, fields::ACCEL | fields::GYRO | fields::MAG | fields::BARO);
+        assert!(r
+            .mag
+            .iter()
+            .zip(b)
+            .all(|(m, b)| (f64::from(*m) - b).abs() < 1e-6));
+        assert_eq!(
+            r.fields_updated,
+            fields::ACCEL | fields::GYRO | fields::MAG | fields::BARO
+        );
         // The pressure of home's altitude.
         let (p, _) = standard_atmosphere(488.0);
         assert!((f64::from(r.pressure) - p).abs() < 1e-3);
@@ -351,8 +368,16 @@ mod tests {
         let mut s = quiet();
         let low = PlantState::at_rest(Vector3::zeros());
         let high = PlantState::at_rest(Vector3::new(0.0, 0.0, 10.0));
-        let (a, b) = (s.imu(&low, &Vector3::zeros(), true), s.imu(&high, &Vector3::zeros(), true));
-        assert!(a.pressure - b.pressure > 1.0, "{} {}", a.pressure, b.pressure);
+        let (a, b) = (
+            s.imu(&low, &Vector3::zeros(), true),
+            s.imu(&high, &Vector3::zeros(), true),
+        );
+        assert!(
+            a.pressure - b.pressure > 1.0,
+            "{} {}",
+            a.pressure,
+            b.pressure
+        );
         assert_eq!(s.gps(&high).alt - s.gps(&low).alt, 10_000);
     }
 
@@ -416,7 +441,10 @@ mod tests {
             baro_noise: -1.0,
             ..Default::default()
         };
-        let e = SensorModel::new(config, Home::default()).err().unwrap().to_string();
+        let e = SensorModel::new(config, Home::default())
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("sensors.baro_noise"), "{e}");
     }
 }

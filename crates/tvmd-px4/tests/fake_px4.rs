@@ -80,7 +80,9 @@ fn fake_px4(port: u16, throttle: f32, answer: usize, then: Then) -> (f32, f32, u
     loop {
         let message = match reader.read_any_message::<MavMessage>() {
             Ok((_, m)) => m,
-            Err(mavlink::error::MessageReadError::Io(e)) if e.kind() == ErrorKind::UnexpectedEof => {
+            Err(mavlink::error::MessageReadError::Io(e))
+                if e.kind() == ErrorKind::UnexpectedEof =>
+            {
                 return (first, last, answered)
             }
             Err(e) => panic!("fake PX4 read: {e:?}"),
@@ -110,7 +112,11 @@ fn fake_px4(port: u16, throttle: f32, answer: usize, then: Then) -> (f32, f32, u
             mode: MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
             flags: HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP,
         });
-        let header = MavHeader { system_id: 1, component_id: 1, sequence: 0 };
+        let header = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 0,
+        };
         if mavlink::write_versioned_msg(&mut writer, MavlinkVersion::V2, header, &reply).is_err() {
             return (first, last, answered);
         }
@@ -118,7 +124,12 @@ fn fake_px4(port: u16, throttle: f32, answer: usize, then: Then) -> (f32, f32, u
     }
 }
 
-fn fly(f: Px4Flight, throttle: f32, answer: usize, then: Then) -> (Px4Report, Option<Px4Error>, (f32, f32, usize)) {
+fn fly(
+    f: Px4Flight,
+    throttle: f32,
+    answer: usize,
+    then: Then,
+) -> (Px4Report, Option<Px4Error>, (f32, f32, usize)) {
     let port = 4560 + u16::from(f.instance);
     let px4 = thread::spawn(move || fake_px4(port, throttle, answer, then));
     let (report, error) = fly_px4(&f, &mut |_| {}).expect("the flight starts");
@@ -129,8 +140,12 @@ fn fly(f: Px4Flight, throttle: f32, answer: usize, then: Then) -> (Px4Report, Op
 fn lockstep_flight_climbs_on_px4s_throttle_and_logs_every_tick() {
     let log = temp_log("lockstep");
     // 0.6 of each agent's sigma_Tf = 2 m_i g lifts the team at 0.2 g.
-    let (report, error, (first, last, answered)) =
-        fly(flight(201, 2.0, Some(log.clone())), 0.6, usize::MAX, Then::Fly);
+    let (report, error, (first, last, answered)) = fly(
+        flight(201, 2.0, Some(log.clone())),
+        0.6,
+        usize::MAX,
+        Then::Fly,
+    );
     assert!(error.is_none(), "{error:?}");
     // Every tick answered in lockstep: 2 s at 250 Hz.
     assert_eq!(answered, 500);
@@ -141,7 +156,7 @@ fn lockstep_flight_climbs_on_px4s_throttle_and_logs_every_tick() {
     assert!((first + 9.81).abs() < 0.2, "{first}");
     assert!((last + 1.2 * 9.81).abs() < 0.3, "{last}");
     // 0.2 g for 2 s: about 3.9 m up.
-    let z = report.summary.final_position[2];
+    let z = report.summary.as_ref().unwrap().final_position[2];
     assert!((z - 3.9).abs() < 0.3, "{z}");
     let run = tvmd_log::read_run(&log).unwrap();
     assert_eq!(run.ticks.len(), 500);
@@ -155,7 +170,10 @@ fn px4_killed_mid_flight_ends_the_run_naming_px4_with_a_readable_log() {
         fly(flight(202, 5.0, Some(log.clone())), 0.55, 100, Then::Die);
     assert_eq!(answered, 100);
     let error = error.expect("the run must fail").to_string();
-    assert!(error.contains("PX4 closed the simulator connection"), "{error}");
+    assert!(
+        error.contains("PX4 closed the simulator connection"),
+        "{error}"
+    );
     assert!(report.error.as_deref() == Some(error.as_str()));
     assert!((report.sim_time - 0.4).abs() < 0.01, "{}", report.sim_time);
     let run = tvmd_log::read_run(&log).unwrap();
@@ -169,7 +187,10 @@ fn px4_hung_mid_flight_is_a_stall_with_a_readable_log() {
     let log = temp_log("stalled");
     let (report, error, _) = fly(flight(203, 5.0, Some(log.clone())), 0.55, 50, Then::Hang);
     let error = error.expect("the run must fail").to_string();
-    assert!(error.contains("PX4 stalled") && error.contains("t = 0.200 s"), "{error}");
+    assert!(
+        error.contains("PX4 stalled") && error.contains("t = 0.200 s"),
+        "{error}"
+    );
     assert!((report.sim_time - 0.2).abs() < 0.01);
     assert_eq!(tvmd_log::read_run(&log).unwrap().ticks.len(), 50);
     std::fs::remove_file(&log).ok();
@@ -183,7 +204,10 @@ fn px4_that_never_connects_is_named() {
         Err(e) => e.to_string(),
         Ok(_) => panic!("nothing connected"),
     };
-    assert!(error.contains("PX4 did not connect to TCP port 4764"), "{error}");
+    assert!(
+        error.contains("PX4 did not connect to TCP port 4764"),
+        "{error}"
+    );
 }
 
 #[test]
@@ -194,7 +218,10 @@ fn a_port_in_use_is_a_clear_error() {
         Err(e) => e.to_string(),
         Ok(_) => panic!("the port is taken"),
     };
-    assert!(error.contains("cannot listen for PX4 on TCP port 4765"), "{error}");
+    assert!(
+        error.contains("cannot listen for PX4 on TCP port 4765"),
+        "{error}"
+    );
     assert!(error.contains("--instance"), "{error}");
     drop(taken);
 }
