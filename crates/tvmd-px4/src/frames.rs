@@ -22,10 +22,11 @@ pub fn rotation_ned_frd(r: &Matrix3<f64>) -> Matrix3<f64> {
 }
 
 /// PX4's attitude quaternion `[w, x, y, z]` (FRD to NED, Hamilton, as HIL_STATE_QUATERNION and
-/// `vehicle_attitude.q`) of the tvmd attitude `R`. Re-orthonormalised first: rapier's
-/// rotation drifts from orthonormal by round-off only.
+/// `vehicle_attitude.q`) of the tvmd attitude `R`, in closed form (rapier's rotation is
+/// orthonormal to round-off; nalgebra's iterative `from_matrix` never ends on a non-finite
+/// matrix, this gives NaN).
 pub fn quaternion_ned_frd(r: &Matrix3<f64>) -> [f64; 4] {
-    let rotation = Rotation3::from_matrix(&rotation_ned_frd(r));
+    let rotation = Rotation3::from_matrix_unchecked(rotation_ned_frd(r));
     let q = UnitQuaternion::from_rotation_matrix(&rotation);
     // One sign: w >= 0 (q and -q are the same attitude).
     let s = if q.w < 0.0 { -1.0 } else { 1.0 };
@@ -41,8 +42,26 @@ pub fn rotation_of_px4_quaternion(q: [f64; 4]) -> Matrix3<f64> {
 /// Roll, pitch, yaw (rad, ZYX) of PX4's FRD-to-NED rotation of the tvmd attitude `R`: the
 /// Euler angles a PX4 user reads (yaw from north, clockwise seen from above).
 pub fn euler_ned(r: &Matrix3<f64>) -> [f64; 3] {
-    let (roll, pitch, yaw) = Rotation3::from_matrix(&rotation_ned_frd(r)).euler_angles();
+    // Read off the matrix (ZYX): no iteration, so a non-finite matrix gives NaN, never a hang.
+    let m = rotation_ned_frd(r);
+    let roll = m[(2, 1)].atan2(m[(2, 2)]);
+    let pitch = -m[(2, 0)].clamp(-1.0, 1.0).asin();
+    let yaw = m[(1, 0)].atan2(m[(0, 0)]);
     [roll, pitch, yaw]
+}
+
+/// The angle (rad) of the rotation between two attitudes `a` and `b` (any frames, the same
+/// for both), from the trace of `a^T b`.
+pub fn angle_between(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+    let c = ((a.transpose() * b).trace() - 1.0) / 2.0;
+    c.clamp(-1.0, 1.0).acos()
+}
+
+/// True if `q` is a usable attitude quaternion: finite, of a norm near one (PX4 sends NaN or
+/// zeros for an unset setpoint).
+pub fn is_attitude(q: &[f64; 4]) -> bool {
+    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    q.iter().all(|c| c.is_finite()) && (n - 1.0).abs() < 0.1
 }
 
 #[cfg(test)]
@@ -84,6 +103,18 @@ mod tests {
         // A yaw to the left (counter-clockwise from above, about +z up) is a negative PX4 yaw.
         let yaw = Rotation3::from_axis_angle(&Vector3::z_axis(), a);
         assert!(close(&euler_ned(yaw.matrix()), &[0.0, 0.0, -a]));
+    }
+
+    #[test]
+    fn unset_attitudes_are_recognised_and_never_hang() {
+        assert!(!is_attitude(&[f64::NAN, 0.0, 0.0, 0.0]));
+        assert!(!is_attitude(&[0.0; 4]));
+        assert!(is_attitude(&[1.0, 0.0, 0.0, 0.0]));
+        let nan = Matrix3::from_element(f64::NAN);
+        assert!(euler_ned(&nan)[0].is_nan());
+        assert!(quaternion_ned_frd(&nan).iter().all(|c| c.is_finite() || c.is_nan()));
+        let a = Rotation3::from_euler_angles(0.1, 0.0, 0.0);
+        assert!((angle_between(a.matrix(), &Matrix3::identity()) - 0.1).abs() < 1e-12);
     }
 
     #[test]

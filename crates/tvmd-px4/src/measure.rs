@@ -3,12 +3,12 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Vector3;
 use serde::Serialize;
 use tvmd_plant::physics::PlantState;
 
 use crate::flight::Window;
-use crate::frames::{euler_ned, flip, rotation_of_px4_quaternion};
+use crate::frames::{angle_between, euler_ned, flip, is_attitude, rotation_of_px4_quaternion};
 use crate::gcs::Telemetry;
 use crate::geo::Home;
 
@@ -191,11 +191,12 @@ impl FlightRecord {
                 let error = Vector3::from(position) - truth_local;
                 self.position_errors.push(PositionError { t, error });
             }
+            // PX4 sends NaN or zero quaternions for unset attitudes: not measured.
+            Telemetry::Attitude { q, .. } | Telemetry::AttitudeTarget { q, .. } if !is_attitude(&q) => {}
             Telemetry::Attitude { t, q } => {
                 if let Some(truth) = self.truth_at(t) {
                     let estimate = rotation_of_px4_quaternion(q);
-                    let relative = Rotation3::from_matrix(&(estimate.transpose() * truth.rotation));
-                    self.attitude_errors.push((t, relative.angle()));
+                    self.attitude_errors.push((t, angle_between(&estimate, &truth.rotation)));
                 }
             }
             Telemetry::AttitudeTarget { t, q } => {
@@ -387,6 +388,8 @@ mod tests {
             w.ekf_position_max
         );
         assert!(w.ekf_attitude_max.unwrap() < 1e-6);
+        assert_eq!(r.matched(), (1, 1));
+        assert!(w.planned_roll_max.is_none());
     }
 
     #[test]
