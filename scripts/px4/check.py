@@ -27,7 +27,7 @@ def main():
     if a.compare:
         print(f"{'measure':<28} {'tvmd-sim':>10} {'SIH':>10}")
         for window in ("hover", "step"):
-            for key in ("hold_max", "hold_rms", "settling_time", "rise_time_90", "overshoot", "ekf_position_max",
+            for key in ("hold_max", "hold_rms", "hold_rms_estimated", "settling_time", "rise_time_90", "overshoot", "ekf_position_max",
                         "ekf_attitude_max", "roll_std"):
                 x, y = first.get(window, {}).get(key), second.get(window, {}).get(key)
                 if x is None and y is None:

@@ -288,5 +288,9 @@ mod tests {
         assert!(err("[[step]]\nat = 1.0\naction = \"fly\"").contains("flight file"));
         assert!(err("[[window]]\nname = \"w\"\nfrom = 2.0\nto = 1.0").contains("window[0]"));
         assert!(err("[[step]]\nat = 1.0\naction = \"sticks\"\nroll = 2.0").contains("sticks"));
+        // A misspelt key of an action is refused, not ignored.
+        assert!(
+            err("[[step]]\nat = 1.0\naction = \"takeoff\"\naltitud = 1.5").contains("flight file")
+        );
     }
 }

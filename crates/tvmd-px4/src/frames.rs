@@ -112,7 +112,9 @@ mod tests {
         assert!(is_attitude(&[1.0, 0.0, 0.0, 0.0]));
         let nan = Matrix3::from_element(f64::NAN);
         assert!(euler_ned(&nan)[0].is_nan());
-        assert!(quaternion_ned_frd(&nan).iter().all(|c| c.is_finite() || c.is_nan()));
+        assert!(quaternion_ned_frd(&nan)
+            .iter()
+            .all(|c| c.is_finite() || c.is_nan()));
         let a = Rotation3::from_euler_angles(0.1, 0.0, 0.0);
         assert!((angle_between(a.matrix(), &Matrix3::identity()) - 0.1).abs() < 1e-12);
     }

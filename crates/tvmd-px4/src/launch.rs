@@ -86,11 +86,15 @@ impl Px4Process {
             let what = format!("PX4 start: {what}");
             move |source| Px4Error::Link { what, source }
         };
-        let work = &launch.work_dir;
-        if work.exists() {
-            std::fs::remove_dir_all(work).map_err(io("clear the working directory"))?;
+        if launch.work_dir.exists() {
+            std::fs::remove_dir_all(&launch.work_dir).map_err(io("clear the working directory"))?;
         }
-        std::fs::create_dir_all(work).map_err(io("make the working directory"))?;
+        std::fs::create_dir_all(&launch.work_dir).map_err(io("make the working directory"))?;
+        // Absolute paths: PX4 changes into its working directory, where a relative hook
+        // directory on its PATH (the flight's parameters) or data path would not resolve.
+        let work = &std::fs::canonicalize(&launch.work_dir)
+            .map_err(io("resolve the working directory"))?;
+        let tree = std::fs::canonicalize(&launch.tree).map_err(io("resolve the PX4 tree"))?;
         let hooks = work.join("hooks");
         std::fs::create_dir_all(&hooks).map_err(io("make the hook directory"))?;
         let mut params = String::from("#!/bin/sh\n# The flight's parameters (tvmd-sim px4).\n");
@@ -111,7 +115,7 @@ impl Px4Process {
             .arg(launch.instance.to_string())
             .arg("-w")
             .arg(work.join("rootfs"))
-            .arg(launch.tree.join("build/px4_sitl_default/etc"))
+            .arg(tree.join("build/px4_sitl_default/etc"))
             .env("PATH", format!("{}:{path}", hooks.display()))
             .env("PX4_SYS_AUTOSTART", launch.autostart.to_string())
             // An external simulator on simulator_mavlink: neither SIH nor Gazebo.
@@ -137,7 +141,7 @@ impl Px4Process {
             .map_err(io(&format!("run {}", binary.display())))?;
         Ok(Self {
             child,
-            work_dir: work.clone(),
+            work_dir: work.to_path_buf(),
         })
     }
 

@@ -192,11 +192,13 @@ impl FlightRecord {
                 self.position_errors.push(PositionError { t, error });
             }
             // PX4 sends NaN or zero quaternions for unset attitudes: not measured.
-            Telemetry::Attitude { q, .. } | Telemetry::AttitudeTarget { q, .. } if !is_attitude(&q) => {}
+            Telemetry::Attitude { q, .. } | Telemetry::AttitudeTarget { q, .. }
+                if !is_attitude(&q) => {}
             Telemetry::Attitude { t, q } => {
                 if let Some(truth) = self.truth_at(t) {
                     let estimate = rotation_of_px4_quaternion(q);
-                    self.attitude_errors.push((t, angle_between(&estimate, &truth.rotation)));
+                    self.attitude_errors
+                        .push((t, angle_between(&estimate, &truth.rotation)));
                 }
             }
             Telemetry::AttitudeTarget { t, q } => {
