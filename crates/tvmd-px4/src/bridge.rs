@@ -133,13 +133,13 @@ impl Bridge {
         let time = time_usec(t);
         let imu = self
             .sensors
-            .imu(state, &accel, self.tick % self.every[0] == 0);
+            .imu(state, &accel, self.tick.is_multiple_of(self.every[0]));
         self.link.send(&hil_sensor(time, &imu))?;
-        if self.tick % self.every[1] == 0 {
+        if self.tick.is_multiple_of(self.every[1]) {
             let gps = self.sensors.gps(state);
             self.link.send(&hil_gps(time, &gps))?;
         }
-        if self.tick % self.every[2] == 0 {
+        if self.tick.is_multiple_of(self.every[2]) {
             let truth = self.sensors.truth(state, &accel);
             self.link.send(&hil_state(time, &truth))?;
         }

@@ -257,7 +257,6 @@ impl GcsLink {
             z: (throttle.clamp(0.0, 1.0) * 1000.0).round() as i16,
             r: s(yaw),
             buttons: 0,
-            ..Default::default()
         }))
     }
 
@@ -280,7 +279,7 @@ impl GcsLink {
             let datagram = self.buffer[..n].to_vec();
             let mut reader = MavlinkReader::new(datagram.as_slice());
             while let Ok((header, message)) = reader.read_any_message::<MavMessage>() {
-                if u32::from(header.system_id) != u32::from(self.system) {
+                if header.system_id != u32::from(self.system) {
                     continue;
                 }
                 if let Some(t) = self.keep(&message, header.component_id) {

@@ -86,8 +86,8 @@ impl Listener {
 
 /// What a read from PX4 gave.
 pub enum Received {
-    /// A message.
-    Message(MavMessage),
+    /// A message (boxed: a MAVLink message is up to 280 bytes).
+    Message(Box<MavMessage>),
     /// Nothing before the deadline.
     Timeout,
     /// PX4 closed the connection.
@@ -150,7 +150,7 @@ impl SimLink {
     pub fn recv_until(&mut self, deadline: Instant) -> Result<Received, Px4Error> {
         loop {
             match self.reader.read_any_message::<MavMessage>() {
-                Ok((_, message)) => return Ok(Received::Message(message)),
+                Ok((_, message)) => return Ok(Received::Message(Box::new(message))),
                 Err(MessageReadError::Io(e))
                     if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) =>
                 {

@@ -41,7 +41,6 @@ pub fn hil_sensor(time: u64, r: &ImuReading) -> MavMessage {
         pressure_alt: r.pressure_alt,
         temperature: r.temperature,
         fields_updated: HilSensorUpdatedFlags::from_bits_truncate(r.fields_updated),
-        ..Default::default()
     })
 }
 
@@ -61,7 +60,6 @@ pub fn hil_gps(time: u64, g: &GpsReading) -> MavMessage {
         vd: g.vel_ned[2],
         cog: g.cog,
         satellites_visible: 10,
-        ..Default::default()
     })
 }
 
