@@ -349,3 +349,40 @@ fn a_reference_table_without_kind_is_the_paper_tilt() {
     let t = s.reference.at(3.0).position;
     assert!((t[2] - 1.0).abs() < 1e-12, "{t:?}");
 }
+
+/// `tvmd-sim px4` with a PX4 tree that does not exist, or is not built: a clear error naming
+/// the tree before anything listens or flies, and no log.
+#[test]
+fn px4_with_a_missing_or_unbuilt_tree_is_refused() {
+    let dir = tmp_dir("px4-tree");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let fly = |tree: &Path| {
+        bin()
+            .current_dir(&root)
+            .args([
+                "px4",
+                "scripts/px4/quad/scenario.toml",
+                "--flight",
+                "scripts/px4/quad/flight.toml",
+            ])
+            .arg("--px4-dir")
+            .arg(tree)
+            .arg("--out")
+            .arg(dir.join("px4.mcap"))
+            .output()
+            .unwrap()
+    };
+    let missing = dir.join("no-such-px4");
+    let err = failure(&fly(&missing));
+    assert!(err.contains("no-such-px4: no such directory"), "{err}");
+    let unbuilt = dir.join("unbuilt");
+    std::fs::create_dir_all(unbuilt.join("ROMFS/px4fmu_common/init.d-posix")).unwrap();
+    std::fs::write(unbuilt.join("ROMFS/px4fmu_common/init.d-posix/rcS"), "").unwrap();
+    let err = failure(&fly(&unbuilt));
+    assert!(
+        err.contains("PX4 SITL is not built") && err.contains("make px4_sitl_default"),
+        "{err}"
+    );
+    assert!(!dir.join("px4.mcap").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
