@@ -165,11 +165,7 @@ pub fn fly_px4(
         .map(|w| record.window(w))
         .collect();
     let texts = record.texts().to_vec();
-    let failsafe_texts = texts
-        .iter()
-        .filter(|(_, _, t)| t.to_lowercase().contains("failsafe"))
-        .map(|(t, _, text)| format!("{t:.2} s: {text}"))
-        .collect();
+    let failsafe_texts = failsafe_texts(&texts);
     let report = Px4Report {
         scenario: scenario.name.clone(),
         flight: flight.plan.description.clone(),
@@ -191,6 +187,15 @@ pub fn fly_px4(
         error: error.as_ref().map(ToString::to_string),
     };
     Ok((report, error))
+}
+
+/// PX4's status texts that name a failsafe, with their times.
+fn failsafe_texts(texts: &[(f64, u8, String)]) -> Vec<String> {
+    texts
+        .iter()
+        .filter(|(_, _, t)| t.to_lowercase().contains("failsafe"))
+        .map(|(t, _, text)| format!("{t:.2} s: {text}"))
+        .collect()
 }
 
 /// The bridge's own error out of the loop's controller error, so that the message names PX4
@@ -273,11 +278,7 @@ pub fn fly_sih(
         flight: plan.description.clone(),
         events: record.events().clone(),
         windows: Vec::new(),
-        failsafe_texts: texts
-            .iter()
-            .filter(|(_, _, t)| t.to_lowercase().contains("failsafe"))
-            .map(|(t, _, text)| format!("{t:.2} s: {text}"))
-            .collect(),
+        failsafe_texts: failsafe_texts(&texts),
         texts,
         estimator_samples: (0, 0),
         lockstep: LockstepStats::default(),
