@@ -67,6 +67,19 @@ bool TvmdControl::init()
 		return false;
 	}
 
+	/* PX4's takeoff timing: COM_SPOOLUP_TIME, MPC_TKO_RAMP_T (defaults where a build lacks them). */
+	float spoolup = 1.f, ramp = 3.f;
+	const param_t spoolup_param = param_find("COM_SPOOLUP_TIME"), ramp_param = param_find("MPC_TKO_RAMP_T");
+
+	if (spoolup_param != PARAM_INVALID) { param_get(spoolup_param, &spoolup); }
+
+	if (ramp_param != PARAM_INVALID) { param_get(ramp_param, &ramp); }
+
+	_takeoff.setSpoolupTime(spoolup);
+	_takeoff.setTakeoffRampTime(ramp);
+	_takeoff_status_pub.advertise();
+	_status_pub.advertise();
+
 	const int32_t law_hz = _param_law_hz.get();
 	_law_position_sub.set_interval_us(static_cast<uint32_t>(1000000 / (law_hz > 0 ? law_hz : 100)));
 
@@ -141,12 +154,8 @@ bool TvmdControl::apply_parameters()
 	return true;
 }
 
-void TvmdControl::update_landed()
+void TvmdControl::set_landed(bool landed)
 {
-	_control_mode_sub.update(&_control_mode);
-	_land_detected_sub.update(&_land_detected);
-	const bool landed = !_control_mode.flag_armed || _land_detected.landed;
-
 	if (landed != _landed) {
 		const TvmdStatus status = tvmd_set_landed(&_controller, landed ? 1 : 0);
 		_log.record(tvmd_control::LANDED, status);
@@ -155,10 +164,44 @@ void TvmdControl::update_landed()
 			_landed = landed;
 		}
 	}
+}
+
+bool TvmdControl::update_takeoff(hrt_abstime timestamp_sample)
+{
+	_vehicle_constraints_sub.update(&_constraints);
+	const float speed_up = std::isfinite(_constraints.speed_up) && _constraints.speed_up > 0.f ? _constraints.speed_up : 1.f;
+	_takeoff.updateTakeoffState(_control_mode.flag_armed, _land_detected.landed, _constraints.want_takeoff, speed_up,
+				    false, timestamp_sample);
+	const float dt = _last_law_sample != 0 && timestamp_sample > _last_law_sample
+			 ? static_cast<float>(timestamp_sample - _last_law_sample) * 1e-6f : 0.f;
+	_last_law_sample = timestamp_sample;
+	_takeoff.updateRamp(dt < 0.1f ? dt : 0.1f, speed_up);
+
+	const uint8_t state = static_cast<uint8_t>(_takeoff.getTakeoffState());
+
+	if (state != _takeoff_status_pub.get().takeoff_state) {
+		_takeoff_status_pub.get().takeoff_state = state;
+		_takeoff_status_pub.get().tilt_limit = NAN;
+		_takeoff_status_pub.get().timestamp = hrt_absolute_time();
+		_takeoff_status_pub.update();
+	}
+
+	/* Until the ramp-up the team stands on the ground: landed for the offset-free state (the
+	 * ground's reaction is no disturbance), idle commands, no law. */
+	const bool taken_off = _takeoff.getTakeoffState() >= TakeoffState::rampup;
+	set_landed(!taken_off);
+
+	if (!taken_off && !_ground_idle) {
+		_log.record(tvmd_control::LAW, tvmd_reset(&_controller));  // the held command becomes idle
+	}
+
+	_ground_idle = !taken_off;
 
 	if (!_control_mode.flag_armed) {
 		_land_requested = false;
 	}
+
+	return taken_off;
 }
 
 void TvmdControl::update_failures()
@@ -225,13 +268,20 @@ TvmdReference TvmdControl::reference_for(const vehicle_local_position_s &lp, con
 		_have_reference_position = true;
 	}
 
+	/* With the sticks on the attitude (TVMD_RC_TILT), their tilt is the reference attitude,
+	 * not a horizontal acceleration: PX4's altitude mode turns stick tilt into an acceleration
+	 * setpoint for a multicopter, which a team that tilts in place must not follow. */
+	const bool sticks_on_attitude = _param_rc_tilt.get() > 0.f && _control_mode.flag_control_manual_enabled
+					&& !pose_fresh;
 	trajectory_setpoint_s sp{};
 
 	for (int i = 0; i < 3; ++i) {
+		const bool horizontal_by_sticks = sticks_on_attitude && i < 2;
 		sp.position[i] = _reference_position_ned[i];
-		sp.velocity[i] = std::isfinite(_trajectory_setpoint.velocity[i]) && !_landed ? _trajectory_setpoint.velocity[i] : 0.f;
-		sp.acceleration[i] = std::isfinite(_trajectory_setpoint.acceleration[i])
-				     && !_landed ? _trajectory_setpoint.acceleration[i] : 0.f;
+		sp.velocity[i] = std::isfinite(_trajectory_setpoint.velocity[i]) && !_landed && !horizontal_by_sticks
+				 ? _trajectory_setpoint.velocity[i] : 0.f;
+		sp.acceleration[i] = std::isfinite(_trajectory_setpoint.acceleration[i]) && !_landed && !horizontal_by_sticks
+				     ? _trajectory_setpoint.acceleration[i] : 0.f;
 	}
 
 	/* Attitude: the pose setpoint's, else the sticks' roll and pitch (TVMD_RC_TILT), at the
@@ -272,6 +322,10 @@ void TvmdControl::run_law()
 
 	if (!_have_attitude || !_have_angular_velocity || !lp.xy_valid || !lp.z_valid || !lp.v_xy_valid || !lp.v_z_valid) {
 		return;  // no estimate yet: nothing to control
+	}
+
+	if (!update_takeoff(lp.timestamp_sample)) {
+		return;  // on the ground: idle (the rate loop sends the held idle commands)
 	}
 
 	perf_begin(_law_perf);
@@ -348,7 +402,8 @@ void TvmdControl::Run()
 
 	_have_attitude |= _attitude_sub.update(&_attitude);
 	_have_local_position |= _local_position_sub.update(&_local_position);
-	update_landed();
+	_control_mode_sub.update(&_control_mode);
+	_land_detected_sub.update(&_land_detected);
 
 	if (!_have_attitude || !_have_local_position || !_have_angular_velocity) {
 		perf_end(_rate_perf);
@@ -360,6 +415,19 @@ void TvmdControl::Run()
 	TvmdAllocationOutput alloc;
 	std::memset(&alloc, 0, sizeof(alloc));
 	alloc.size = sizeof(alloc);
+
+	if (_ground_idle) {
+		/* On the ground before the ramp-up: the held commands, idle since tvmd_reset (the
+		 * fallback of tvmd_allocate without a wrench; its status says only that). */
+		tvmd_allocate(&_controller, nullptr, &alloc);
+		alloc.status = TVMD_OK;
+		publish_outputs(alloc, _angular_velocity.timestamp_sample);
+		_rate_timer.end();
+		publish_status(alloc, _angular_velocity.timestamp_sample);
+		perf_end(_rate_perf);
+		return;
+	}
+
 	const TvmdStatus status = _cascade.attitude_and_allocate(state, &alloc);
 
 	if (status != TVMD_OK && !_cascade.has_law() && status == TVMD_ERR_NOT_INITIALIZED) {
@@ -407,8 +475,11 @@ void TvmdControl::publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime
 	if (status == TVMD_OK && alloc.status == TVMD_OK && scale > 0.f) {
 		vehicle_thrust_setpoint_s thrust{};
 		thrust.timestamp_sample = timestamp_sample;
-		float frd[3];
-		flipped(alloc.allocated_force, frd);
+		float frd[3] {};
+
+		if (!_ground_idle) {
+			flipped(alloc.allocated_force, frd);
+		}
 
 		for (int i = 0; i < 3; ++i) { thrust.xyz[i] = frd[i] / scale; }
 

@@ -22,16 +22,20 @@
 #include <uORB/topics/failure_detector_status.h>
 #include <uORB/topics/manual_control_setpoint.h>
 #include <uORB/topics/parameter_update.h>
+#include <uORB/topics/takeoff_status.h>
 #include <uORB/topics/trajectory_setpoint.h>
 #include <uORB/topics/tvmd_control_status.h>
 #include <uORB/topics/tvmd_pose_setpoint.h>
 #include <uORB/topics/vehicle_angular_velocity.h>
 #include <uORB/topics/vehicle_attitude.h>
 #include <uORB/topics/vehicle_command.h>
+#include <uORB/topics/vehicle_constraints.h>
 #include <uORB/topics/vehicle_control_mode.h>
 #include <uORB/topics/vehicle_land_detected.h>
 #include <uORB/topics/vehicle_local_position.h>
 #include <uORB/topics/vehicle_thrust_setpoint.h>
+
+#include <Takeoff.hpp>
 
 #include "CycleTimer.hpp"
 #include "StatusLog.hpp"
@@ -74,7 +78,10 @@ private:
 	/* Parameters to a configuration; applied all or nothing, a refused one reported and the
 	 * last good one kept. Returns whether a controller is running. */
 	bool apply_parameters();
-	void update_landed();
+	/* PX4's takeoff (mc_pos_control's TakeoffHandling): idle on the ground until the flight
+	 * mode asks for a takeoff, then the law. Returns whether the law flies. */
+	bool update_takeoff(hrt_abstime timestamp_sample);
+	void set_landed(bool landed);
 	void update_failures();
 	TvmdReference reference_for(const vehicle_local_position_s &lp, const vehicle_attitude_s &att);
 	void publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample);
@@ -101,6 +108,7 @@ private:
 	uORB::Subscription _control_mode_sub{ORB_ID(vehicle_control_mode)};
 	uORB::Subscription _land_detected_sub{ORB_ID(vehicle_land_detected)};
 	uORB::Subscription _failure_detector_sub{ORB_ID(failure_detector_status)};
+	uORB::Subscription _vehicle_constraints_sub{ORB_ID(vehicle_constraints)};
 
 	uORB::Publication<actuator_motors_s> _motors_pub{ORB_ID(actuator_motors)};
 	uORB::Publication<actuator_servos_s> _servos_pub{ORB_ID(actuator_servos)};
@@ -108,6 +116,12 @@ private:
 	uORB::Publication<tvmd_pose_setpoint_s> _pose_pub{ORB_ID(tvmd_pose_setpoint)};
 	uORB::Publication<vehicle_command_s> _command_pub{ORB_ID(vehicle_command)};
 	uORB::Publication<vehicle_thrust_setpoint_s> _thrust_pub{ORB_ID(vehicle_thrust_setpoint)};
+	uORB::PublicationData<takeoff_status_s> _takeoff_status_pub{ORB_ID(takeoff_status)};
+
+	TakeoffHandling _takeoff{};
+	vehicle_constraints_s _constraints{};
+	hrt_abstime _last_law_sample{0};
+	bool _ground_idle{true};  // not taken off: idle commands, no law
 
 	vehicle_attitude_s _attitude{};
 	vehicle_local_position_s _local_position{};
