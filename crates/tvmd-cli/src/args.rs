@@ -186,6 +186,46 @@ pub enum Command {
         /// Built-in scenario name.
         name: String,
     },
+    /// Serve PX4 SITL as its simulator (simulator_mavlink, lockstep) and fly a flight file's
+    /// script with it (docs/px4.md).
+    Px4(Px4Args),
+}
+
+/// Arguments of `tvmd-sim px4`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Px4Args {
+    /// A built-in scenario name or a TOML file (team, plant, disturbances, duration; its
+    /// controller period is PX4's sensor period).
+    pub scenario: String,
+    /// The flight file: script, control mapping, sensors, measured windows.
+    #[arg(long)]
+    pub flight: PathBuf,
+    /// MCAP log to write (PX4's ulog is copied beside it as .ulg; the report as .px4.json).
+    #[arg(long, default_value = "out/px4.mcap")]
+    pub out: PathBuf,
+    /// PX4's instance: it connects to TCP 4560 + N and serves its GCS link on UDP 18570 + N.
+    #[arg(long, default_value_t = 0)]
+    pub instance: u8,
+    /// Start PX4 from this tree (built with `make px4_sitl_default`); without it, start PX4
+    /// yourself (`PX4_SYS_AUTOSTART=... build/px4_sitl_default/bin/px4`).
+    #[arg(long, value_name = "PX4_DIR")]
+    pub px4_dir: Option<PathBuf>,
+    /// The airframe PX4 starts with (PX4_SYS_AUTOSTART), with --px4-dir.
+    #[arg(long, default_value_t = 10016, requires = "px4_dir")]
+    pub autostart: u32,
+    /// A file of `param set` lines applied after the airframe, with --px4-dir.
+    #[arg(long, requires = "px4_dir")]
+    pub params: Option<PathBuf>,
+    /// Fly the flight file's script on PX4's own SIH quadcopter instead (airframe 10040, real
+    /// time, for comparison; measured from its ulog): needs --px4-dir.
+    #[arg(long, requires = "px4_dir")]
+    pub sih: bool,
+    /// Seconds of wall time to wait for PX4 to connect.
+    #[arg(long, default_value_t = 120.0)]
+    pub connect_timeout: f64,
+    /// Seconds of wall time PX4 may take to answer one tick in lockstep.
+    #[arg(long, default_value_t = 10.0)]
+    pub stall_timeout: f64,
 }
 
 /// Arguments of `tvmd-sim afs`.

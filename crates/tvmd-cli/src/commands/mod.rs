@@ -2,6 +2,7 @@
 
 mod montecarlo;
 mod plot;
+mod px4;
 mod record;
 mod report;
 mod run;
@@ -126,5 +127,6 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             .and_then(|s| s.to_toml_string())
             .map(|t| print!("{t}"))
             .map_err(CliError::from),
+        Command::Px4(args) => px4::cmd_px4(args),
     }
 }
