@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Builds a PX4 tree (v1.15 or later) with tvmd's PX4 module tvmd_control (px4/, a PX4
-# external-modules folder) and, with --smoke, checks that the module starts in SITL, refuses a
-# bad parameter and keeps running.
+# external-modules folder); with --smoke, checks that the module starts in SITL, refuses a bad
+# parameter and keeps running; with --fly, flies it on tvmd-sim in lockstep (tvmd-sim px4) and
+# checks the flights from their ulogs (docs/px4-module.md).
 #
-#   bash scripts/px4-module.sh PX4_DIR [--smoke]      (or PX4_DIR=... bash scripts/px4-module.sh)
+#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly]   (or PX4_DIR=... bash scripts/px4-module.sh)
 #
 # What it changes in PX4_DIR (each once; rerunning is safe):
 #   - installs the airframe px4/airframes/4090_tvmd_control_a4 (+ .post) into
@@ -15,15 +16,26 @@
 # over the network). PX4's Python build dependencies must be importable: activate their
 # virtual environment first, or name it in PX4_VENV. The build log goes to
 # PX4_DIR/build/tvmd-module-build.log.
+#
+# --fly builds tvmd-sim (cargo, release; or TVMD_SIM names a tvmd-sim binary) and flies
+# scripts/px4/tvmd_control/flight.toml twice, on the nominal team and with model error (+3% mass,
+# gimbal offsets): takeoff, hover with a bad parameter refused in flight, the paper's tilt through
+# the sticks, landing; scripts/px4/tvmd_control.py checks each (hover rms error at most 2 cm, the
+# tilt held within 0.1 m, the largest planned roll within 0.02 rad of tvmd-sim's own flight of the
+# reference, the parameter refused, no refused period, no non-finite output, landed). It needs
+# pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
+# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
 px4_dir="${PX4_DIR:-}"
 smoke=0
+fly=0
 for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --fly) fly=1 ;;
+    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -89,17 +101,46 @@ if ! (cd "$px4_dir" && GIT_SUBMODULES_ARE_EVIL="${GIT_SUBMODULES_ARE_EVIL:-1}" \
 fi
 echo "built in $(($(date +%s) - start)) s (log: $log)"
 
-[ "$smoke" -eq 1 ] || exit 0
-
+[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || exit 0
 case "$target" in
   px4_sitl*) ;;
-  *) echo "error: --smoke needs a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
+  *) echo "error: --smoke and --fly need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
 esac
-step "smoke: PX4 SITL (SIH quadcopter for sensors), tvmd_control started, a bad parameter refused"
 build="$px4_dir/build/$target"
-work="$(mktemp -d)"
-# Its own PX4 instance (daemon socket, MAVLink ports), so that it runs beside other SITL runs.
 instance="${PX4_INSTANCE:-7}"
+
+if [ "$fly" -eq 1 ]; then
+  python3 -c 'import pyulog' 2>/dev/null || {
+    echo "error: --fly reads the ulogs with pyulog: install it in the Python environment (pip install pyulog)" >&2
+    exit 2
+  }
+  sim="${TVMD_SIM:-}"
+  if [ -z "$sim" ]; then
+    step "tvmd-sim (cargo build --release -p tvmd-cli)"
+    (cd "$repo" && cargo build --release --locked -p tvmd-cli)
+    sim="$repo/target/release/tvmd-sim"
+  fi
+  out="$repo/target/px4-module-flights"
+  mkdir -p "$out"
+  flights="$repo/scripts/px4/tvmd_control"
+  step "tvmd-sim's own flight of the reference (the paper's tilt, tvmd_control's law)"
+  "$sim" run "$flights/own-tilt.toml" --summary "$out/own-tilt.json" --out "$out/own-tilt.mcap" >/dev/null
+  for flight in scenario scenario-model-error; do
+    step "tvmd_control in PX4 on tvmd-sim: $flight"
+    start=$(date +%s)
+    "$sim" px4 "$flights/$flight.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
+      --autostart 4090 --params "$flights/params" --instance "$instance" --out "$out/$flight.mcap"
+    echo "flown in $(($(date +%s) - start)) s wall"
+    python3 "$repo/scripts/px4/tvmd_control.py" "$out/$flight.ulg" "$out/$flight.px4.json" \
+      --own "$out/own-tilt.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
+      --json "$out/$flight.measures.json"
+  done
+  echo "tvmd_control flew hover and the tilt in PX4 SITL (ulogs in $out)"
+fi
+
+[ "$smoke" -eq 1 ] || exit 0
+step "smoke: PX4 SITL (SIH quadcopter for sensors), tvmd_control started, a bad parameter refused"
+work="$(mktemp -d)"
 px4_pid=""
 cleanup() {
   if [ -n "$px4_pid" ]; then kill "$px4_pid" 2>/dev/null || true; wait "$px4_pid" 2>/dev/null || true; fi
@@ -111,6 +152,7 @@ trap cleanup EXIT
 PX4_SYS_AUTOSTART=10040 PX4_SIM_MODEL=sihsim_quadx PX4_SIMULATOR=sihsim \
   "$build/bin/px4" -d -i "$instance" -w "$work/rootfs" "$build/etc" >"$work/px4.log" 2>&1 &
 px4_pid=$!
+# Its own PX4 instance (daemon socket, MAVLink ports), so that it runs beside other SITL runs.
 client() { (cd "$work/rootfs" && timeout 20 "$build/bin/px4-$1" --instance "$instance" "${@:2}"); }
 for _ in $(seq 1 60); do
   grep -q "Ready for takeoff\|Startup script returned successfully" "$work/px4.log" 2>/dev/null && break
