@@ -348,20 +348,28 @@ void TvmdControl::run_law()
 	}
 
 	if (!_hover.capable && _control_mode.flag_armed && !_landed) {
-		request_land();
+		request_land("hover certificate lost");
+	}
+
+	/* Half a second of refused law periods: the fast loop flies on a stale law output. */
+	const int32_t law_hz = _param_law_hz.get();
+
+	if (_cascade.report().law.consecutive >= static_cast<uint32_t>(law_hz > 1 ? law_hz / 2 : 1)
+	    && _control_mode.flag_armed && !_landed) {
+		request_land("law refused for 0.5 s");
 	}
 
 	_law_timer.end();
 	perf_end(_law_perf);
 }
 
-void TvmdControl::request_land()
+void TvmdControl::request_land(const char *reason)
 {
 	if (_land_requested) {
 		return;
 	}
 
-	PX4_ERR("hover certificate lost (margin %.3f): asking to land", static_cast<double>(_hover.margin));
+	PX4_ERR("%s (hover margin %.3f): asking to land", reason, static_cast<double>(_hover.margin));
 	vehicle_command_s cmd{};
 	cmd.command = vehicle_command_s::VEHICLE_CMD_NAV_LAND;
 	cmd.param4 = NAN;

@@ -86,7 +86,7 @@ private:
 	TvmdReference reference_for(const vehicle_local_position_s &lp, const vehicle_attitude_s &att);
 	void publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample);
 	void publish_status(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample);
-	void request_land();
+	void request_land(const char *reason);
 
 	alignas(8) TvmdController _controller {};
 	TvmdConfig _config{};           // the last good configuration
