@@ -4,6 +4,7 @@ report, and checks it against targets.
 
     tvmd_control.py ULOG REPORT.px4.json [--own SUMMARY.json] [--json OUT.json]
         [--hover-rms M] [--tilt-hold M] [--roll-tolerance RAD] [--refused-at T]
+        [--failed-hold M]
 
 ULOG: PX4's log of the flight (tvmd_control_status is in it: scripts/px4-module.sh adds it to
 the logger's default topics). REPORT: tvmd-sim px4's `.px4.json` (the true position in the
@@ -11,7 +12,10 @@ flight file's windows `hover` and `tilt`). SUMMARY: `tvmd-sim run scripts/px4/tv
 own-tilt.toml --summary`: tvmd-sim's own flight of the same reference, whose largest planned
 roll the module's must match within --roll-tolerance. --refused-at T: a bad parameter was set
 at T s; tvmd_control must have refused it (config_status TVMD_ERR_CONFIG_RELAXATION = 33 at
-T + 1 s) and kept flying. Prints one line per measure; exits 1 on a missed target.
+T + 1 s) and kept flying. A flight with an agent failure (window `failed`) is checked for
+the agent masked (failed_agents) and the position held within --failed-hold; the masked
+agents' motors are NaN by design (PX4's "stopped"). Prints one line per measure; exits 1 on a
+missed target.
 """
 import argparse
 import json
@@ -36,11 +40,13 @@ def roll_of(data, prefix):
     return np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
 
 
-def window(report, name):
+def window(report, name, required=True):
     for w in report.get("windows", []):
         if w["name"] == name:
             return w
-    raise SystemExit(f"error: the report has no window `{name}`")
+    if required:
+        raise SystemExit(f"error: the report has no window `{name}`")
+    return None
 
 
 def main():
@@ -53,6 +59,7 @@ def main():
     p.add_argument("--tilt-hold", type=float, help="largest position error in the tilt window (m)")
     p.add_argument("--roll-tolerance", type=float, default=0.02)
     p.add_argument("--refused-at", type=float)
+    p.add_argument("--failed-hold", type=float, help="largest position error in the window `failed` (m)")
     a = p.parse_args()
 
     ulog = ULog(a.ulog, ["tvmd_control_status", "actuator_motors", "actuator_servos", "vehicle_status"])
@@ -62,17 +69,25 @@ def main():
     m = {}
     problems = []
 
-    hover, tilt = window(report, "hover"), window(report, "tilt")
+    hover, tilt = window(report, "hover"), window(report, "tilt", required=False)
+    failed = window(report, "failed", required=False)
     m["hover_hold_max"], m["hover_hold_rms"] = hover["hold_max"], hover["hold_rms"]
     m["hover_height_max"] = hover["height_max"]
-    m["tilt_hold_max"], m["tilt_roll_max"] = tilt["hold_max"], tilt["roll_max"]
     m["ekf_position_max_hover"], m["ekf_attitude_max_hover"] = hover["ekf_position_max"], hover["ekf_attitude_max"]
-
     planned = roll_of(status, "q_planned")
-    in_tilt = (t >= tilt["from"]) & (t <= tilt["to"])
     m["planned_roll_max"] = float(np.nanmax(planned))
-    m["force_unallocated_max_tilt"] = float(np.nanmax(status["force_unallocated"][in_tilt]))
-    m["saturated_periods_tilt"] = int(np.count_nonzero(status["saturated"][in_tilt]))
+    if tilt is not None:
+        m["tilt_hold_max"], m["tilt_roll_max"] = tilt["hold_max"], tilt["roll_max"]
+        in_tilt = (t >= tilt["from"]) & (t <= tilt["to"])
+        m["force_unallocated_max_tilt"] = float(np.nanmax(status["force_unallocated"][in_tilt]))
+        m["saturated_periods_tilt"] = int(np.count_nonzero(status["saturated"][in_tilt]))
+    masked = int(np.bitwise_or.reduce(status["failed_agents"].astype(np.int64)))
+    m["failed_agents"] = masked
+    if failed is not None:
+        m["failed_hold_max"], m["failed_hold_rms"] = failed["hold_max"], failed["hold_rms"]
+        in_failed = (t >= failed["from"]) & (t <= failed["to"])
+        m["force_unallocated_max_failed"] = float(np.nanmax(status["force_unallocated"][in_failed]))
+        m["hover_capable_after_failure"] = bool(np.all(status["hover_capable"][in_failed]))
     m["saturated_periods"] = int(status["saturated_periods"][-1])
     flying = status["landed"] == 0
     m["rate_loop_us_mean"] = float(np.mean(status["rate_loop_us"][flying]))
@@ -87,7 +102,10 @@ def main():
     nonfinite = 0
     for name in ("actuator_motors", "actuator_servos"):
         d = topic(ulog, name)
-        nonfinite += sum(int(np.count_nonzero(~np.isfinite(d[f"control[{i}]"]))) for i in range(8))
+        for i in range(8):
+            if name == "actuator_motors" and masked & (1 << (i // 2)):
+                continue  # a masked agent's motors are stopped (NaN) by design
+            nonfinite += int(np.count_nonzero(~np.isfinite(d[f"control[{i}]"])))
     for key in ("force_allocated", "torque_allocated", "force_requested", "torque_requested"):
         nonfinite += sum(int(np.count_nonzero(~np.isfinite(status[f"{key}[{i}]"][flying]))) for i in range(3))
     m["nonfinite_outputs"] = nonfinite
@@ -115,7 +133,12 @@ def main():
         problems.append("not landed and disarmed at the end")
     if a.hover_rms is not None and m["hover_hold_rms"] > a.hover_rms:
         problems.append(f"hover rms error {m['hover_hold_rms']:.4f} m above {a.hover_rms} m")
-    if a.tilt_hold is not None and m["tilt_hold_max"] > a.tilt_hold:
+    if a.failed_hold is not None:
+        if failed is None or masked == 0:
+            problems.append("no agent was masked in a window `failed`")
+        elif m["failed_hold_max"] > a.failed_hold:
+            problems.append(f"position error after the failure {m['failed_hold_max']:.4f} m above {a.failed_hold} m")
+    if a.tilt_hold is not None and tilt is not None and m["tilt_hold_max"] > a.tilt_hold:
         problems.append(f"tilt position error {m['tilt_hold_max']:.4f} m above {a.tilt_hold} m")
     if m["nonfinite_outputs"]:
         problems.append(f"{m['nonfinite_outputs']} non-finite outputs")

@@ -208,18 +208,18 @@ void TvmdControl::update_failures()
 {
 	failure_detector_status_s fd;
 
-	if (!_failure_detector_sub.update(&fd)) {
-		return;
-	}
+	if (_failure_detector_sub.update(&fd)) {
+		/* Agent i drives motors 2i and 2i+1: either one failed masks the agent. */
+		_detected_failures = 0;
 
-	/* Agent i drives motors 2i and 2i+1: either one failed masks the agent. */
-	uint32_t mask = 0;
-
-	for (uint32_t i = 0; i < _config.agent_count; ++i) {
-		if (fd.motor_failure_mask & (3u << (2 * i))) {
-			mask |= 1u << i;
+		for (uint32_t i = 0; i < _config.agent_count; ++i) {
+			if (fd.motor_failure_mask & (3u << (2 * i))) {
+				_detected_failures |= 1u << i;
+			}
 		}
 	}
+
+	const uint32_t mask = _detected_failures | static_cast<uint32_t>(_param_fail_mask.get());
 
 	if (mask == _failed_agents) {
 		return;

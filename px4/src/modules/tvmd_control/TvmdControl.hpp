@@ -137,6 +137,7 @@ private:
 	bool _landed{true};
 	bool _land_requested{false};
 	uint32_t _failed_agents{0};
+	uint32_t _detected_failures{0};  // agents with a motor in failure_detector_status
 	TvmdHover _hover{};
 	TvmdFaultReport _fault{};
 	float _reference_position_ned[3] {};
@@ -171,6 +172,7 @@ private:
 		(ParamFloat<px4::params::TVMD_POSE_TOUT>) _param_pose_tout,
 		(ParamFloat<px4::params::TVMD_RC_TILT>) _param_rc_tilt,
 		(ParamInt<px4::params::TVMD_MOT_CURVE>) _param_mot_curve,
+		(ParamInt<px4::params::TVMD_FAIL_MASK>) _param_fail_mask,
 		(ParamInt<px4::params::TVMD_AG_COUNT>) _param_ag_count,
 		(ParamFloat<px4::params::TVMD_AG_MASS>) _param_ag_mass,
 		(ParamFloat<px4::params::TVMD_NAV_MASS>) _param_nav_mass,
