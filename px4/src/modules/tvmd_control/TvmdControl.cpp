@@ -292,8 +292,16 @@ TvmdReference TvmdControl::reference_for(const vehicle_local_position_s &lp, con
 		std::memcpy(q, _pose_setpoint.q, sizeof(q));
 
 	} else {
-		const float yaw = std::isfinite(_trajectory_setpoint.yaw) ? _trajectory_setpoint.yaw
-				  : matrix::Eulerf(matrix::Quatf(att.q)).psi();
+		/* A NaN yaw holds the last one (as PX4's attitude controller does), or the vehicle's
+		 * own on the ground: following the vehicle's yaw would leave yaw uncontrolled. */
+		if (std::isfinite(_trajectory_setpoint.yaw) && !_landed) {
+			_reference_yaw = _trajectory_setpoint.yaw;
+
+		} else if (_landed || !std::isfinite(_reference_yaw)) {
+			_reference_yaw = matrix::Eulerf(matrix::Quatf(att.q)).psi();
+		}
+
+		const float yaw = _reference_yaw;
 		float roll = 0.f, pitch = 0.f;
 		const float tilt = _param_rc_tilt.get();
 

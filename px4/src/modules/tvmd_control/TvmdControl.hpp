@@ -142,6 +142,7 @@ private:
 	TvmdFaultReport _fault{};
 	float _reference_position_ned[3] {};
 	float _reference_q[4] {1.f, 0.f, 0.f, 0.f};
+	float _reference_yaw{NAN};  // held while the setpoint's yaw is NaN
 	bool _have_reference_position{false};
 
 	TvmdActuatorOutputs _outputs{};  // the last good actuator outputs
