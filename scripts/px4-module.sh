@@ -35,7 +35,7 @@ for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
     --fly) fly=1 ;;
-    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
