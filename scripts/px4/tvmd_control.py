@@ -10,7 +10,7 @@ ULOG: PX4's log of the flight (tvmd_control_status is in it: scripts/px4-module.
 the logger's default topics). REPORT: tvmd-sim px4's `.px4.json` (the true position in the
 flight file's windows `hover` and `tilt`). SUMMARY: `tvmd-sim run scripts/px4/tvmd_control/
 own-tilt.toml --summary`: tvmd-sim's own flight of the same reference, whose largest planned
-roll the module's must match within --roll-tolerance. --refused-at T: a bad parameter was set
+roll the module's in the window `tilt` must match within --roll-tolerance. --refused-at T: a bad parameter was set
 at T s; tvmd_control must have refused it (config_status TVMD_ERR_CONFIG_RELAXATION = 33 at
 T + 1 s) and kept flying. A flight with an agent failure (window `failed`) is checked for
 the agent masked (failed_agents) and the position held within --failed-hold; the masked
@@ -75,10 +75,14 @@ def main():
     m["hover_height_max"] = hover["height_max"]
     m["ekf_position_max_hover"], m["ekf_attitude_max_hover"] = hover["ekf_position_max"], hover["ekf_attitude_max"]
     planned = roll_of(status, "q_planned")
-    m["planned_roll_max"] = float(np.nanmax(planned))
+    # The manoeuvre's largest planned roll is the tilt window's; the flight's (touchdown
+    # included, where the team stands on the ground before PX4 detects the landing) apart.
+    m["planned_roll_max_flight"] = float(np.nanmax(planned))
+    m["planned_roll_max"] = m["planned_roll_max_flight"]
     if tilt is not None:
         m["tilt_hold_max"], m["tilt_roll_max"] = tilt["hold_max"], tilt["roll_max"]
         in_tilt = (t >= tilt["from"]) & (t <= tilt["to"])
+        m["planned_roll_max"] = float(np.nanmax(planned[in_tilt]))
         m["force_unallocated_max_tilt"] = float(np.nanmax(status["force_unallocated"][in_tilt]))
         m["saturated_periods_tilt"] = int(np.count_nonzero(status["saturated"][in_tilt]))
     masked = int(np.bitwise_or.reduce(status["failed_agents"].astype(np.int64)))
