@@ -23,10 +23,9 @@
  * PX4's stock output path has 8 servo channels: at most four two-axis agents (eta_x, eta_y)
  * on one flight controller; larger teams need another servo output.
  *
- * Parameters (a sketch for a PX4 module; names are suggestions): TVMD_LAW (0 paper,
- * 1 offset-free), TVMD_S (relaxation s), TVMD_POS_W / TVMD_ATT_W (natural frequencies, rad/s),
- * TVMD_OBS_BW (observer bandwidth, rad/s), TVMD_RATE_LIM (gimbal rate limit, rad/s, 0: none),
- * TVMD_TRQ_SCALE / TVMD_THR_SCALE (N m and N of a normalized setpoint of 1): see `Parameters`.
+ * The PX4 module px4/src/modules/tvmd_control (docs/px4-module.md) is built on this header;
+ * its parameters are in its module.yaml. `Parameters` below are the scales of PX4's normalized
+ * torque and thrust setpoints, for a module that keeps PX4's own controllers upstream.
  *
  * Thread safety: as tvmd.h, one task per controller handle; no heap, no exceptions. */
 #ifndef TVMD_PX4_HPP
@@ -189,22 +188,65 @@ void actuators_from(const TvmdActuatorOutputs &out, Motors &motors, Servos &serv
   for (std::size_t i = 0; i < 8; ++i) servos.control[i] = out.servos[i];
 }
 
+/* One stage's statuses, so that none is swallowed: the latest call's, the latest that was not
+ * TVMD_OK, how many were not since creation and since the stage last succeeded (a flight
+ * stack raises a failsafe when `consecutive` grows). */
+struct StageReport {
+  TvmdStatus last = TVMD_OK;
+  TvmdStatus last_error = TVMD_OK;
+  std::uint32_t errors = 0;
+  std::uint32_t consecutive = 0;
+
+  void record(TvmdStatus status) {
+    last = status;
+    if (status == TVMD_OK) {
+      consecutive = 0;
+    } else {
+      last_error = status;
+      ++errors;
+      ++consecutive;
+    }
+  }
+};
+
 /* The controller as PX4's cascade: `position` at the position loop's rate runs the law stage
  * (tvmd_law: the planned attitude R_d and the body force, kept as an inertial force);
  * `attitude_and_allocate` at the rate loop's rate takes the torque for the kept R_d from the
  * newest state (tvmd_attitude), the kept inertial force in the newest body frame, and
- * allocates them (tvmd_allocate). */
+ * allocates them (tvmd_allocate).
+ *
+ * A bad sample does not stop it. A refused law period keeps the last good law output (R_d,
+ * the force, the reference), so the fast loop keeps flying on it; a refused fast period
+ * (a NaN gyro sample, a refused allocation, no law output yet) still writes `out`: the held
+ * commands of the C interface (`tvmd_allocate`'s fallback), never an unwritten or zero
+ * output. Every status that is not TVMD_OK is returned and counted in `report()`. */
 class Cascade {
  public:
+  struct Report {
+    StageReport law;      /* `position`: tvmd_law */
+    StageReport attitude; /* `attitude_and_allocate`: tvmd_attitude (and "no law output yet") */
+    StageReport allocate; /* `attitude_and_allocate`: tvmd_allocate */
+  };
+
   explicit Cascade(TvmdController *controller) : controller_(controller) {
     std::memset(&law_, 0, sizeof law_);
     law_.size = sizeof law_;
+    std::memset(&attitude_, 0, sizeof attitude_);
+    attitude_.size = sizeof attitude_;
+    std::memset(&requested_, 0, sizeof requested_);
+    requested_.size = sizeof requested_;
     force_world_.fill(0.0f);
   }
 
+  /* The law stage. On an error the last good law output stays in force. */
   TvmdStatus position(const TvmdState &state, const TvmdReference &reference) {
-    const TvmdStatus status = tvmd_law(controller_, &state, &reference, &law_);
+    TvmdLawOutput law;
+    std::memset(&law, 0, sizeof law);
+    law.size = sizeof law;
+    const TvmdStatus status = tvmd_law(controller_, &state, &reference, &law);
+    report_.law.record(status);
     if (status == TVMD_OK) {
+      law_ = law;
       Mat3 r;
       std::memcpy(r.data(), state.attitude, sizeof state.attitude);
       force_world_ = times(r, Vec3{law_.force[0], law_.force[1], law_.force[2]});
@@ -214,33 +256,60 @@ class Cascade {
     return status;
   }
 
+  /* The attitude stage and the allocation. `out` is always written (when usable): the new
+   * commands, or on an error the held ones with `out->status` the error. */
   TvmdStatus attitude_and_allocate(const TvmdState &state, TvmdAllocationOutput *out) {
-    if (!have_law_) return TVMD_ERR_NOT_INITIALIZED;
-    TvmdAttitudeOutput att;
-    std::memset(&att, 0, sizeof att);
-    att.size = sizeof att;
+    if (!have_law_) return held(TVMD_ERR_NOT_INITIALIZED, out);
+    std::memset(&attitude_, 0, sizeof attitude_);
+    attitude_.size = sizeof attitude_;
     const TvmdStatus status =
-        tvmd_attitude(controller_, &state, law_.planned_attitude, &reference_, &att);
-    if (status != TVMD_OK) return status;
+        tvmd_attitude(controller_, &state, law_.planned_attitude, &reference_, &attitude_);
+    if (status != TVMD_OK) return held(status, out);
+    report_.attitude.record(status);
     Mat3 r;
     std::memcpy(r.data(), state.attitude, sizeof state.attitude);
     const Vec3 force_body = transpose_times(r, force_world_);
-    TvmdWrench w;
-    std::memset(&w, 0, sizeof w);
-    w.size = sizeof w;
-    std::memcpy(w.torque, att.torque, sizeof w.torque);
-    std::memcpy(w.force, force_body.data(), sizeof w.force);
-    return tvmd_allocate(controller_, &w, out);
+    std::memcpy(requested_.torque, attitude_.torque, sizeof requested_.torque);
+    std::memcpy(requested_.force, force_body.data(), sizeof requested_.force);
+    /* On an error tvmd_allocate itself writes the held commands. */
+    const TvmdStatus allocated = tvmd_allocate(controller_, &requested_, out);
+    report_.allocate.record(allocated);
+    return allocated;
   }
 
+  /* The last good law output (zero before the first). */
   const TvmdLawOutput &law() const { return law_; }
+  /* The latest fast period's attitude stage (NaN when it was refused) and the wrench it asked
+   * the allocation for (the last one that reached it). */
+  const TvmdAttitudeOutput &attitude() const { return attitude_; }
+  const TvmdWrench &requested() const { return requested_; }
+  bool has_law() const { return have_law_; }
+  const Report &report() const { return report_; }
 
  private:
+  /* The held commands into `out` (tvmd_allocate without a wrench writes them and changes
+   * nothing), with the stage's error as the status. */
+  TvmdStatus held(TvmdStatus status, TvmdAllocationOutput *out) {
+    report_.attitude.record(status);
+    if (out == nullptr) return status;
+    const TvmdStatus fallback = tvmd_allocate(controller_, nullptr, out);
+    if (fallback != TVMD_ERR_NULL_POINTER) {
+      /* The handle itself was refused (not created, corrupted, `out` of another size). */
+      report_.allocate.record(fallback);
+      return fallback;
+    }
+    out->status = status;
+    return status;
+  }
+
   TvmdController *controller_;
   TvmdLawOutput law_;
+  TvmdAttitudeOutput attitude_;
+  TvmdWrench requested_;
   TvmdReference reference_{};
   Vec3 force_world_{};
   bool have_law_ = false;
+  Report report_{};
 };
 
 } /* namespace px4 */

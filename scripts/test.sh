@@ -18,7 +18,7 @@ step "self-contained: no tracked file refers to a directory beside the checkout"
 # Bracketed patterns, so that this file does not match itself.
 outside='\.\./shar[e]d|TVMD_SHAR[E]D'
 paths=()
-for p in crates src examples benches scripts embedded include docs .ci README.md BENCHMARKS.md; do
+for p in crates src examples benches scripts embedded include docs px4 .ci README.md BENCHMARKS.md; do
   [ -e "$p" ] && paths+=("$p")
 done
 status=0

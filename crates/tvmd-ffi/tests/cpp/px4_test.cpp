@@ -3,7 +3,8 @@
 // trips, the uORB mapping of a hover against the C state built by hand (same commands, bit for
 // bit), and a flight of hover and the saturating tilt through the cascade (the law at 50 Hz,
 // the attitude and the allocation at 250 Hz) against the full step at 250 Hz: the same
-// planned roll within 1e-3 rad.
+// planned roll within 1e-3 rad; and the cascade through bad samples (a NaN gyro sample gets
+// the held commands, a refused law period keeps the last good law output).
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -241,12 +242,87 @@ void test_cascade_flight() {
   CHECK(std::fabs(staged.x[2] - 1.5f) < 0.2f);
 }
 
+
+float total_thrust(const TvmdAllocationOutput &a) {
+  float t = 0.0f;
+  for (std::size_t i = 0; i < a.agent_count; ++i) t += a.commands[i].thrust;
+  return t;
+}
+
+bool all_finite(const float *v, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return false;
+  }
+  return true;
+}
+
+// The cascade keeps flying through a bad sample: a NaN gyro sample gets the held commands (not
+// an unwritten output), a refused law period keeps the last good law output, and every error is
+// counted in the report.
+void test_cascade_bad_samples() {
+  TvmdConfig config = paper();
+  CHECK(tvmd_create(&staged_storage, sizeof staged_storage, &config) == TVMD_OK);
+  tvmd::px4::Cascade cascade(&staged_storage);
+  TvmdAllocationOutput alloc;
+  std::memset(&alloc, 0, sizeof alloc);
+  alloc.size = sizeof alloc;
+  Body body;
+  const TvmdReference hover = tilt_reference(0.0f);
+  // Before the first law period: the held (idle) commands, written, and the status says why.
+  alloc.agent_count = 99;
+  CHECK(cascade.attitude_and_allocate(state_of(body), &alloc) == TVMD_ERR_NOT_INITIALIZED);
+  CHECK(alloc.status == TVMD_ERR_NOT_INITIALIZED && alloc.agent_count == config.agent_count);
+  CHECK(cascade.report().attitude.errors == 1);
+  // Hover: the law at 50 Hz, the attitude and the allocation at 250 Hz.
+  for (int k = 0; k < 250; ++k) {
+    const TvmdState s = state_of(body);
+    if (k % 5 == 0) CHECK(cascade.position(s, hover) == TVMD_OK);
+    CHECK(cascade.attitude_and_allocate(s, &alloc) == TVMD_OK);
+  }
+  const TvmdAllocationOutput good = alloc;
+  const float weight = 9.81f * (config.navigator_mass + 4.0f * config.agents[0].mass);
+  std::printf("hover through the cascade: total thrust %.3f N (weight %.3f N)\n",
+              static_cast<double>(total_thrust(good)), static_cast<double>(weight));
+  CHECK(std::fabs(total_thrust(good) - weight) < 0.05f * weight);
+
+  // One NaN gyro sample: refused, and the output is the held commands, bit for bit.
+  std::memset(alloc.commands, 0, sizeof alloc.commands);
+  TvmdState bad = state_of(body);
+  bad.angular_velocity[0] = NAN;
+  CHECK(cascade.attitude_and_allocate(bad, &alloc) == TVMD_ERR_INPUT_NON_FINITE);
+  CHECK(alloc.status == TVMD_ERR_INPUT_NON_FINITE);
+  CHECK(std::memcmp(alloc.commands, good.commands, sizeof alloc.commands) == 0);
+  CHECK(total_thrust(alloc) > 0.9f * weight);
+  CHECK(cascade.report().attitude.last_error == TVMD_ERR_INPUT_NON_FINITE);
+  CHECK(cascade.report().attitude.errors == 2 && cascade.report().attitude.consecutive == 1);
+  // The next good sample flies again.
+  CHECK(cascade.attitude_and_allocate(state_of(body), &alloc) == TVMD_OK);
+  CHECK(cascade.report().attitude.consecutive == 0);
+
+  // One refused law period (a NaN position): the last good law output stays, the fast loop
+  // keeps allocating from it.
+  const TvmdLawOutput kept = cascade.law();
+  bad = state_of(body);
+  bad.position[2] = NAN;
+  CHECK(cascade.position(bad, hover) == TVMD_ERR_INPUT_NON_FINITE);
+  CHECK(std::memcmp(&cascade.law(), &kept, sizeof kept) == 0);
+  CHECK(all_finite(cascade.law().planned_attitude, 9) && all_finite(cascade.law().force, 3));
+  CHECK(cascade.report().law.errors == 1 && cascade.report().law.consecutive == 1);
+  for (int k = 0; k < 5; ++k) {
+    CHECK(cascade.attitude_and_allocate(state_of(body), &alloc) == TVMD_OK);
+    CHECK(total_thrust(alloc) > 0.9f * weight);
+  }
+  CHECK(cascade.position(state_of(body), hover) == TVMD_OK);
+  CHECK(cascade.report().law.consecutive == 0 && cascade.report().law.errors == 1);
+  CHECK(cascade.report().allocate.errors == 0);
+}
 }  // namespace
 
 int main() {
   test_frames();
   test_hover_matches_c();
   test_cascade_flight();
+  test_cascade_bad_samples();
   std::printf("tvmd C++ PX4 adapter test: %d checks, %d failed\n", checks, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -1,0 +1,189 @@
+#!/usr/bin/env bash
+# Builds a PX4 tree (v1.15 or later) with tvmd's PX4 module tvmd_control (px4/, a PX4
+# external-modules folder); with --smoke, checks that the module starts in SITL, refuses a bad
+# parameter and keeps running; with --fly, flies it on tvmd-sim in lockstep (tvmd-sim px4) and
+# checks the flights from their ulogs (docs/px4-module.md).
+#
+#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly]   (or PX4_DIR=... bash scripts/px4-module.sh)
+#
+# What it changes in PX4_DIR (each once; rerunning is safe):
+#   - installs the airframe px4/airframes/4090_tvmd_control_a4 (+ .post) into
+#     ROMFS/px4fmu_common/init.d-posix/airframes and lists it in that folder's CMakeLists.txt;
+#   - adds tvmd_control_status to the logger's default topics (src/modules/logger/
+#     logged_topics.cpp), so that every ulog has it.
+# Then it runs `make $PX4_TARGET EXTERNAL_MODULES_LOCATION=<repo>/px4` (PX4_TARGET defaults to
+# px4_sitl_default; GIT_SUBMODULES_ARE_EVIL defaults to 1, so PX4 does not update submodules
+# over the network). PX4's Python build dependencies must be importable: activate their
+# virtual environment first, or name it in PX4_VENV. The build log goes to
+# PX4_DIR/build/tvmd-module-build.log.
+#
+# --fly builds tvmd-sim (cargo, release; or TVMD_SIM names a tvmd-sim binary) and flies
+# scripts/px4/tvmd_control/flight.toml twice, on the nominal team and with model error (+3% mass,
+# gimbal offsets): takeoff, hover with a bad parameter refused in flight, the paper's tilt through
+# the sticks, landing; scripts/px4/tvmd_control.py checks each (hover rms error at most 2 cm, the
+# tilt held within 0.1 m, the largest planned roll within 0.02 rad of tvmd-sim's own flight of the
+# reference, the parameter refused, no refused period, no non-finite output, landed). It needs
+# pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
+# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs.
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+
+px4_dir="${PX4_DIR:-}"
+smoke=0
+fly=0
+for arg in "$@"; do
+  case "$arg" in
+    --smoke) smoke=1 ;;
+    --fly) fly=1 ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    *) px4_dir="$arg" ;;
+  esac
+done
+if [ -z "$px4_dir" ]; then
+  echo "error: no PX4 tree: give its path (bash scripts/px4-module.sh PX4_DIR) or set PX4_DIR" >&2
+  exit 2
+fi
+if [ ! -f "$px4_dir/Makefile" ] || [ ! -d "$px4_dir/src/modules/logger" ] || [ ! -d "$px4_dir/msg" ]; then
+  echo "error: $px4_dir is not a PX4 source tree (no Makefile, src/modules/logger or msg/)" >&2
+  exit 2
+fi
+px4_dir="$(cd "$px4_dir" && pwd)"
+target="${PX4_TARGET:-px4_sitl_default}"
+step() { printf '\n==> %s\n' "$*"; }
+
+if [ -n "${PX4_VENV:-}" ]; then
+  # shellcheck disable=SC1091
+  source "$PX4_VENV/bin/activate"
+fi
+python3 -c 'import em, genmsg, kconfiglib, jinja2, yaml' 2>/dev/null || {
+  echo "error: PX4's Python build dependencies are missing (empy==3.3.4 pyros-genmsg kconfiglib jinja2 pyyaml jsonschema ...): activate their venv or set PX4_VENV" >&2
+  exit 2
+}
+
+step "airframe 4090_tvmd_control_a4 into $px4_dir"
+airframes="$px4_dir/ROMFS/px4fmu_common/init.d-posix/airframes"
+for f in 4090_tvmd_control_a4 4090_tvmd_control_a4.post; do
+  cp "$repo/px4/airframes/$f" "$airframes/$f"
+  if ! grep -qE "^[[:space:]]*$f\$" "$airframes/CMakeLists.txt"; then
+    sed -i "s/^px4_add_romfs_files(\$/px4_add_romfs_files(\n\t$f/" "$airframes/CMakeLists.txt"
+  fi
+  grep -qE "^[[:space:]]*$f\$" "$airframes/CMakeLists.txt" || {
+    echo "error: could not list $f in $airframes/CMakeLists.txt" >&2
+    exit 1
+  }
+done
+
+step "tvmd_control_status in the logger's default topics"
+topics="$px4_dir/src/modules/logger/logged_topics.cpp"
+if ! grep -q '"tvmd_control_status"' "$topics"; then
+  sed -i 's/^void LoggedTopics::add_default_topics()$/&\n{\n\tadd_optional_topic("tvmd_control_status", 10);\n\tadd_optional_topic("tvmd_pose_setpoint");/' "$topics"
+  # The function's own brace follows: drop it (the inserted block opened the body).
+  python3 - "$topics" <<'EOF'
+import sys
+path = sys.argv[1]
+text = open(path).read()
+marker = 'add_optional_topic("tvmd_pose_setpoint");\n{\n'
+assert marker in text, "logged_topics.cpp: unexpected layout after add_default_topics()"
+open(path, "w").write(text.replace(marker, 'add_optional_topic("tvmd_pose_setpoint");\n', 1))
+EOF
+fi
+grep -q '"tvmd_control_status"' "$topics"
+
+step "make $target EXTERNAL_MODULES_LOCATION=$repo/px4"
+log="$px4_dir/build/tvmd-module-build.log"
+mkdir -p "$px4_dir/build"
+start=$(date +%s)
+if ! (cd "$px4_dir" && GIT_SUBMODULES_ARE_EVIL="${GIT_SUBMODULES_ARE_EVIL:-1}" \
+  make "$target" EXTERNAL_MODULES_LOCATION="$repo/px4" >"$log" 2>&1); then
+  tail -40 "$log"
+  echo "error: the PX4 build failed; its log: $log" >&2
+  exit 1
+fi
+echo "built in $(($(date +%s) - start)) s (log: $log)"
+
+[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || exit 0
+case "$target" in
+  px4_sitl*) ;;
+  *) echo "error: --smoke and --fly need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
+esac
+build="$px4_dir/build/$target"
+instance="${PX4_INSTANCE:-7}"
+
+if [ "$fly" -eq 1 ]; then
+  python3 -c 'import pyulog' 2>/dev/null || {
+    echo "error: --fly reads the ulogs with pyulog: install it in the Python environment (pip install pyulog)" >&2
+    exit 2
+  }
+  sim="${TVMD_SIM:-}"
+  if [ -z "$sim" ]; then
+    step "tvmd-sim (cargo build --release -p tvmd-cli)"
+    (cd "$repo" && cargo build --release --locked -p tvmd-cli)
+    sim="$repo/target/release/tvmd-sim"
+  fi
+  out="$repo/target/px4-module-flights"
+  mkdir -p "$out"
+  flights="$repo/scripts/px4/tvmd_control"
+  step "tvmd-sim's own flight of the reference (the paper's tilt, tvmd_control's law)"
+  "$sim" run "$flights/own-tilt.toml" --summary "$out/own-tilt.json" --out "$out/own-tilt.mcap" >/dev/null
+  for flight in scenario scenario-model-error; do
+    step "tvmd_control in PX4 on tvmd-sim: $flight"
+    start=$(date +%s)
+    "$sim" px4 "$flights/$flight.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
+      --autostart 4090 --params "$flights/params" --instance "$instance" --out "$out/$flight.mcap"
+    echo "flown in $(($(date +%s) - start)) s wall"
+    python3 "$repo/scripts/px4/tvmd_control.py" "$out/$flight.ulg" "$out/$flight.px4.json" \
+      --own "$out/own-tilt.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
+      --json "$out/$flight.measures.json"
+  done
+  echo "tvmd_control flew hover and the tilt in PX4 SITL (ulogs in $out)"
+fi
+
+[ "$smoke" -eq 1 ] || exit 0
+step "smoke: PX4 SITL (SIH quadcopter for sensors), tvmd_control started, a bad parameter refused"
+work="$(mktemp -d)"
+px4_pid=""
+cleanup() {
+  if [ -n "$px4_pid" ]; then kill "$px4_pid" 2>/dev/null || true; wait "$px4_pid" 2>/dev/null || true; fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+# The SIH quadcopter's own controllers stay on the ground (disarmed); tvmd_control runs beside
+# them on the estimator's state and publishes its outputs, which nothing arms.
+PX4_SYS_AUTOSTART=10040 PX4_SIM_MODEL=sihsim_quadx PX4_SIMULATOR=sihsim \
+  "$build/bin/px4" -d -i "$instance" -w "$work/rootfs" "$build/etc" >"$work/px4.log" 2>&1 &
+px4_pid=$!
+# Its own PX4 instance (daemon socket, MAVLink ports), so that it runs beside other SITL runs.
+client() { (cd "$work/rootfs" && timeout 20 "$build/bin/px4-$1" --instance "$instance" "${@:2}"); }
+for _ in $(seq 1 60); do
+  grep -q "Ready for takeoff\|Startup script returned successfully" "$work/px4.log" 2>/dev/null && break
+  kill -0 "$px4_pid" 2>/dev/null || { cat "$work/px4.log"; echo "error: PX4 exited" >&2; exit 1; }
+  sleep 1
+done
+client tvmd_control start
+sleep 3
+client tvmd_control status | tee "$work/status1.txt"
+client param set TVMD_S 1.5
+sleep 3
+client tvmd_control status | tee "$work/status2.txt"
+client param set TVMD_S 0.6
+sleep 3
+client tvmd_control status | tee "$work/status3.txt"
+client perf | grep tvmd_control | tee "$work/perf.txt" || true
+client tvmd_control stop
+fail=0
+grep -q "parameters (tvmd_reconfigure): last TVMD_ERR_CONFIG_RELAXATION, 1 refused" "$work/status2.txt" ||
+  { echo "error: TVMD_S 1.5 was not refused with TVMD_ERR_CONFIG_RELAXATION" >&2; fail=1; }
+grep -q "parameters (tvmd_reconfigure): last TVMD_OK, 1 refused" "$work/status3.txt" ||
+  { echo "error: TVMD_S 0.6 was not accepted after the refusal" >&2; fail=1; }
+# Still running the whole time: the rate loop's event count grew between the checks.
+events() { grep -m1 "attitude+allocation" "$1" | sed -E 's/.*: ([0-9]+) events.*/\1/'; }
+e1=$(events "$work/status1.txt"); e3=$(events "$work/status3.txt")
+echo "rate-loop periods: $e1 after start, $e3 after the refusal and the accepted change"
+if [ -z "$e1" ] || [ -z "$e3" ] || [ "$e3" -le "$e1" ]; then
+  echo "error: the rate loop did not keep running" >&2; fail=1
+fi
+if [ "$fail" -ne 0 ]; then
+  tail -40 "$work/px4.log"
+  exit 1
+fi
+echo "tvmd_control started in SITL, refused TVMD_S = 1.5 and kept running, accepted 0.6"
