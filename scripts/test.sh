@@ -136,7 +136,10 @@ step "PX4 in the loop: PX4 SITL built and flown on tvmd-sim in lockstep (scripts
 # ci build (its dependencies left by the wheel's build), then the flights: the stock quadcopter on
 # tvmd-sim 5 s for 60 s simulated, on SIH 61 s (real time), the authors' airframe 20 s for 45 s.
 if [ -n "${PX4_DIR:-}" ]; then
-  bash scripts/px4.sh
+  TVMD_PX4_WITH_MODULE=1 bash scripts/px4.sh
+  step "tvmd inside PX4: the tvmd_control module flown on tvmd-sim and its smoke test (scripts/px4-module.sh)"
+  # The tree px4.sh built already holds the module; the flights reuse its venv and tvmd-sim.
+  PX4_VENV=target/px4-venv TVMD_SIM=target/ci/tvmd-sim bash scripts/px4-module.sh "$PX4_DIR" --fly --smoke
 else
   echo "PX4 flights SKIPPED: PX4_DIR is not set. To run them: PX4_DIR=/path/to/PX4-Autopilot bash scripts/px4.sh"
   echo "(or PX4_DIR=... bash scripts/test.sh; see docs/px4.md)"
