@@ -143,6 +143,9 @@ pub enum Command {
         /// Override the scenario's allocator (as `run --allocator`).
         #[arg(long)]
         allocator: Option<String>,
+        /// Override the scenario's control law (as `run --law`).
+        #[arg(long, value_parser = law_parser())]
+        law: Option<tvmd_scenario::LawConfig>,
     },
     /// Re-plot runs from their MCAP logs: figures of each run, and the relaxation-study figure
     /// when several logs are given.
@@ -283,9 +286,14 @@ impl From<AfsArgs> for tvmd_studies::afs_atlas::AtlasRequest {
 /// Arguments of `tvmd-sim montecarlo`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct MonteCarloArgs {
-    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file.
-    #[arg(default_value = "paper-tilt")]
+    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file (default: the hover
+    /// family, flown with the default law).
+    #[arg(default_value = tvmd_studies::montecarlo::DEFAULT_SCENARIO)]
     pub scenario: String,
+    /// Override the scenario's control law (`[law]`): offset-free (the default law) or paper
+    /// (the paper's law as published, no integral action; docs/method.md).
+    #[arg(long, value_parser = law_parser())]
+    pub law: Option<tvmd_scenario::LawConfig>,
     /// Flights per team, allocator and model-error level.
     #[arg(long, default_value_t = 100)]
     pub runs: usize,
@@ -322,6 +330,14 @@ pub struct MonteCarloArgs {
     /// Largest initial tilt (rad, at most 2.5; the scenario must start in the air).
     #[arg(long)]
     pub initial_tilt: Option<f64>,
+    /// Dryden turbulence in every flight (MIL-F-8785C low altitude): light, moderate, severe
+    /// (W20 = 15, 30, 45 kt) or W20 in m/s; on the standard's mean wind where the scenario has
+    /// none (docs/monte-carlo.md).
+    #[arg(long, value_parser = parse_turbulence)]
+    pub turbulence: Option<f64>,
+    /// A 1-cos gust of this peak speed (m/s, 2 s, drawn heading and start) in every flight.
+    #[arg(long)]
+    pub gust: Option<f64>,
     /// Directory for `flights.csv`, `groups.csv` and the PNG figures (default:
     /// `out/montecarlo/<scenario>`).
     #[arg(long)]
@@ -335,6 +351,7 @@ impl From<MonteCarloArgs> for tvmd_studies::montecarlo::MonteCarloRequest {
     fn from(a: MonteCarloArgs) -> Self {
         Self {
             scenario: a.scenario,
+            law: a.law,
             runs: a.runs,
             seed: a.seed,
             teams: a.teams,
@@ -347,6 +364,8 @@ impl From<MonteCarloArgs> for tvmd_studies::montecarlo::MonteCarloRequest {
             gimbal_offset: a.gimbal_offset,
             initial_position: a.initial_position,
             initial_tilt: a.initial_tilt,
+            turbulence: a.turbulence,
+            gust: a.gust,
             out: a.out,
             jobs: a.jobs,
         }
@@ -368,7 +387,11 @@ pub struct CatalogueArgs {
     /// Allocators, comma-separated (default: the four without the `clarabel` feature).
     #[arg(long, value_delimiter = ',')]
     pub allocators: Vec<String>,
-    /// Write `catalogue.csv` (one row per flight) and `catalogue.md` here.
+    /// Override the tasks' control law (`[law]`): offset-free (the default law, the tasks' own) or paper
+    /// (the paper's law as published, no integral action; docs/method.md).
+    #[arg(long, value_parser = law_parser())]
+    pub law: Option<tvmd_scenario::LawConfig>,
+    /// Write `catalogue.csv` (one row per team and allocator) and `catalogue.md` here.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Worker threads (default: every core).
@@ -383,8 +406,61 @@ impl From<CatalogueArgs> for tvmd_studies::catalogue::CatalogueSettings {
             seed: a.seed,
             teams: a.teams,
             allocators: a.allocators,
+            law: a.law,
             out: a.out,
             jobs: a.jobs,
         }
+    }
+}
+
+/// `--turbulence`: a level of the standard, or `W20` in m/s.
+fn parse_turbulence(text: &str) -> Result<f64, String> {
+    use tvmd_plant::turbulence::{LIGHT_W20, MODERATE_W20, SEVERE_W20};
+    match text {
+        "light" => Ok(LIGHT_W20),
+        "moderate" => Ok(MODERATE_W20),
+        "severe" => Ok(SEVERE_W20),
+        _ => text
+            .parse::<f64>()
+            .map_err(|_| format!("`{text}`: light, moderate, severe, or W20 in m/s")),
+    }
+}
+
+/// `--law`: one of [`tvmd_scenario::LAW_NAMES`] (listed in `--help`), as the scenario's law.
+fn law_parser() -> impl clap::builder::TypedValueParser<Value = tvmd_scenario::LawConfig> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(tvmd_scenario::LAW_NAMES)
+        .try_map(|name| name.parse::<tvmd_scenario::LawConfig>())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn montecarlo(args: &[&str]) -> Result<MonteCarloArgs, clap::Error> {
+        let all = ["tvmd-sim", "montecarlo"].iter().chain(args);
+        match Cli::try_parse_from(all)?.command {
+            Command::Montecarlo(a) => Ok(a),
+            other => panic!("parsed as {other:?}"),
+        }
+    }
+
+    /// Issue 61: `montecarlo` with no arguments flies the default scenario with its own (the
+    /// default) law; `--law` takes the law's names only.
+    #[test]
+    fn montecarlo_defaults_to_the_default_law_and_takes_law() {
+        let plain = montecarlo(&[]).unwrap();
+        assert_eq!(plain.scenario, tvmd_studies::montecarlo::DEFAULT_SCENARIO);
+        assert_eq!(plain.law, None);
+        let paper = montecarlo(&["paper-tilt", "--law", "offset-free"]).unwrap();
+        assert_eq!(paper.law, Some(tvmd_scenario::LawConfig::default()));
+        let e = montecarlo(&["--law", "pid"]).unwrap_err().to_string();
+        assert!(e.contains("pid") && e.contains("offset-free"), "{e}");
+        let sweep = Cli::try_parse_from(["tvmd-sim", "sweep", "--law", "paper"]).unwrap();
+        assert!(matches!(
+            sweep.command,
+            Command::Sweep { law: Some(l), .. } if l.is_paper()
+        ));
     }
 }

@@ -8,8 +8,8 @@
 //! Modules, in import order: [`math`] (rotations, planned roll, row-major conversions),
 //! [`actuators`] (commands, thrust direction (eq. 1), servo and rotor-lag models, failures),
 //! [`physics`] (team body, rapier world, [`PlantState`]), [`rk4`] (an independent RK4 of the
-//! paper's dynamics, eqs. 2-3, a check on rapier) and [`reference`] (the paper's reference
-//! trajectory and the other references).
+//! paper's dynamics, eqs. 2-3, a check on rapier), [`reference`] (the paper's reference
+//! trajectory and the other references) and [`turbulence`] (the Dryden field of the air).
 //!
 //! Conventions: SI units, z up, gravity `g = 9.81 m/s^2` along `-z`; body-frame twist
 //! `xi = [Omega; v]` with `x_dot = R v`; [`PlantState::velocity`] is in the world frame.
@@ -22,6 +22,7 @@ pub mod math;
 pub mod physics;
 pub mod reference;
 pub mod rk4;
+pub mod turbulence;
 
 pub use actuators::{ActuatorBank, ActuatorCommand, ActuatorModel, FailureKind, SaturationLimits};
 pub use error::PhysicsError;
@@ -30,6 +31,7 @@ pub use physics::{
     DEFAULT_COLLIDER_RADIUS,
 };
 pub use reference::{ReferenceConfig, ReferenceSample};
+pub use turbulence::Turbulence;
 
 /// Standard gravity used throughout the simulator (m/s^2).
 pub const GRAVITY: f64 = 9.81;

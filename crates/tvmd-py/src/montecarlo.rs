@@ -8,18 +8,19 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tvmd_scenario::Scenario;
 use tvmd_studies::montecarlo::{
-    fly_all_until, fly_flight_until, Distributions, FlightRow, FlightSpec, Study, StudyReport,
+    fly_all_until, fly_flight_until, with_law, Distributions, FlightRow, FlightSpec, Study,
+    StudyReport, DEFAULT_SCENARIO,
 };
 
-use crate::convert::{jobs_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
+use crate::convert::{jobs_arg, law_arg, record_to_py, scenario_arg, Int, USIZE_MAX};
 use crate::errors::value_error;
 use crate::interrupt::{interruptible, Ended};
 
 #[doc = include_str!("../docstrings/tvmd.sim.monte_carlo_specs.txt")]
 #[pyfunction]
 #[pyo3(
-    signature = (scenario = None, *, toml = None, runs = Int::of(100), seed = Int::of(0), teams = None, allocators = None, model_errors = None, distributions = None),
-    text_signature = "(scenario=None, *, toml=None, runs=100, seed=0, teams=None, allocators=None, model_errors=None, distributions=None)"
+    signature = (scenario = None, *, toml = None, runs = Int::of(100), seed = Int::of(0), teams = None, allocators = None, model_errors = None, distributions = None, law = None),
+    text_signature = "(scenario=None, *, toml=None, runs=100, seed=0, teams=None, allocators=None, model_errors=None, distributions=None, law=None)"
 )]
 #[allow(clippy::too_many_arguments)]
 fn monte_carlo_specs(
@@ -31,7 +32,12 @@ fn monte_carlo_specs(
     allocators: Option<Vec<String>>,
     model_errors: Option<Vec<f64>>,
     distributions: Option<&Bound<'_, PyAny>>,
+    law: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Vec<String>> {
+    let law = law
+        .filter(|l| !l.is_none())
+        .map(|l| law_arg(l, "law"))
+        .transpose()?;
     let base = match (scenario.filter(|s| !s.is_none()), toml) {
         (Some(_), Some(_)) => {
             return Err(PyValueError::new_err(
@@ -40,8 +46,9 @@ fn monte_carlo_specs(
         }
         (Some(s), None) => scenario_arg(s, "scenario")?,
         (None, Some(text)) => Scenario::from_toml_str(&text).map_err(value_error)?,
-        (None, None) => Scenario::builtin("paper-tilt").map_err(value_error)?,
+        (None, None) => Scenario::builtin(DEFAULT_SCENARIO).map_err(value_error)?,
     };
+    let base = with_law(base, law).map_err(value_error)?;
     let runs = runs.to("runs", 1, USIZE_MAX)?;
     let seed = seed.to("seed", 0, u64::MAX.into())?;
     let distributions = match distributions.filter(|d| !d.is_none()) {

@@ -727,3 +727,42 @@ def test_results_pickle_and_batches_fly_on_an_executor(tmp_path):
         sim.run_many(items, jobs=2, executor=object())
     with pytest.raises(ValueError, match="pickled"):
         sim._sim_result_from_state(b"nope")
+
+
+def test_monte_carlo_flies_the_default_law_and_takes_law():
+    # Issue 61: no scenario flies the hover family with the default law; `law` replaces any
+    # scenario's own, and every row says which law flew.
+    import json
+
+    default = sim.monte_carlo_specs(runs=1)
+    assert len(default) == 1
+    assert 'name = "hover"' in json.loads(default[0])["scenario_toml"]
+    plain = sim.monte_carlo(toml=MC_SHORT, runs=1)
+    paper = sim.monte_carlo(toml=MC_SHORT, runs=1, law="paper")
+    assert [r["law"] for r in plain["flights"]] == ["offset-free"]
+    assert [r["law"] for r in paper["flights"]] == ["paper"]
+    with pytest.raises(ValueError, match="law"):
+        sim.monte_carlo(toml=MC_SHORT, runs=1, law="pid")
+
+
+def test_monte_carlo_flies_turbulence_and_gusts_drawn_per_flight():
+    # Issue 61: the weather conditions reach Python through `distributions`.
+    import json
+
+    weather = {
+        "conditions": {
+            "turbulence": {"wind_speed_20ft": 7.7, "altitude": 1.5},
+            "gust": {"speed": 3.0, "duration": 2.0},
+        }
+    }
+    specs = sim.monte_carlo_specs(toml=MC_SHORT, runs=2, distributions=weather)
+    turbulences = [json.loads(s)["distributions"]["conditions"]["turbulence"] for s in specs]
+    assert all(t["wind_speed_20ft"] == 7.7 for t in turbulences)
+    with pytest.raises(ValueError, match="duration"):
+        sim.monte_carlo_specs(
+            toml=MC_SHORT, runs=1, distributions={"conditions": {"gust": {"speed": 3.0}}}
+        )
+    rows = sim.monte_carlo(toml=MC_SHORT, runs=2, distributions=weather)["flights"]
+    calm = sim.monte_carlo(toml=MC_SHORT, runs=2)["flights"]
+    # The air moves the team: every turbulent flight strays further than its calm twin.
+    assert all(r["position_rms"] > c["position_rms"] for r, c in zip(rows, calm))

@@ -1,7 +1,8 @@
-//! `[disturbances.air]`: wind as air velocity (constant plus gusts) acting on the team through a
-//! quadratic drag model (`docs/method.md`, "Scenario families").
+//! `[disturbances.air]`: wind as air velocity (constant, plus gusts, plus Dryden turbulence)
+//! acting on the team through a quadratic drag model (`docs/method.md`, "Scenario families").
 
 use serde::{Deserialize, Serialize};
+use tvmd_plant::turbulence::{Turbulence, MIN_SPEED};
 
 use crate::checks::{check_magnitude, check_nonneg, check_pos, check_range};
 use crate::error::invalid;
@@ -36,7 +37,8 @@ impl Gust {
     }
 }
 
-/// Wind on the team: the air moves at `velocity` plus the gusts, and the team feels the drag
+/// Wind on the team: the air moves at `velocity` plus the gusts plus the turbulence (carried
+/// past the team by `velocity`), and the team feels the drag
 /// `F = (rho / 2) C_d A |w - v| (w - v)` through its centre of mass (`w`: air velocity, `v`: the
 /// team's), world frame.
 ///
@@ -45,6 +47,7 @@ impl Gust {
 /// velocity = [3.0, 0.0, 0.0]  # m/s
 /// drag_area = 0.2             # C_d A (m^2); default 0.05 per agent
 /// gusts = [{ start = 5.0, duration = 2.0, velocity = [0.0, 3.0, 0.0] }]
+/// turbulence = { wind_speed_20ft = 7.72, altitude = 1.5, seed = 0 }  # Dryden, MIL-F-8785C
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -54,6 +57,10 @@ pub struct Air {
     /// Gusts on top of it.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub gusts: Vec<Gust>,
+    /// Dryden turbulence on top ([`Turbulence`]); needs a steady `velocity` of at least
+    /// [`MIN_SPEED`] to carry the frozen field past the team.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub turbulence: Option<Turbulence>,
     /// Drag area `C_d A` of the whole team (m^2), the same in every direction; none:
     /// [`DRAG_AREA_PER_AGENT`] per agent.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -72,6 +79,7 @@ impl Default for Air {
         Self {
             velocity: [0.0; 3],
             gusts: Vec::new(),
+            turbulence: None,
             drag_area: None,
             density: 1.225,
         }
@@ -84,6 +92,12 @@ impl Air {
         let mut w = self.velocity;
         for g in &self.gusts {
             let d = g.at(t);
+            for k in 0..3 {
+                w[k] += d[k];
+            }
+        }
+        if let Some(turbulence) = &self.turbulence {
+            let d = turbulence.velocity_at(t, self.velocity);
             for k in 0..3 {
                 w[k] += d[k];
             }
@@ -124,6 +138,27 @@ impl Air {
             check_nonneg(&format!("{f}.start"), &[g.start])?;
             check_pos(&format!("{f}.duration"), g.duration)?;
             check_magnitude(&format!("{f}.velocity"), &g.velocity, MAX_WIND_SPEED)?;
+        }
+        if let Some(t) = &self.turbulence {
+            let f = format!("{F}.turbulence");
+            check_range(
+                &format!("{f}.wind_speed_20ft"),
+                t.wind_speed_20ft,
+                0.0,
+                50.0,
+            )?;
+            check_range(&format!("{f}.altitude"), t.altitude, 0.0, 304.8)?;
+            check_range(&format!("{f}.scale"), t.scale, 0.0, 10.0)?;
+            let speed = self.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if speed < MIN_SPEED {
+                return Err(invalid(
+                    f,
+                    format!(
+                        "the frozen turbulence field is carried past the team by the steady wind: \
+                         give `{F}.velocity` of at least {MIN_SPEED} m/s (it is {speed} m/s)"
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -176,5 +211,44 @@ mod tests {
         };
         let e = bad.validate().unwrap_err().to_string();
         assert!(e.contains("disturbances.air.gusts[0].duration"), "{e}");
+    }
+
+    #[test]
+    fn turbulence_rides_on_the_steady_wind_and_needs_one() {
+        let calm = Air {
+            turbulence: Some(Turbulence::default()),
+            ..Air::default()
+        };
+        let e = calm.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("disturbances.air.turbulence") && e.contains("velocity"),
+            "{e}"
+        );
+        let windy = Air {
+            velocity: [3.0, 0.0, 0.0],
+            ..calm.clone()
+        };
+        windy.validate().unwrap();
+        // The air moves about the steady wind, not at it.
+        let mut sum = [0.0; 3];
+        let mut differs = false;
+        for i in 0..20_000 {
+            let w = windy.velocity_at(i as f64 * 0.05);
+            differs |= w != windy.velocity;
+            for k in 0..3 {
+                sum[k] += w[k] / 20_000.0;
+            }
+        }
+        assert!(differs);
+        assert!((sum[0] - 3.0).abs() < 0.3 && sum[1].abs() < 0.3 && sum[2].abs() < 0.3);
+        let strong = Air {
+            turbulence: Some(Turbulence {
+                wind_speed_20ft: 80.0,
+                ..Turbulence::default()
+            }),
+            ..windy
+        };
+        let e = strong.validate().unwrap_err().to_string();
+        assert!(e.contains("turbulence.wind_speed_20ft"), "{e}");
     }
 }

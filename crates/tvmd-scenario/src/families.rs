@@ -6,11 +6,13 @@
 
 use super::{Air, Gust, Payload, PlantError, Scenario};
 use tvmd_plant::reference::{FigureEight, ReferenceConfig, Sine, Step};
+use tvmd_plant::turbulence::{Turbulence, MODERATE_W20};
 
 /// Names of the scenario families.
 pub const FAMILY_NAMES: &[&str] = &[
     "hover",
     "wind",
+    "turbulence",
     "payload",
     "model-error",
     "reference-jump",
@@ -59,6 +61,25 @@ pub(super) fn family(name: &str) -> Option<Scenario> {
             "Hover at 1.5 m in a 1 m/s wind along x with a 3 m/s 1-cos gust along y at 4-6 s \
              (drag C_d A = 0.05 m^2 per agent)"
                 .into()
+        }
+        "turbulence" => {
+            let turbulence = Turbulence::standard(MODERATE_W20, HOVER_HEIGHT);
+            let mean = turbulence.mean_wind_speed();
+            s.duration = 30.0;
+            s.disturbances.air = Some(Air {
+                velocity: [mean, 0.0, 0.0],
+                turbulence: Some(turbulence),
+                ..Air::default()
+            });
+            // Turbulence has no steady state: the bound is on the mean error over the flight.
+            s.success.steady_state_window = s.duration;
+            s.success.max_steady_state_position_error = 0.1;
+            format!(
+                "Hover at 1.5 m for 30 s in moderate turbulence (Dryden, MIL-F-8785C low \
+                 altitude, W20 = 30 kt) carried by the standard's mean wind at 1.5 m, \
+                 {mean:.2} m/s along x (drag C_d A = 0.05 m^2 per agent); success: mean position \
+                 error at most 0.1 m"
+            )
         }
         "payload" => {
             s.payloads = vec![Payload {

@@ -88,9 +88,11 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             jobs,
             precision,
             allocator,
+            law,
         } => RunRequest {
             scenario: ScenarioSource::NameOrFile(scenario),
             allocator,
+            law,
             ..RunRequest::default()
         }
         .with_strings(precision.as_deref(), None, None)

@@ -46,6 +46,7 @@ def monte_carlo(
     allocators=None,
     model_errors=None,
     distributions=None,
+    law=None,
     out=None,
     jobs=None,
     executor=None,
@@ -60,6 +61,7 @@ def monte_carlo(
         allocators=allocators,
         model_errors=model_errors,
         distributions=distributions,
+        law=law,
     )
     if out is not None:
         # Checked before any flight: a bad `out` must not cost the study.

@@ -785,7 +785,11 @@ class Distributions(TypedDict, total=False):
     """Flight conditions every flight meets where the scenario sets none: ``servo`` (a servo
     model table), ``state_noise`` (a noise table; its seed is drawn per flight),
     ``feedback_latency`` (periods); default 40 rad/s servos, 1 mm / 1 cm/s / 2 mrad / 0.01 rad/s
-    noise and one period. ``{"servo": None, "state_noise": None, "feedback_latency": 0}``: none."""
+    noise and one period. ``{"servo": None, "state_noise": None, "feedback_latency": 0}``: none.
+    Off by default: ``turbulence`` (``{"wind_speed_20ft": W20, "altitude": m, "scale": 1.0,
+    "seed": 0}``, Dryden, MIL-F-8785C; phases drawn per flight, on the standard's mean wind
+    where the scenario has no air) and ``gust`` (``{"speed": m/s, "duration": s}``, heading
+    and start drawn per flight)."""
 
 def monte_carlo(
     scenario: Optional[_ScenarioArg] = None,
@@ -797,6 +801,7 @@ def monte_carlo(
     allocators: Optional[Iterable[AllocatorName]] = None,
     model_errors: Optional[Iterable[float]] = None,
     distributions: Optional[Distributions] = None,
+    law: Optional[_LawArg] = None,
     out: Optional[_PathArg] = None,
     jobs: Optional[int] = None,
     executor: Optional[Any] = None,
@@ -807,7 +812,9 @@ def monte_carlo(
     and allocators meet the same errors and the results do not depend on where they fly).
 
     Args:
-        scenario, toml: as ``run`` (default ``"paper-tilt"``).
+        scenario, toml: as ``run`` (default ``"hover"``: the hover family, which flies the
+            default law; ``"paper-tilt"`` names the paper's law, which has no integral action
+            and fails every flight under model error).
         runs: flights per group.
         seed: the study's seed.
         teams: catalogue teams (``team.preset`` names); default the scenario's own.
@@ -815,6 +822,7 @@ def monte_carlo(
         model_errors: model-error multipliers, one group each; default
             ``distributions["model_error"]``.
         distributions: the half-widths (``Distributions``).
+        law: the control law of every flight, as ``run``'s ``law``; default the scenario's.
         out: write ``flights.csv``, ``groups.csv`` and the box plots (PNG) into this directory.
         jobs: threads of this process (default: every core); not with ``executor``.
         executor: any ``concurrent.futures.Executor`` (``ProcessPoolExecutor``, a Dask
@@ -849,6 +857,7 @@ def monte_carlo_specs(
     allocators: Optional[Iterable[str]] = None,
     model_errors: Optional[Iterable[float]] = None,
     distributions: Optional[Distributions] = None,
+    law: Optional[_LawArg] = None,
 ) -> list[str]:
     """The study's flights as JSON specs, group by group (as ``monte_carlo``, nothing flown)."""
 

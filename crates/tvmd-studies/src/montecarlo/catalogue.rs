@@ -9,9 +9,9 @@ use std::sync::atomic::AtomicBool;
 use serde::Serialize;
 use tvmd_core::presets::Preset;
 
-use super::{fly_all_until, Distributions, FlightRow, Study};
+use super::{fly_all_until, with_law, Distributions, FlightRow, Study};
 use crate::StudyError;
-use tvmd_scenario::Scenario;
+use tvmd_scenario::{LawConfig, Scenario};
 
 /// The allocators of the table by default (the Clarabel ones need the `clarabel` feature).
 pub const ALLOCATORS: [&str; 4] = [
@@ -40,7 +40,9 @@ pub struct CatalogueSettings {
     pub teams: Vec<String>,
     /// Allocators, comma-separated (default: the four without the `clarabel` feature).
     pub allocators: Vec<String>,
-    /// Write `catalogue.csv` (one row per flight) and `catalogue.md` here.
+    /// The control law of every task; `None`: the tasks' own (the families' default law).
+    pub law: Option<LawConfig>,
+    /// Write `catalogue.csv` (one row per team and allocator) and `catalogue.md` here.
     pub out: Option<PathBuf>,
     /// Worker threads (default: every core).
     pub jobs: Option<usize>,
@@ -79,7 +81,7 @@ fn task_study(
     allocators: &[String],
     args: &CatalogueSettings,
 ) -> Result<Study, StudyError> {
-    let base = Scenario::builtin(scenario)?;
+    let base = with_law(Scenario::builtin(scenario)?, args.law)?;
     let model_error = scenario == "hover";
     let none = Distributions {
         model_error: 0.0,
@@ -244,6 +246,7 @@ mod tests {
             seed: 0,
             teams: vec!["a6-inc".into()],
             allocators: vec!["exact-boundary-redistribution".into()],
+            law: None,
             out: None,
             jobs: None,
         };

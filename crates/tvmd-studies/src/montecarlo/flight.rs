@@ -75,6 +75,8 @@ pub struct FlightRow {
     pub team: String,
     /// Allocator.
     pub allocator: String,
+    /// The control law that flew: `"paper"`, `"offset-free"` or `"custom"`.
+    pub law: String,
     /// The study's seed.
     pub seed: u64,
     /// The flight's index.
@@ -176,6 +178,7 @@ pub fn fly_flight_until(
                 }
             }),
         allocator: scenario.allocator.clone(),
+        law: scenario.law.name().into(),
         seed: spec.seed,
         index: spec.index,
         model_error: spec.distributions.model_error,

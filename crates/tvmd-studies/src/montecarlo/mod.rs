@@ -18,17 +18,34 @@ mod study_run;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-pub use conditions::Conditions;
+pub use conditions::{Conditions, GustCondition};
 pub use distributions::{Distributions, Draw};
 pub use flight::{fly_flight, fly_flight_until, FlightRow, FlightSpec};
 pub use report::{group_summaries, quantile, text_table, write_csv, GroupSummary};
 pub use study_run::{run, run_until, MonteCarloOutput, MonteCarloRequest};
 
 use crate::StudyError;
-use tvmd_scenario::Scenario;
+use tvmd_scenario::{LawConfig, Overrides, Scenario};
 
 /// Largest number of flights of one study.
 pub const MAX_FLIGHTS: usize = 10_000_000;
+
+/// The scenario a study flies when none is named (`tvmd-sim montecarlo`, Python's
+/// `monte_carlo`): the hover family, which flies the library's default law. (`paper-tilt` names
+/// the paper's law, which has no integral action: under any model error it fails every flight.)
+pub const DEFAULT_SCENARIO: &str = "hover";
+
+/// `scenario` with its control law replaced by `law` where one is given (`--law`, `law=`),
+/// validated.
+pub fn with_law(scenario: Scenario, law: Option<LawConfig>) -> Result<Scenario, StudyError> {
+    match law {
+        None => Ok(scenario),
+        Some(law) => Ok(scenario.with_overrides(&Overrides {
+            law: Some(law),
+            ..Overrides::default()
+        })?),
+    }
+}
 
 /// A study: `runs` flights of `scenario` for every team, allocator and model-error level.
 #[derive(Clone, Debug, PartialEq)]
@@ -315,7 +332,7 @@ mod tests {
         let text = std::fs::read_to_string(&files.flights).unwrap();
         let header = text.lines().next().unwrap();
         assert!(
-            header.starts_with("scenario,team,allocator,seed,index,model_error,"),
+            header.starts_with("scenario,team,allocator,law,seed,index,model_error,"),
             "{header}"
         );
         assert_eq!(text.lines().count(), 1 + rows.len());

@@ -4,15 +4,20 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
-use super::{fly_all_until, text_table, Distributions, ReportFiles, Study, StudyReport};
+use super::conditions::{Conditions, GustCondition};
+use super::{fly_all_until, text_table, with_law, Distributions, ReportFiles, Study, StudyReport};
 use crate::StudyError;
-use tvmd_scenario::Scenario;
+use tvmd_plant::turbulence::Turbulence;
+use tvmd_scenario::{LawConfig, Scenario};
 
 /// Arguments of `tvmd-sim montecarlo`.
 #[derive(Debug, Clone)]
 pub struct MonteCarloRequest {
-    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file.
+    /// A built-in scenario name (see `tvmd-sim list`) or a TOML file
+    /// ([`super::DEFAULT_SCENARIO`] by default).
     pub scenario: String,
+    /// The control law every flight flies; `None`: the scenario's own.
+    pub law: Option<LawConfig>,
     /// Flights per team, allocator and model-error level.
     pub runs: usize,
     /// Seed of every draw (flight k of a group always draws the same errors).
@@ -37,6 +42,12 @@ pub struct MonteCarloRequest {
     pub initial_position: Option<f64>,
     /// Largest initial tilt (rad, at most 2.5; the scenario must start in the air).
     pub initial_tilt: Option<f64>,
+    /// Dryden turbulence in every flight: `W20`, the wind speed 20 ft above ground (m/s), at
+    /// the scenario's initial height ([`super::conditions::Conditions::turbulence`]).
+    pub turbulence: Option<f64>,
+    /// A `1 - cos` gust of this peak speed (m/s, 2 s long) in every flight
+    /// ([`super::conditions::Conditions::gust`]).
+    pub gust: Option<f64>,
     /// Directory for `flights.csv`, `groups.csv` and the PNG figures (default:
     /// `out/montecarlo/<scenario>`).
     pub out: Option<PathBuf>,
@@ -47,8 +58,25 @@ pub struct MonteCarloRequest {
 impl MonteCarloRequest {
     /// The study these arguments describe.
     pub fn study(&self) -> Result<Study, StudyError> {
-        let scenario = Scenario::load(&self.scenario)?;
+        let scenario = with_law(Scenario::load(&self.scenario)?, self.law)?;
         let d = Distributions::default();
+        let height = scenario.initial_position[2].max(0.0);
+        for (name, v) in [("turbulence", self.turbulence), ("gust", self.gust)] {
+            if v.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
+                return Err(StudyError::InvalidArgument {
+                    name: name.into(),
+                    reason: format!("{} m/s: must be finite and at least 0", v.unwrap_or(0.0)),
+                });
+            }
+        }
+        let conditions = Conditions {
+            turbulence: self.turbulence.map(|w20| Turbulence::standard(w20, height)),
+            gust: self.gust.map(|speed| GustCondition {
+                speed,
+                duration: 2.0,
+            }),
+            ..d.conditions
+        };
         let or = |v: Option<f64>, default: f64| v.unwrap_or(default);
         Ok(Study {
             runs: self.runs,
@@ -65,7 +93,7 @@ impl MonteCarloRequest {
                 gimbal_offset: or(self.gimbal_offset, d.gimbal_offset),
                 initial_position: or(self.initial_position, d.initial_position),
                 initial_tilt: or(self.initial_tilt, d.initial_tilt),
-                conditions: d.conditions,
+                conditions,
             },
             scenario,
         })
@@ -142,4 +170,51 @@ pub fn run_until(
             .files
             .ok_or_else(|| StudyError::Internal("the report wrote no files".into()))?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::DEFAULT_SCENARIO;
+    use super::*;
+
+    fn request(scenario: &str, law: Option<LawConfig>) -> MonteCarloRequest {
+        MonteCarloRequest {
+            scenario: scenario.into(),
+            law,
+            runs: 1,
+            seed: 0,
+            teams: Vec::new(),
+            allocators: Vec::new(),
+            model_error: Vec::new(),
+            mass: None,
+            inertia: None,
+            com_offset: None,
+            thrust_efficiency: None,
+            gimbal_offset: None,
+            initial_position: None,
+            initial_tilt: None,
+            turbulence: None,
+            gust: None,
+            out: None,
+            jobs: None,
+        }
+    }
+
+    /// Issue 61: a study that names no scenario flies the library's default law, and `law`
+    /// replaces any scenario's own.
+    #[test]
+    fn the_default_study_flies_the_default_law_and_law_replaces_the_scenarios() {
+        let default = request(DEFAULT_SCENARIO, None).study().unwrap();
+        assert_eq!(default.scenario.law, LawConfig::default());
+        let paper = request("paper-tilt", None).study().unwrap();
+        assert!(paper.scenario.law.is_paper());
+        let overridden = request("paper-tilt", Some(LawConfig::default()))
+            .study()
+            .unwrap();
+        assert_eq!(overridden.scenario.law, LawConfig::default());
+        let hover_paper = request(DEFAULT_SCENARIO, Some(LawConfig::paper()))
+            .study()
+            .unwrap();
+        assert!(hover_paper.scenario.law.is_paper());
+    }
 }
