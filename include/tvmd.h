@@ -1459,7 +1459,8 @@ TvmdStatus tvmd_set_rate_limits(struct TvmdController *handle,
  The commands the vehicle flies now (at a switch from another controller) become the held
  ones: what a refused period repeats and where the rate limits start. `commands` holds
  `count` entries, `count` = the team's agent count; each working agent's command must lie in
- its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+ its admissible set (gimbal and thrust limits, the rotor speed within `[0, sigma_omega]`:
+ what `tvmd_actuator_outputs` outputs), a failed agent's must be all zero. A bad
  command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
  `count`: `TVMD_ERR_SIZE`) and the held commands stay.
 
