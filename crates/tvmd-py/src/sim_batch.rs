@@ -188,6 +188,15 @@ impl PySimulationBatch {
             None => (0..b).collect(),
         };
         let m = indices.len();
+        let mut seen = vec![false; b];
+        for &k in &indices {
+            if std::mem::replace(&mut seen[k], true) {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "`indices` names team {k} twice (each team is reset once, with its own seed \
+                     and pose)"
+                )));
+            }
+        }
         let seeds: Option<Vec<u64>> = seeds
             .map(|s| {
                 s.iter()

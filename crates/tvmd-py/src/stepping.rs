@@ -347,6 +347,8 @@ impl PyControllerOutput {
 pub(crate) struct PyScenarioController {
     /// In a mutex: a Python class must be `Sync`, the controller is `Send` only.
     inner: Mutex<AnyTvmdController>,
+    /// The number of agents of its team (an observation of another team is refused).
+    n: usize,
 }
 
 #[pymethods]
@@ -369,14 +371,23 @@ impl PyScenarioController {
             py, scenario, toml, team, relaxation, allocator, precision, null_space, law, None,
         )?;
         let inner = AnyTvmdController::from_scenario(&spec.scenario).map_err(value_error)?;
+        let n = spec.scenario.team_body().map_err(value_error)?.len();
         Ok(Self {
             inner: Mutex::new(inner),
+            n,
         })
     }
 
     /// The commands and diagnostics for one tick's observation (call it once per tick).
     fn step(&mut self, observation: &Bound<'_, PyObservation>) -> PyResult<PyControllerOutput> {
         let o = &observation.get().inner.observation;
+        if o.failed.len() != self.n {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "`observation` is of a team of {} agents; this controller flies {}",
+                o.failed.len(),
+                self.n
+            )));
+        }
         let mut controller = self
             .inner
             .lock()
