@@ -1175,7 +1175,9 @@ typedef struct TvmdPlanOutput {
 #define TVMD_ERR_MAP_AGENT_COUNT 50
 
 /*
- A channel index of the actuator map is at or beyond `TVMD_MAX_AGENTS` (16 channels).
+ A channel index of the actuator map is at or beyond its kind's channels: motors
+ `TVMD_MOTOR_CHANNELS` (12, PX4's `actuator_motors`), servos `TVMD_SERVO_CHANNELS` (8, PX4's
+ `actuator_servos`).
  */
 #define TVMD_ERR_MAP_CHANNEL_RANGE 51
 

@@ -328,7 +328,8 @@ pub struct CatalogueArgs {
     /// Allocators, comma-separated (default: the four without the `clarabel` feature).
     #[arg(long, value_delimiter = ',')]
     pub allocators: Vec<String>,
-    /// Write `catalogue.csv` (one row per flight) and `catalogue.md` here.
+    /// Write `catalogue.csv` (one row per team and allocator, each over its flights) and
+    /// `catalogue.md` here.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Worker threads (default: every core).
