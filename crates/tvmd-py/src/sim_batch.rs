@@ -190,7 +190,7 @@ impl PySimulationBatch {
         let m = indices.len();
         let mut seen = vec![false; b];
         for &k in &indices {
-            if std::mem::replace(&mut seen[k], true) {
+            if seen.get_mut(k).is_some_and(|s| std::mem::replace(s, true)) {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
                     "`indices` names team {k} twice (each team is reset once, with its own seed \
                      and pose)"

@@ -251,7 +251,7 @@ impl Scenario {
             )?;
             if !f.controller_informed && f.informed_after != 0.0 {
                 return Err(invalid(
-                    &format!("failures[{i}].informed_after"),
+                    format!("failures[{i}].informed_after"),
                     "a controller never informed (`controller_informed = false`) is never told \
                      late: drop one of the two",
                 ));
