@@ -1175,7 +1175,9 @@ typedef struct TvmdPlanOutput {
 #define TVMD_ERR_MAP_AGENT_COUNT 50
 
 /*
- A channel index of the actuator map is at or beyond `TVMD_MAX_AGENTS` (16 channels).
+ A channel index of the actuator map is at or beyond its kind's channels: motors
+ `TVMD_MOTOR_CHANNELS` (12, PX4's `actuator_motors`), servos `TVMD_SERVO_CHANNELS` (8, PX4's
+ `actuator_servos`).
  */
 #define TVMD_ERR_MAP_CHANNEL_RANGE 51
 
@@ -1378,9 +1380,11 @@ TvmdStatus tvmd_hover_capability(const struct TvmdController *handle, struct Tvm
 TvmdStatus tvmd_reset(struct TvmdController *handle);
 
 /*
- The preflight integrity check: `TVMD_OK` when the handle was created and both guards
- around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
- otherwise (every other entry point makes the same check first).
+ The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
+ the storage are intact and the controller's bytes match the seal the last entry point left
+ (a checksum of them), `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED` otherwise. Every
+ other entry point makes the same check first, so a handle a stray write changed is refused
+ before anything in it is used: no entry point hangs or crashes whatever the storage holds.
 
  # Safety
  `handle` as for [`tvmd_step`].
@@ -1459,7 +1463,8 @@ TvmdStatus tvmd_set_rate_limits(struct TvmdController *handle,
  The commands the vehicle flies now (at a switch from another controller) become the held
  ones: what a refused period repeats and where the rate limits start. `commands` holds
  `count` entries, `count` = the team's agent count; each working agent's command must lie in
- its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+ its admissible set (gimbal and thrust limits, the rotor speed within `[0, sigma_omega]`:
+ what `tvmd_actuator_outputs` outputs), a failed agent's must be all zero. A bad
  command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
  `count`: `TVMD_ERR_SIZE`) and the held commands stay.
 

@@ -387,11 +387,12 @@ pub struct CatalogueArgs {
     /// Allocators, comma-separated (default: the four without the `clarabel` feature).
     #[arg(long, value_delimiter = ',')]
     pub allocators: Vec<String>,
-    /// Override the tasks' control law (`[law]`): offset-free (the default law, the tasks' own) or paper
-    /// (the paper's law as published, no integral action; docs/method.md).
+    /// Override the tasks' control law (`[law]`): offset-free (the default law, the tasks'
+    /// own) or paper (the paper's law as published, no integral action; docs/method.md).
     #[arg(long, value_parser = law_parser())]
     pub law: Option<tvmd_scenario::LawConfig>,
-    /// Write `catalogue.csv` (one row per team and allocator) and `catalogue.md` here.
+    /// Write `catalogue.csv` (one row per team and allocator, each over its flights) and
+    /// `catalogue.md` here.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Worker threads (default: every core).

@@ -172,7 +172,7 @@ unsafe fn checked<'a>(
 
 /// Whether a command is finite and inside `E_f` (eq. 6) up to the core's round-off tolerance,
 /// so that no output is clipped beyond round-off.
-fn admissible(limits: &AgentLimits<f32>, c: &TvmdAgentCommand) -> bool {
+pub(crate) fn admissible(limits: &AgentLimits<f32>, c: &TvmdAgentCommand) -> bool {
     let tol = command_tolerance::<f32>();
     let within = |x: f32, hi: f32| x.is_finite() && x >= -tol * hi && x <= hi * (1.0 + tol);
     c.eta_x.is_finite()

@@ -8,6 +8,7 @@ use tvmd_core::{AgentCommand, AnyAllocator, RateLimits, Relaxation};
 
 use core::mem::MaybeUninit;
 
+use crate::actuator::admissible;
 use crate::blueprint::Blueprint;
 use crate::handle::{checked_size, inner_mut, FfiController, TvmdController};
 use crate::status::*;
@@ -58,7 +59,7 @@ pub unsafe extern "C" fn tvmd_reconfigure(
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    let inner = match inner_mut(handle) {
+    let mut inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -90,7 +91,7 @@ pub unsafe extern "C" fn tvmd_set_gains(
     let Some(gains) = gains.as_ref() else {
         return TVMD_ERR_NULL_POINTER;
     };
-    let inner = match inner_mut(handle) {
+    let mut inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -110,7 +111,7 @@ pub unsafe extern "C" fn tvmd_set_relaxation(
     handle: *mut TvmdController,
     relaxation: f32,
 ) -> TvmdStatus {
-    let inner = match inner_mut(handle) {
+    let mut inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -135,7 +136,7 @@ pub unsafe extern "C" fn tvmd_set_rate_limits(
     enabled: u32,
     limits: *const f32,
 ) -> TvmdStatus {
-    let inner = match inner_mut(handle) {
+    let mut inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -158,7 +159,8 @@ pub unsafe extern "C" fn tvmd_set_rate_limits(
 /// The commands the vehicle flies now (at a switch from another controller) become the held
 /// ones: what a refused period repeats and where the rate limits start. `commands` holds
 /// `count` entries, `count` = the team's agent count; each working agent's command must lie in
-/// its admissible set (gimbal and thrust limits), a failed agent's must be all zero. A bad
+/// its admissible set (gimbal and thrust limits, the rotor speed within `[0, sigma_omega]`:
+/// what `tvmd_actuator_outputs` outputs), a failed agent's must be all zero. A bad
 /// command is refused (`TVMD_ERR_INPUT_NON_FINITE`, `TVMD_ERR_INPUT_OUT_OF_RANGE`; a wrong
 /// `count`: `TVMD_ERR_SIZE`) and the held commands stay.
 ///
@@ -173,7 +175,7 @@ pub unsafe extern "C" fn tvmd_seed_commands(
     if commands.is_null() {
         return TVMD_ERR_NULL_POINTER;
     }
-    let inner = match inner_mut(handle) {
+    let mut inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -182,6 +184,18 @@ pub unsafe extern "C" fn tvmd_seed_commands(
         return TVMD_ERR_SIZE;
     }
     let given = core::slice::from_raw_parts(commands, n);
+    // What the actuator map would refuse to output is refused here (a rotor speed beyond the
+    // largest, which the core's gimbal and thrust check does not read): a held command must
+    // stay publishable. Non-finite values are the core's refusal.
+    let limits = inner.controller.team().limits();
+    let finite = |c: &TvmdAgentCommand| {
+        [c.eta_x, c.eta_y, c.thrust, c.omega]
+            .iter()
+            .all(|x| x.is_finite())
+    };
+    if given.iter().any(|c| finite(c) && !admissible(limits, c)) {
+        return TVMD_ERR_INPUT_OUT_OF_RANGE;
+    }
     let mut seeded = [AgentCommand::<f32>::idle(); TVMD_MAX_AGENTS];
     for (slot, c) in seeded.iter_mut().zip(given) {
         *slot = AgentCommand {

@@ -86,7 +86,9 @@ pub const TVMD_ERR_CONFIG_STAGE_UNAVAILABLE: TvmdStatus = 39;
 
 /// The actuator map's agent count is not the controller's.
 pub const TVMD_ERR_MAP_AGENT_COUNT: TvmdStatus = 50;
-/// A channel index of the actuator map is at or beyond `TVMD_MAX_AGENTS` (16 channels).
+/// A channel index of the actuator map is at or beyond its kind's channels: motors
+/// `TVMD_MOTOR_CHANNELS` (12, PX4's `actuator_motors`), servos `TVMD_SERVO_CHANNELS` (8, PX4's
+/// `actuator_servos`).
 pub const TVMD_ERR_MAP_CHANNEL_RANGE: TvmdStatus = 51;
 /// Two outputs of the actuator map share a channel (motors and servos are counted apart).
 pub const TVMD_ERR_MAP_DUPLICATE_CHANNEL: TvmdStatus = 52;

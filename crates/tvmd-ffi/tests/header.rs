@@ -27,3 +27,20 @@ fn header_is_up_to_date() {
          `TVMD_BLESS=1 cargo test -p tvmd-ffi --test header` and commit it"
     );
 }
+
+/// Each `TVMD_ERR_MAP_CHANNEL_RANGE` bound the header states is the one the map checks: the
+/// motor and servo channels of PX4's topics, not `TVMD_MAX_AGENTS` (issue 57, item 8).
+#[test]
+fn the_channel_range_error_names_the_channels_the_map_checks() {
+    let crate_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let header = std::fs::read_to_string(crate_dir.join("../../include/tvmd.h")).unwrap();
+    let at = header.find("#define TVMD_ERR_MAP_CHANNEL_RANGE").unwrap();
+    let comment = &header[header[..at].rfind("/*").unwrap()..at];
+    let motors = tvmd_ffi::actuator::TVMD_MOTOR_CHANNELS;
+    let servos = tvmd_ffi::actuator::TVMD_SERVO_CHANNELS;
+    assert!(
+        comment.contains(&format!("({motors},")) && comment.contains(&format!("({servos},")),
+        "{comment}"
+    );
+    assert!(!comment.contains("16"), "{comment}");
+}

@@ -49,7 +49,7 @@ pub use convert::{fg_quaternion, fg_vector, frame_transform, nanos, timestamp};
 pub use error::LogError;
 pub use kind::LogKind;
 pub use live::{LiveOptions, LiveServer};
-pub use read::{read_run, read_run_bytes, LoggedRun, TickMessages};
+pub use read::{read_log_file, read_run, read_run_bytes, LoggedRun, TickMessages};
 pub use run_log::RunLog;
 pub use writer::{LogJob, QUEUE_JOBS};
 

@@ -76,6 +76,18 @@ pub struct SaturationLimits {
     pub max_thrust: f64,
 }
 
+impl SaturationLimits {
+    /// `cmd` with each gimbal angle clamped to its limit and the thrust to `[0, max_thrust]`
+    /// (a rotor pushes only up its axis); a non-finite value stays non-finite.
+    pub fn saturate(&self, cmd: &ActuatorCommand) -> ActuatorCommand {
+        ActuatorCommand {
+            eta_x: cmd.eta_x.clamp(-self.sigma_x, self.sigma_x),
+            eta_y: cmd.eta_y.clamp(-self.sigma_y, self.sigma_y),
+            thrust: cmd.thrust.clamp(0.0, self.max_thrust),
+        }
+    }
+}
+
 /// Actuator model of every agent. The default is ideal (commands pass through).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -164,12 +176,7 @@ impl AgentActuator {
         model: &ActuatorModel,
         dt: f64,
     ) -> ActuatorCommand {
-        let mut c = *cmd;
-        if let Some(l) = &model.limits {
-            c.eta_x = c.eta_x.clamp(-l.sigma_x, l.sigma_x);
-            c.eta_y = c.eta_y.clamp(-l.sigma_y, l.sigma_y);
-            c.thrust = c.thrust.clamp(0.0, l.max_thrust);
-        }
+        let c = model.limits.map_or(*cmd, |l| l.saturate(cmd));
         if !self.gimbal_stuck {
             match &model.servo {
                 None => {

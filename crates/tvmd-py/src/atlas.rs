@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use tvmd_core::team::presets::Preset;
 use tvmd_studies::afs_atlas::{run_until, AtlasRequest};
 
 use crate::convert::{count, indices, record_to_py, Int};
@@ -39,6 +40,14 @@ fn afs_atlas<'py>(
         return Err(PyValueError::new_err(
             "afs_atlas takes one team; loop over tvmd.Team.preset_names() for the catalogue",
         ));
+    }
+    // The names this function takes (the CLI's list adds `all`, which it refuses).
+    let known: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+    if !known.contains(&team) {
+        return Err(PyValueError::new_err(format!(
+            "unknown team `{team}` (known: {})",
+            known.join(", ")
+        )));
     }
     let failed = indices(failed, "failed")?
         .iter()

@@ -171,8 +171,22 @@ impl PyController {
     }
 
     #[doc = include_str!("../docstrings/tvmd.Controller.set_landed.txt")]
-    fn set_landed(&mut self, landed: bool) {
-        self.inner.set_landed(landed);
+    fn set_landed(&mut self, landed: &Bound<'_, PyAny>) -> PyResult<()> {
+        // A flag as flight code passes it: a bool, or the integers 0 and 1 (as C's `landed`).
+        let flag = match landed.extract::<bool>() {
+            Ok(b) => b,
+            Err(_) => match landed.extract::<i64>() {
+                Ok(i @ (0 | 1)) => i == 1,
+                _ => {
+                    return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                        "`landed` must be a bool (or 0 or 1), got {}",
+                        landed.repr()?
+                    )))
+                }
+            },
+        };
+        self.inner.set_landed(flag);
+        Ok(())
     }
 
     /// Whether the landed hold is on (`set_landed`).

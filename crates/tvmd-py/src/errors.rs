@@ -108,7 +108,9 @@ pub(crate) trait SimErrorKind: std::fmt::Display {
 impl SimErrorKind for PhysicsError {
     fn kind(&self) -> ErrorKind<'_> {
         match self {
-            PhysicsError::InvalidTeam(_) | PhysicsError::InvalidScenario { .. } => ErrorKind::Value,
+            PhysicsError::InvalidTeam(_)
+            | PhysicsError::InvalidScenario { .. }
+            | PhysicsError::InvalidCommand { .. } => ErrorKind::Value,
             _ => ErrorKind::Runtime,
         }
     }

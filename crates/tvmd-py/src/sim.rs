@@ -136,9 +136,27 @@ fn relaxation_sweep(
 #[pyfunction]
 #[pyo3(signature = (path))]
 fn load(py: Python<'_>, path: PathBuf) -> PyResult<PySimResult> {
+    const CONTEXT: &str = "cannot load the run log: ";
     let loaded = py
         .detach(|| tvmd_sim::load_run(&path))
-        .map_err(|e| PyValueError::new_err(format!("cannot load the run log: {e}")))?;
+        .map_err(|e| match e {
+            // The file itself (missing, unreadable, not a regular file): an `OSError`, as in `run`.
+            e @ tvmd_sim::SimError::Log(tvmd_log::LogError::File { .. }) => {
+                crate::errors::sim_error(e, CONTEXT, None)
+            }
+            e => PyValueError::new_err(format!("{CONTEXT}{e}")),
+        })?;
+    if let Some(damage) = &loaded.damage {
+        let message = format!(
+            "{}: the log is damaged; loaded the {} ticks before the damage ({damage})",
+            path.display(),
+            loaded.result.samples.len()
+        );
+        let message = std::ffi::CString::new(message.replace('\0', " "))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        PyErr::warn(py, &category, &message, 1)?;
+    }
     let spec = RunSpec {
         scenario: loaded.scenario,
         log: Some(path),

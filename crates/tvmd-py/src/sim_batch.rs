@@ -17,8 +17,9 @@ use crate::stepping::spec;
 /// `SimulationBatch(scenario="hover", *, count, jobs, ...)` (`Simulation`'s scenario
 /// arguments). `reset`, `step_wrench((B, 6))` and `step((B, n, 3))` return a dict of `(B, ...)`
 /// arrays (`t`, `position`, `velocity_world`, `angular_velocity`, `rotation`, `true_position`,
-/// `reference_position`, `reference_velocity`, `reference_rotation`, `done`) and `errors` (one
-/// message or None per team: a failed team does not stop the others).
+/// `reference_position`, `reference_velocity`, `reference_rotation`, `done`, `saturation`
+/// (B, n, 3): what the plant clamped off each team's last commands) and `errors` (one message
+/// or None per team: a failed team does not stop the others).
 #[pyclass(module = "tvmd.sim", name = "SimulationBatch")]
 pub(crate) struct PySimulationBatch {
     batch: SimulationBatch,
@@ -78,6 +79,24 @@ fn arrays<'py>(
             .collect();
         out.set_item(name, shaped(py, values, &[b, 3, 3])?)?;
     }
+    // (B, n, 3): what the plant clamped off each team's last commands (NaN for a failed team).
+    let n = steps
+        .iter()
+        .flatten()
+        .map(|s| s.saturation.len())
+        .max()
+        .unwrap_or(0);
+    let saturation: Vec<f64> = (0..b)
+        .flat_map(|k| {
+            let clamped = ok(k).map(|s| s.saturation.as_slice()).unwrap_or_default();
+            (0..n).flat_map(move |i| {
+                clamped
+                    .get(i)
+                    .map_or([f64::NAN; 3], |c| [c.eta_x, c.eta_y, c.thrust])
+            })
+        })
+        .collect();
+    out.set_item("saturation", shaped(py, saturation, &[b, n, 3])?)?;
     let done: Vec<bool> = (0..b).map(|k| ok(k).is_some_and(|s| s.finished)).collect();
     out.set_item("done", shaped(py, done, &[b])?)?;
     let errors: Vec<Option<String>> = steps
@@ -169,6 +188,15 @@ impl PySimulationBatch {
             None => (0..b).collect(),
         };
         let m = indices.len();
+        let mut seen = vec![false; b];
+        for &k in &indices {
+            if seen.get_mut(k).is_some_and(|s| std::mem::replace(s, true)) {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "`indices` names team {k} twice (each team is reset once, with its own seed \
+                     and pose)"
+                )));
+            }
+        }
         let seeds: Option<Vec<u64>> = seeds
             .map(|s| {
                 s.iter()

@@ -10,6 +10,7 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
+use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_sim::control::{core_reference, core_state};
 use tvmd_sim::runner::RunSpec;
 use tvmd_sim::sim::{Observation, SimOptions, Simulation, Verdict};
@@ -63,12 +64,14 @@ pub(crate) fn spec(
 pub(crate) struct ObservationData {
     observation: Observation,
     done: bool,
+    /// Per agent, what the plant clamped off the last step's commands.
+    saturation: Vec<ActuatorCommand>,
 }
 
 record! {
     /// One controller tick as a controller sees it: `t` (s), `state` (the fed-back
     /// `tvmd.State`, noise and latency applied), `true_state`, `velocity_world` (3,),
-    /// `reference` (a `tvmd.Reference`), `failed` (n,) and `done`.
+    /// `reference` (a `tvmd.Reference`), `failed` (n,), `done` and `saturation` (n, 3).
     "Observation" in "tvmd.sim" => PyObservation(ObservationData) |py, o| {
         /// Simulation time `t_k` (s).
         t => o.observation.t,
@@ -84,6 +87,13 @@ record! {
         failed => shaped(py, o.observation.failed.clone(), &[o.observation.failed.len()])?,
         /// The scenario's duration is reached (no step follows).
         done => o.done,
+        /// (n, 3) by how much the plant clamped the last step's commands to the hardware's
+        /// range: the command minus what it held (`eta_x`, `eta_y` rad, thrust N); zero inside
+        /// the range and after a reset.
+        saturation => {
+            let s = &o.saturation;
+            shaped(py, s.iter().flat_map(|c| [c.eta_x, c.eta_y, c.thrust]).collect(), &[s.len(), 3])?
+        },
     }
 }
 
@@ -111,8 +121,13 @@ impl PySimulation {
     fn observation(&mut self) -> PyResult<PyObservation> {
         let done = self.sim.is_finished();
         let observation = self.sim.observe().map_err(step_error)?.clone();
+        let saturation = self.sim.saturation().to_vec();
         Ok(PyObservation {
-            inner: ObservationData { observation, done },
+            inner: ObservationData {
+                observation,
+                done,
+                saturation,
+            },
         })
     }
 }
@@ -332,6 +347,8 @@ impl PyControllerOutput {
 pub(crate) struct PyScenarioController {
     /// In a mutex: a Python class must be `Sync`, the controller is `Send` only.
     inner: Mutex<AnyTvmdController>,
+    /// The number of agents of its team (an observation of another team is refused).
+    n: usize,
 }
 
 #[pymethods]
@@ -354,14 +371,23 @@ impl PyScenarioController {
             py, scenario, toml, team, relaxation, allocator, precision, null_space, law, None,
         )?;
         let inner = AnyTvmdController::from_scenario(&spec.scenario).map_err(value_error)?;
+        let n = spec.scenario.team_body().map_err(value_error)?.len();
         Ok(Self {
             inner: Mutex::new(inner),
+            n,
         })
     }
 
     /// The commands and diagnostics for one tick's observation (call it once per tick).
     fn step(&mut self, observation: &Bound<'_, PyObservation>) -> PyResult<PyControllerOutput> {
         let o = &observation.get().inner.observation;
+        if o.failed.len() != self.n {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "`observation` is of a team of {} agents; this controller flies {}",
+                o.failed.len(),
+                self.n
+            )));
+        }
         let mut controller = self
             .inner
             .lock()

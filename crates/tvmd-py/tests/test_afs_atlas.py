@@ -39,8 +39,10 @@ def test_afs_atlas_a4_inc(tmp_path):
 
 
 def test_afs_atlas_rejects_bad_arguments():
-    with pytest.raises(ValueError, match="unknown team"):
+    with pytest.raises(ValueError, match="unknown team") as refused:
         tvmd.afs_atlas("a42")
+    # The names it lists are the ones it takes (not "all", which it refuses).
+    assert "all" not in str(refused.value) and "a4-inc" in str(refused.value)
     with pytest.raises(ValueError, match="one team"):
         tvmd.afs_atlas("all")
     with pytest.raises(ValueError, match="directions"):

@@ -100,6 +100,39 @@ def test_bad_arguments_raise():
         tgym.HoverEnv(weights={"speed": 1.0})
 
 
+BAD_TASKS = [
+    ({"initial_offset": -1.0}, "initial_offset"),
+    ({"initial_offset": float("nan")}, "initial_offset"),
+    ({"initial_offset": float("inf")}, "initial_offset"),
+    ({"initial_offset": "far"}, "initial_offset"),
+    ({"initial_tilt": 10.0}, "initial_tilt"),
+    ({"initial_tilt": -0.1}, "initial_tilt"),
+    ({"initial_offset": 1e9}, "initial_offset"),
+    ({"max_position_error": 0.0}, "max_position_error"),
+    ({"max_position_error": float("nan")}, "max_position_error"),
+    ({"max_tilt": float("inf")}, "max_tilt"),
+    ({"weights": {"position": float("nan")}}, "weights"),
+    ({"weights": {"alive": "much"}}, "weights"),
+]
+
+
+@pytest.mark.parametrize(("kwargs", "name"), BAD_TASKS)
+def test_make_refuses_each_bad_argument_naming_it(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        gym.make(tgym.HOVER_ID, **kwargs)
+    with pytest.raises(ValueError, match=name):
+        gym.make_vec(tgym.HOVER_ID, num_envs=2, vectorization_mode="vector_entry_point", **kwargs)
+
+
+def test_an_initial_pose_under_the_ground_is_refused_at_make():
+    # paper-tilt starts on the ground: any tilt swings an agent below it.
+    with pytest.raises(ValueError, match="initial_tilt"):
+        gym.make(tgym.HOVER_ID, scenario="paper-tilt", initial_tilt=0.3)
+    env = gym.make(tgym.HOVER_ID, scenario="paper-tilt", initial_tilt=0.0)
+    obs, _ = env.reset(seed=3)
+    assert np.isfinite(obs).all()
+
+
 def test_the_vector_env_steps_every_team_in_one_call():
     toml = 'name = "short-hover"\nduration = 0.5\ninitial_position = [0.0, 0.0, 1.5]\n[reference]\nkind = "hover"\nposition = [0.0, 0.0, 1.5]\n'
     env = gym.make_vec(tgym.HOVER_ID, num_envs=4, vectorization_mode="vector_entry_point", toml=toml, jobs=2)

@@ -3,12 +3,18 @@
 The log stores every value as a protobuf ``double`` (float64), so the comparison is exact
 (NaN where the result has NaN; ``-0.0 == 0.0``, as protobuf does not keep the sign of a zero
 scalar): every array field, the summary, the paper metrics and the
-scalars. A missing, corrupt or foreign file is a ``ValueError`` naming the path.
+scalars. A corrupt or foreign file is a ``ValueError`` naming the path; a missing file a
+``FileNotFoundError`` (as in ``run``); a FIFO or device is refused before it is opened
+(``OSError``), each case in a child process under a timeout; a truncated log loads the ticks
+before the damage with a warning.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -86,10 +92,44 @@ def test_a_thinned_log_has_nan_on_the_ticks_it_left_out(tmp_path):
     same(flown.summary, loaded.summary, "summary")
 
 
-def test_a_missing_file_is_a_value_error_naming_it(tmp_path):
+def test_a_missing_file_is_a_file_not_found_error_naming_it(tmp_path):
     path = tmp_path / "nowhere" / "run.mcap"
-    with pytest.raises(ValueError, match="nowhere"):
+    with pytest.raises(FileNotFoundError, match="nowhere"):
         sim.load(path)
+
+
+def load_in_child(path, timeout=60):
+    """`load(path)` in a child process: (exception type name, message); a hang is a timeout."""
+    code = (
+        "import sys, tvmd.sim as s\n"
+        "try:\n    s.load(sys.argv[1]); print('LOADED')\n"
+        "except BaseException as e:\n    print(type(e).__name__, e)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=timeout)
+    return done.stdout.strip()
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_a_fifo_is_refused_before_it_is_opened(tmp_path):
+    fifo = tmp_path / "p.mcap"
+    os.mkfifo(fifo)
+    out = load_in_child(fifo)
+    assert out.startswith("OSError") and "not a regular file" in out and "p.mcap" in out, out
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
+def test_a_device_is_refused_before_it_is_read():
+    out = load_in_child("/dev/zero")
+    assert out.startswith("OSError") and "not a regular file" in out, out
+
+
+def test_a_large_file_that_is_not_mcap_is_refused_after_its_first_bytes(tmp_path):
+    path = tmp_path / "sparse.mcap"
+    with open(path, "wb") as f:
+        f.write(b"not mcap")
+        f.truncate(2**31)  # sparse: 2 GB that reading whole would hold in memory
+    out = load_in_child(path)
+    assert out.startswith("ValueError") and "magic" in out and "sparse.mcap" in out, out
 
 
 def test_a_file_that_is_not_mcap_is_a_value_error_naming_it(tmp_path):
@@ -103,11 +143,28 @@ def test_a_file_that_is_not_mcap_is_a_value_error_naming_it(tmp_path):
         sim.load(empty)
 
 
-def test_a_truncated_log_is_a_value_error_naming_it(tmp_path):
+def test_a_truncated_log_loads_what_it_holds_with_a_warning(tmp_path):
     path = tmp_path / "whole.mcap"
-    sim.run(toml='name = "short"\nduration = 1.0\n', mcap=path)
+    flown = sim.run(toml='name = "long"\nduration = 8.0\n', mcap=path)
     data = path.read_bytes()
-    cut = tmp_path / "cut.mcap"
-    cut.write_bytes(data[: len(data) // 2])
-    with pytest.raises(ValueError, match="cut.mcap"):
-        sim.load(cut)
+    partial = 0
+    for keep in (len(data) - 100, 3 * len(data) // 4, len(data) // 2, 2 * len(data) // 5):
+        damaged = tmp_path / f"cut-{keep}.mcap"
+        damaged.write_bytes(data[:keep])
+        try:
+            with pytest.warns(UserWarning, match=f"cut-{keep}.mcap.*damaged"):
+                loaded = sim.load(damaged)
+        except ValueError as e:
+            # Cut inside the first chunk: nothing whole before the damage.
+            assert keep < len(data) - 100 and "cut-" in str(e), e
+            continue
+        k = len(loaded)
+        assert 0 < k <= len(flown)
+        if keep == len(data) - 100:
+            assert k == len(flown), "only the summary section is lost"
+            same(flown.summary, loaded.summary, "summary")
+        partial += k < len(flown)
+        np.testing.assert_array_equal(loaded.position, flown.position[:k])
+        np.testing.assert_array_equal(loaded.commands, flown.commands[:k])
+        assert loaded.scenario_toml == flown.scenario_toml
+    assert partial > 0, "some cut loads the ticks before it"

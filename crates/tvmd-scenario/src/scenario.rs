@@ -191,7 +191,8 @@ impl Scenario {
     }
 
     /// Reads, parses and validates a scenario file: a regular file (after links) of at most
-    /// [`MAX_SCENARIO_BYTES`], so that a device or FIFO is refused before it is opened.
+    /// [`MAX_SCENARIO_BYTES`], so that a device or FIFO is refused before it is opened. A file
+    /// without `name` takes its file name without the extension (`mine.toml` runs as `mine`).
     /// Errors: [`ScenarioError::File`] naming the path (missing, unreadable, not a regular file, too
     /// large, not UTF-8), then as [`Scenario::from_toml_str`].
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self, ScenarioError> {
@@ -224,13 +225,22 @@ impl Scenario {
                 "grew beyond {MAX_SCENARIO_BYTES} bytes while read"
             )));
         }
-        Self::from_toml_str(&text).map_err(|e| match e {
+        let mut scenario = Self::from_toml_str(&text).map_err(|e| match e {
             ScenarioError::ScenarioParse { message, .. } => ScenarioError::ScenarioParse {
                 path: Some(path.display().to_string()),
                 message,
             },
             other => other,
-        })
+        })?;
+        // A file that names no scenario is its own run, not the default's (whose log and
+        // summary it would replace): it takes the file's name.
+        let named = text
+            .parse::<toml::Table>()
+            .is_ok_and(|t| t.contains_key("name"));
+        if let (false, Some(stem)) = (named, path.file_stem()) {
+            scenario.name = stem.to_string_lossy().into_owned();
+        }
+        Ok(scenario)
     }
 
     /// The scenario named by a command-line or Python argument: a TOML file if `name_or_path`

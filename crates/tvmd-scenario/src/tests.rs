@@ -180,6 +180,11 @@ fn load_takes_a_builtin_name_or_a_file() {
     std::fs::write(&path, "name = \"from-file\"\nrelaxation = 1.0\n").unwrap();
     let s = Scenario::load(path.to_str().unwrap()).unwrap();
     assert_eq!((s.name.as_str(), s.relaxation), ("from-file", 1.0));
+    // A file that names no scenario runs under its file name, not as the default paper-tilt.
+    let unnamed = dir.join("mine.toml");
+    std::fs::write(&unnamed, "duration = 1.0\n").unwrap();
+    let s = Scenario::load(unnamed.to_str().unwrap()).unwrap();
+    assert_eq!((s.name.as_str(), s.duration), ("mine", 1.0));
     std::fs::write(&path, "[physics]\ndt = -1.0\n").unwrap();
     let e = Scenario::load(path.to_str().unwrap()).unwrap_err();
     assert!(

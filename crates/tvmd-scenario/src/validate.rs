@@ -249,6 +249,13 @@ impl Scenario {
                 &format!("failures[{i}].informed_after"),
                 &[f.informed_after],
             )?;
+            if !f.controller_informed && f.informed_after != 0.0 {
+                return Err(invalid(
+                    format!("failures[{i}].informed_after"),
+                    "a controller never informed (`controller_informed = false`) is never told \
+                     late: drop one of the two",
+                ));
+            }
         }
         check_magnitude("disturbances.wind", &self.disturbances.wind, MAX_EXTERNAL)?;
         if let Some(w) = &self.disturbances.external_wrench {
@@ -352,6 +359,12 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.failures[0].informed_after, 0.05);
+        // Told late, but never told: an option that would be ignored is refused.
+        let e = Scenario::from_toml_str(
+            "[[failures]]\nagent = 0\ntime = 1.0\nkind = \"no-thrust\"\ncontroller_informed = false\ninformed_after = 0.05\n",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("failures[0].informed_after"), "{e}");
     }
 
     #[test]

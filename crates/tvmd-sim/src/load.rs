@@ -10,7 +10,8 @@
 //! allocation values (NaN in Python). The summary and the paper's metrics are the ones the run
 //! computed (written when it ended, [`write_result_metadata`]); a log without them (a run that
 //! did not finish writing) gets them folded over the samples read, with the last tick as the
-//! final state and no wall time.
+//! final state and no wall time. A file damaged after its first tick (truncated) loads the ticks
+//! before the damage and says so ([`LoadedRun::damage`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -38,6 +39,9 @@ pub struct LoadedRun {
     pub scenario: Scenario,
     /// Its samples (one per logged tick, stride 1), summary and paper metrics.
     pub result: RunResult,
+    /// The file is damaged (e.g. truncated): what stopped the reading. The samples are the
+    /// ticks before it, the summary folded over them.
+    pub damage: Option<String>,
 }
 
 fn bad(what: impl std::fmt::Display) -> SimError {
@@ -298,6 +302,7 @@ pub fn load_run(path: impl AsRef<Path>) -> Result<LoadedRun, SimError> {
         }
     };
     Ok(LoadedRun {
+        damage: run.damage,
         scenario,
         result: RunResult {
             samples,

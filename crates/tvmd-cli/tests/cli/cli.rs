@@ -345,3 +345,40 @@ fn detect_option_reports_the_fault_and_needs_the_observer() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("fault_detection"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 57: `catalogue --help` says what a row of `catalogue.csv` is (a team and an
+/// allocator, over their flights); `plot` of a missing log leaves no figure directory; a FIFO
+/// or device given to `plot` is refused before it is opened.
+#[test]
+fn catalogue_help_and_plot_inputs_checked_first() {
+    let help = ok(bin().args(["catalogue", "--help"]).output().unwrap());
+    assert!(help.contains("one row per team and allocator"), "{help}");
+    assert!(!help.contains("one row per flight"), "{help}");
+    let dir = tmp_dir("plot-missing");
+    let figures = dir.join("p");
+    let out = bin()
+        .arg("plot")
+        .arg(dir.join("missing.mcap"))
+        .arg("--out")
+        .arg(&figures)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(
+        !figures.exists(),
+        "plot made its output directory for a missing log"
+    );
+    if Path::new("/dev/zero").exists() {
+        let out = bin()
+            .args(["plot", "/dev/zero", "--out"])
+            .arg(&figures)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && stderr.contains("not a regular file"),
+            "{stderr}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -4,6 +4,7 @@
 
 use std::mem::size_of;
 
+use tvmd_ffi::actuator::*;
 use tvmd_ffi::config::*;
 use tvmd_ffi::handle::*;
 use tvmd_ffi::reconfigure::*;
@@ -155,6 +156,48 @@ fn setters_and_the_seed_refuse_bad_values() {
         [hover; 4],
         "a refused period holds the seed"
     );
+}
+
+#[test]
+fn a_seed_the_actuator_map_would_refuse_is_refused() {
+    let mut handle = created_with(TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION);
+    let hover = TvmdAgentCommand {
+        eta_x: 0.0,
+        eta_y: 0.0,
+        thrust: 6.9,
+        omega: 0.7,
+    };
+    let mut map: TvmdActuatorMap = unsafe { std::mem::zeroed() };
+    map.size = size_of::<TvmdActuatorMap>() as u32;
+    let mut act: TvmdActuatorOutputs = unsafe { std::mem::zeroed() };
+    act.size = size_of::<TvmdActuatorOutputs>() as u32;
+    // SAFETY: valid pointers to live values.
+    unsafe {
+        assert_eq!(tvmd_actuator_map_default(&*handle, &mut map), TVMD_OK);
+        let mut seed = [hover; 4];
+        seed[1].omega = 123.0;
+        assert_eq!(
+            tvmd_seed_commands(&mut *handle, seed.as_ptr(), 4),
+            TVMD_ERR_INPUT_OUT_OF_RANGE
+        );
+        seed[1].omega = -0.1;
+        assert_eq!(
+            tvmd_seed_commands(&mut *handle, seed.as_ptr(), 4),
+            TVMD_ERR_INPUT_OUT_OF_RANGE
+        );
+        assert_eq!(
+            tvmd_seed_commands(&mut *handle, [hover; 4].as_ptr(), 4),
+            TVMD_OK
+        );
+    }
+    // The next refused period holds the seed, and the seed is publishable.
+    let (status, held) = step(&mut handle, f32::NAN);
+    assert_eq!(status, TVMD_ERR_INPUT_NON_FINITE);
+    assert_eq!(held.commands[..4], [hover; 4]);
+    // SAFETY: valid pointers to live values; 16 commands.
+    let published =
+        unsafe { tvmd_actuator_outputs(&*handle, &map, held.commands.as_ptr(), 16, &mut act) };
+    assert_eq!(published, TVMD_OK);
 }
 
 #[test]

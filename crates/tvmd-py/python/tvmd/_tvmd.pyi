@@ -1032,11 +1032,12 @@ class Controller:
         observer's estimate or the integral back to zero) and the planned-rate filter (at rest).
         The landed flag (``set_landed``) is kept.
         """
-    def set_landed(self, landed: bool) -> None:
+    def set_landed(self, landed: Union[bool, Literal[0, 1]]) -> None:
         """Tells the controller whether the team stands on the ground (the caller's contact or
         landing detector). While landed the offset-free state is cleared and held at zero (the
         ground's reaction is no disturbance to compensate); after ``set_landed(False)`` it starts
-        again from zero. No effect on anything else, and none with ``law="paper"``.
+        again from zero. No effect on anything else, and none with ``law="paper"``. ``landed``
+        is a bool or the integer 0 or 1 (anything else: ``TypeError``).
         """
     @property
     def landed(self) -> bool:

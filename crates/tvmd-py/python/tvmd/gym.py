@@ -102,13 +102,52 @@ def _action_bounds(simulation: Any, action: str) -> tuple[np.ndarray, np.ndarray
 
 
 def _check(action: str, weights: Optional[dict[str, float]]) -> dict[str, float]:
-    # The checked action mode; the weights over the defaults.
+    # The checked action mode; the weights over the defaults, each a finite number.
     if action not in ("wrench", "commands"):
         raise ValueError(f'`action` must be "wrench" or "commands", got {action!r}')
     unknown = set(weights or {}) - set(DEFAULT_WEIGHTS)
     if unknown:
         raise ValueError(f"unknown reward weights {sorted(unknown)} (known: {sorted(DEFAULT_WEIGHTS)})")
-    return {**DEFAULT_WEIGHTS, **(weights or {})}
+    for name, w in (weights or {}).items():
+        if isinstance(w, bool) or not isinstance(w, (int, float, np.integer, np.floating)) or not math.isfinite(w):
+            raise ValueError(f"`weights[{name!r}]` must be a finite number, got {w!r}")
+    return {**DEFAULT_WEIGHTS, **{k: float(v) for k, v in (weights or {}).items()}}
+
+
+def _bounded(name: str, value: Any, low: float, high: float = math.inf, *, open_low: bool = False) -> float:
+    # `value` as a float in [low, high] (or (low, high] with `open_low`), else ValueError naming it.
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a number, got {value!r}") from None
+    inside = math.isfinite(x) and (x > low if open_low else x >= low) and x <= high
+    if not inside:
+        span = f"{'(' if open_low else '['}{low:g}, {high:g}]"
+        raise ValueError(f"`{name}` must be finite and in {span}, got {value!r}")
+    return x
+
+
+def _check_task(
+    simulation: Any, home: np.ndarray, initial_offset: Any, initial_tilt: Any, max_position_error: Any, max_tilt: Any
+) -> tuple[float, float, float, float]:
+    # The episode's bounds, checked; the farthest initial poses they allow must be poses the
+    # scenario accepts (not under the ground, not beyond its ranges), found here and not at a
+    # later reset. Probing moves `simulation`'s initial pose; every reset sets its own.
+    offset = _bounded("initial_offset", initial_offset, 0.0)
+    tilt = _bounded("initial_tilt", initial_tilt, 0.0, math.pi)
+    error = _bounded("max_position_error", max_position_error, 0.0, open_low=True)
+    max_tilt_ = _bounded("max_tilt", max_tilt, 0.0, math.pi, open_low=True)
+    z_low = 0.0 if home[2] < offset else -offset
+    for corner in ([offset, offset, offset], [-offset, -offset, z_low]):
+        for rpy in ([tilt, tilt, 0.0], [-tilt, -tilt, 0.0]):
+            try:
+                simulation.reset(0, position=home + np.array(corner), attitude_rpy=rpy)
+            except ValueError as e:
+                raise ValueError(
+                    f"`initial_offset` = {offset:g} m with `initial_tilt` = {tilt:g} rad allow an "
+                    f"initial pose the scenario refuses: {e}"
+                ) from None
+    return offset, tilt, error, max_tilt_
 
 
 def _draw_offsets(rng: np.random.Generator, home: np.ndarray, bound: float, m: int) -> np.ndarray:
@@ -128,11 +167,16 @@ class TeamEnv(gym.Env):
         scenario: a scenario for ``tvmd.sim.Simulation`` (default ``"hover"``: A4-Inc at 1.5 m,
             12 s, so 1200 steps).
         action: ``"wrench"`` or ``"commands"``.
-        weights: reward weights over ``DEFAULT_WEIGHTS`` (unknown keys raise ``ValueError``).
-        initial_offset: largest initial position offset per axis (m).
-        initial_tilt: largest initial roll and pitch (rad).
-        max_position_error: the episode terminates beyond it (m).
-        max_tilt: the episode terminates beyond it (rad).
+        weights: reward weights over ``DEFAULT_WEIGHTS`` (unknown keys and values that are not
+            finite numbers raise ``ValueError``).
+        initial_offset: largest initial position offset per axis (m, finite, at least 0).
+        initial_tilt: largest initial roll and pitch (rad, in [0, pi]).
+        max_position_error: the episode terminates beyond it (m, finite, positive).
+        max_tilt: the episode terminates beyond it (rad, in (0, pi]).
+
+    A bad argument raises ``ValueError`` naming it, here rather than at a later reset; so do an
+    ``initial_offset`` and ``initial_tilt`` whose farthest pose the scenario refuses (an agent
+    under the ground).
         **simulation: further ``tvmd.sim.Simulation`` keywords (``team``, ``toml``, ``allocator``,
             ...).
     """
@@ -158,12 +202,10 @@ class TeamEnv(gym.Env):
         self.render_mode = render_mode
         self.sim = _sim.Simulation(scenario, **simulation)
         self.action_mode = action
-        self.initial_offset = float(initial_offset)
-        self.initial_tilt = float(initial_tilt)
-        self.max_position_error = float(max_position_error)
-        self.max_tilt = float(max_tilt)
         first = self.sim.observe()
         self._home = first.true_state.position.copy()
+        checked = _check_task(self.sim, self._home, initial_offset, initial_tilt, max_position_error, max_tilt)
+        self.initial_offset, self.initial_tilt, self.max_position_error, self.max_tilt = checked
         self._low, self._high = _action_bounds(self.sim, action)
         self._scale = np.maximum(np.abs(self._low), np.abs(self._high))
         self.action_space = spaces.Box(self._low.astype(np.float32), self._high.astype(np.float32), dtype=np.float32)
@@ -259,8 +301,8 @@ class TeamVectorEnv(gym.vector.VectorEnv):
         self.single_observation_space = _OBSERVATION
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
-        self.initial_offset, self.initial_tilt = float(initial_offset), float(initial_tilt)
-        self.max_position_error, self.max_tilt = float(max_position_error), float(max_tilt)
+        checked = _check_task(one, self._home, initial_offset, initial_tilt, max_position_error, max_tilt)
+        self.initial_offset, self.initial_tilt, self.max_position_error, self.max_tilt = checked
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
         self._last = np.zeros((self.num_envs, 18), dtype=np.float32)
 

@@ -73,9 +73,12 @@ class SimResult:
             saturated_agents: (K,) int64, agents the allocator saturated (-1 if not reported).
         V_x, V_R: (K,) the Lyapunov candidates. cycle_error: (K,) bool, cycle skipped.
         commands, actual: (K, n, 3) commanded and actual actuator values, columns
-            ``eta_x, eta_y`` (rad), ``thrust`` (N). failed: (K, n) bool, true failure flags.
-        forces: (K, n, 3) body-frame forces of the actual outputs (N). rotor_speeds: (K, n)
-            normalized commanded rotor speeds.
+            ``eta_x, eta_y`` (rad), ``thrust`` (N): ``commands[k]`` is what tick ``k`` commanded,
+            ``actual[k]`` what the actuators output at ``t_k``, before tick ``k``'s commands act
+            (the previous period's commands, through the actuator models and the plant's
+            saturation). failed: (K, n) bool, true failure flags.
+        forces: (K, n, 3) body-frame forces of the actual outputs (N), at ``t_k`` as ``actual``.
+            rotor_speeds: (K, n) normalized commanded rotor speeds.
         summary: dict, every field of tvmd-sim's ``RunSummary`` (``max_planned_roll``, ``max_e_f``,
             ``max_e_f_over_weight`` = ``max e_f / (m_C g)``, ``max_position_error_after_4s``, ...),
             with ``metrics`` (settling time, steady-state, peak and integral errors, force and
@@ -262,6 +265,9 @@ class Observation:
         reference: the scenario's reference at ``t_k``, a ``tvmd.Reference``.
         failed: (n,) bool, the failures the controller is told of.
         done: the scenario's duration is reached (the last state; no step follows).
+        saturation: (n, 3) by how much the plant clamped the last step's commands to the
+            hardware's range: each command minus what the plant held (``eta_x``, ``eta_y`` rad,
+            thrust N); zero inside the range and after a reset.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -286,6 +292,10 @@ class Observation:
     @property
     def done(self) -> bool:
         """The scenario's duration is reached (no step follows)."""
+    @property
+    def saturation(self) -> _F64:
+        """(n, 3) by how much the plant clamped the last step's commands (the command minus
+        what it held)."""
     def to_dict(self) -> dict[str, Any]:
         """Every field as a dict (the states and the reference as dicts)."""
 
@@ -319,6 +329,12 @@ class Simulation:
       centre of mass) that the scenario controller's planner-free allocation stage
       (``tvmd_core::Controller::allocate``: its allocator, limits, rate limits; in f64) turns into
       admissible commands, the failed agents the controller is told of idle.
+
+    The plant flies what the hardware can: it holds each agent's command saturated to the gimbal
+    limits (``|eta_x| <= sigma_x``, ``|eta_y| <= sigma_y``) and to thrusts in ``[0, max_thrust]``
+    (a rotor never pushes down its axis, nor beyond its largest speed), as in ``run`` and
+    ``SimulationBatch``; ``Observation.saturation`` says by how much it clamped each agent's
+    command. tvmd's own commands are inside that range. Non-finite commands are refused.
 
     Example::
 
@@ -396,6 +412,13 @@ class Simulation:
                 are overridden as their failure dictates.
             rotor_speeds: the last column is the normalized rotor speed ``omega`` (1 at
                 ``max_thrust``; thrust ``max_thrust * omega**2``) instead of the thrust.
+
+        The plant holds each command saturated to the hardware's range (the returned
+        observation's ``saturation`` says by how much).
+
+        Raises:
+            ValueError: a wrong shape or count (also a ``ControllerOutput`` of another team), a
+                non-finite value, a negative rotor speed; nothing changes.
         """
     def step_wrench(self, wrench: ArrayLike) -> Observation:
         """Holds the admissible commands of the (6,) body wrench ``[u_tau; u_f]`` (N m, N; body
@@ -465,6 +488,7 @@ class ScenarioController:
         state: call it once per tick).
 
         Raises:
+            ValueError: the observation is of a team with another number of agents.
             RuntimeError: the controller failed.
         """
 
@@ -481,8 +505,10 @@ class SimulationBatch:
     ``t`` (B,), ``position``, ``velocity_world``, ``angular_velocity`` (B, 3), ``rotation``
     (B, 3, 3), ``true_position`` (B, 3), ``reference_position``, ``reference_velocity`` (B, 3),
     ``reference_rotation`` (B, 3, 3),
-    ``done`` (B,) bool (the duration is reached: reset that team) and ``errors`` (a list of
-    B messages or None).
+    ``done`` (B,) bool (the duration is reached: reset that team), ``saturation`` (B, n, 3): by how
+    much the plant clamped each team's last commands to the hardware's range, as
+    ``Observation.saturation`` (NaN for a failed team), and ``errors`` (a list of B messages or
+    None).
 
     Args:
         scenario, toml, team, relaxation, allocator, precision, null_space, law: as
@@ -513,9 +539,9 @@ class SimulationBatch:
         positions: Optional[ArrayLike] = None,
         attitudes_rpy: Optional[ArrayLike] = None,
     ) -> dict[str, Any]:
-        """Resets the teams ``indices`` (default all) as ``Simulation.reset`` does, with one seed
-        and optional (m, 3) initial positions and attitudes per reset team; every team's
-        observation."""
+        """Resets the teams ``indices`` (default all, each named at most once: a repeat is a
+        ``ValueError``) as ``Simulation.reset`` does, with one seed and optional (m, 3) initial
+        positions and attitudes per reset team; every team's observation."""
     def step_wrench(self, wrenches: ArrayLike, *, active: Optional[list[bool]] = None) -> dict[str, Any]:
         """Holds each team's (B, 6) body wrench ``[u_tau; u_f]`` (N m, N) for one controller
         period (only the ``active`` teams step, all by default); every team's observation.
@@ -664,10 +690,16 @@ def load(path: _PathArg) -> SimResult:
     Args:
         path: the ``.mcap`` file (a str or ``os.PathLike``).
 
+    A log damaged after its first tick (a run cut short, a copy truncated) loads the ticks
+    before the damage, its summary folded over them when the stored one is lost, with a
+    ``UserWarning`` naming ``path`` and the damage.
+
     Raises:
-        ValueError: the file is missing or unreadable, not MCAP, truncated, or not a tvmd-sim
-            run's log (no ``/state`` messages or no scenario metadata); the message names
-            ``path``.
+        FileNotFoundError: the file is missing (``OSError`` when it cannot be read, or is not a
+            regular file: a FIFO or device is refused before it is opened).
+        ValueError: not MCAP (checked on its first bytes, so a large foreign file is not read
+            whole), damaged before its first tick, or not a tvmd-sim run's log (no ``/state``
+            messages or no scenario metadata); the message names ``path``.
     """
 
 @overload

@@ -20,6 +20,9 @@ pub struct TeamStep {
     pub observation: Observation,
     /// The team's scenario duration is reached.
     pub finished: bool,
+    /// Per agent, by how much the plant clamped the team's last commands
+    /// ([`Simulation::saturation`]).
+    pub saturation: Vec<tvmd_plant::actuators::ActuatorCommand>,
 }
 
 /// The action of every team of a batch step.
@@ -158,5 +161,6 @@ fn team_step(sim: &mut Simulation) -> Result<TeamStep, SimError> {
     Ok(TeamStep {
         observation,
         finished,
+        saturation: sim.saturation().to_vec(),
     })
 }

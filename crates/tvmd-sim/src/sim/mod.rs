@@ -31,6 +31,7 @@ mod forces;
 pub mod latency;
 pub mod retention;
 pub mod sample;
+mod saturation;
 pub mod step;
 pub mod summary;
 
@@ -153,8 +154,9 @@ pub struct Simulation {
     controller_calls: usize,
     wall_time: f64,
     interrupted: bool,
-    /// The commands held until the next tick (zero-order hold).
+    /// The commands held until the next tick (zero-order hold), saturated by `saturation`.
     held: Vec<ActuatorCommand>,
+    saturation: saturation::PlantSaturation,
     /// The agents' body-frame forces, reused every physics step.
     forces: Vec<Vector3<f64>>,
     /// The forces must be recomputed (new commands, a failure, or actuators with memory).
@@ -200,6 +202,7 @@ impl Simulation {
         Ok(Self {
             options,
             held: vec![ActuatorCommand::default(); n],
+            saturation: saturation::PlantSaturation::new(scenario, n)?,
             forces: Vec::with_capacity(n),
             forces_stale: true,
             observed: None,
@@ -390,7 +393,7 @@ impl Simulation {
         sink: Option<(&mut (dyn TickSink + '_), &SinkPlan)>,
     ) -> Result<(), SimError> {
         self.check_commands(observation.t, &out.commands)?;
-        self.held.clone_from(&out.commands);
+        self.saturation.apply(&out.commands, &mut self.held);
         self.forces_stale = true;
         self.record(observation, out, sink)?;
         self.advance_period()

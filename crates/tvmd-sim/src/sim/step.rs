@@ -12,7 +12,8 @@
 //!
 //! Bad input never panics and never changes the simulation: a wrong number of commands or a
 //! non-finite one is an error ([`PhysicsError::InvalidCommand`]), and so is a step past the
-//! scenario's duration.
+//! scenario's duration. A finite command outside the hardware's range is held saturated, as
+//! the actuators would fly it ([`Simulation::saturation`] says by how much).
 
 use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
@@ -116,6 +117,13 @@ impl Simulation {
     /// The number of agents (the length of every step's commands).
     pub fn agents(&self) -> usize {
         self.team.len()
+    }
+
+    /// Per agent, by how much the plant clamped the last step's command to the hardware's
+    /// range (the command minus what it held: `eta_x`, `eta_y` in rad, thrust in N; zero
+    /// inside the range and before the first step). See the module `saturation`.
+    pub fn saturation(&self) -> &[ActuatorCommand] {
+        self.saturation.clamped()
     }
 
     /// The largest thrust of one agent, `sigma_Tf` (N): the thrust at the normalized rotor

@@ -204,7 +204,7 @@ fn failures_are_reported_only_when_the_controller_is_informed() {
         }
     }
     // Told late: the agent fails at 0.1 s, the controller learns it at 0.16 s (the first tick
-    // from then on); an uninformed failure stays untold whatever the delay.
+    // from then on).
     let late = failure_flags_seen(true, 0.06);
     assert!(late.iter().any(|(t, f, _)| *t > 0.1 + 1e-9 && !f));
     for (t, f, thrust) in late {
@@ -213,7 +213,17 @@ fn failures_are_reported_only_when_the_controller_is_informed() {
             assert_eq!(thrust, 0.0);
         }
     }
-    assert!(failure_flags_seen(false, 0.06).iter().all(|(_, f, _)| !f));
+    // A delay for a controller never told would be ignored: refused (issue 57, item 10).
+    let mut s = hover_scenario(0.0, 0.2);
+    s.failures = vec![Failure {
+        agent: 2,
+        time: 0.1,
+        kind: FailureKind::NoThrust,
+        controller_informed: false,
+        informed_after: 0.06,
+    }];
+    let e = Simulation::new(&s).err().expect("refused").to_string();
+    assert!(e.contains("failures[0].informed_after"), "{e}");
 }
 
 fn fed_positions(seed: u64) -> Vec<[f64; 3]> {

@@ -168,7 +168,7 @@ impl PlotSeries {
     /// Reads an MCAP file and calls [`PlotSeries::from_mcap`].
     pub fn from_mcap_file(path: impl AsRef<Path>) -> Result<Self, StudyError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(StudyError::file("read the MCAP log", path))?;
+        let bytes = tvmd_log::read_log_file(path)?;
         Self::from_mcap(&bytes).map_err(|e| match e {
             StudyError::Log(LogError::LogRead(m)) => {
                 StudyError::Log(LogError::LogRead(format!("{}: {m}", path.display())))
