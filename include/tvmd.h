@@ -1380,11 +1380,9 @@ TvmdStatus tvmd_hover_capability(const struct TvmdController *handle, struct Tvm
 TvmdStatus tvmd_reset(struct TvmdController *handle);
 
 /*
- The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
- the storage are intact and the controller's bytes match the seal the last entry point left
- (a checksum of them), `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED` otherwise. Every
- other entry point makes the same check first, so a handle a stray write changed is refused
- before anything in it is used: no entry point hangs or crashes whatever the storage holds.
+ The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+ around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+ otherwise (every other entry point makes the same check first).
 
  # Safety
  `handle` as for [`tvmd_step`].

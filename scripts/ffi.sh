@@ -37,14 +37,6 @@ cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tv
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
 
-step "storage corruption: every word of a created handle overwritten, each case forked under a watchdog"
-# crates/tvmd-ffi/tests/c/storage_fuzz.c: no entry point hangs or crashes; each refuses the
-# handle (TVMD_ERR_CORRUPTED) unless the word is one none reads.
-cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
-  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
-  -o "$out/storage_fuzz"
-"$out/storage_fuzz"
-
 step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"
 c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \
   crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \

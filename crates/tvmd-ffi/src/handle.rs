@@ -46,59 +46,11 @@ const TAIL: u64 = 0x6474_7664_6e65_6421;
 /// The byte offset of the tail guard.
 const TAIL_OFFSET: usize = TVMD_CONTROLLER_SIZE - 8;
 
-/// What the storage holds, the magic and the seal first (declaration order is layout order).
+/// What the storage holds, the magic first (declaration order is layout order).
 #[repr(C)]
 pub(crate) struct Inner {
     magic: u64,
-    /// [`seal_of`] the controller's bytes, written by every entry point that changed them.
-    seal: u64,
     pub(crate) controller: FfiController,
-}
-
-/// A Fletcher-style sum of the controller's bytes, read as 32-bit words: any change of one
-/// word changes it, and a write over several words changes it but for a chance of 2^-64 or so.
-/// The controller holds counts, indices and enum discriminants the core trusts (a loop bound,
-/// a slice length, a jump table): checked before any of them is read, a storage a stray write
-/// changed is refused (`TVMD_ERR_CORRUPTED`) instead of hanging or crashing the caller.
-/// Volatile reads: the bytes include padding, which the compiler must not assume it knows.
-///
-/// # Safety
-/// `inner` points to a storage of `TVMD_CONTROLLER_SIZE` bytes.
-unsafe fn seal_of(inner: *const Inner) -> u64 {
-    let words = core::ptr::addr_of!((*inner).controller).cast::<u32>();
-    let (mut a, mut b) = (0x7476_6d64_u32, 0x7365_616c_u32);
-    for k in 0..size_of::<FfiController>() / 4 {
-        a = a.wrapping_add(words.add(k).read_volatile());
-        b = b.wrapping_add(a);
-    }
-    (u64::from(b) << 32) | u64::from(a)
-}
-
-/// A created controller open for change: on drop (the entry point's end) its seal is written
-/// again over what the entry point changed.
-pub(crate) struct Sealed<'a> {
-    inner: &'a mut Inner,
-}
-
-impl core::ops::Deref for Sealed<'_> {
-    type Target = Inner;
-    fn deref(&self) -> &Inner {
-        self.inner
-    }
-}
-
-impl core::ops::DerefMut for Sealed<'_> {
-    fn deref_mut(&mut self) -> &mut Inner {
-        self.inner
-    }
-}
-
-impl Drop for Sealed<'_> {
-    fn drop(&mut self) {
-        let inner: *mut Inner = self.inner;
-        // SAFETY: `inner` is the whole created storage this guard holds.
-        unsafe { core::ptr::addr_of_mut!((*inner).seal).write_volatile(seal_of(inner)) };
-    }
 }
 
 // The header's size and alignment hold the real controller and the tail guard, on the target
@@ -152,22 +104,21 @@ pub(crate) unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inne
     }
     // In bounds: the storage is TVMD_CONTROLLER_SIZE bytes and 8-byte aligned.
     let tail = handle.cast::<u8>().add(TAIL_OFFSET).cast::<u64>().read();
-    let storage = handle.cast::<Inner>();
-    if tail != TAIL || core::ptr::addr_of!((*storage).seal).read_volatile() != seal_of(storage) {
+    if tail != TAIL {
         return Err(TVMD_ERR_CORRUPTED);
     }
     Ok(inner)
 }
 
-/// As [`inner`], mutable; sealed again when the returned guard drops.
+/// As [`inner`], mutable.
 ///
 /// # Safety
 /// As [`inner`], and no other reference to the handle is alive.
-pub(crate) unsafe fn inner_mut<'a>(handle: *mut TvmdController) -> Result<Sealed<'a>, TvmdStatus> {
+pub(crate) unsafe fn inner_mut<'a>(
+    handle: *mut TvmdController,
+) -> Result<&'a mut Inner, TvmdStatus> {
     inner(handle)?;
-    Ok(Sealed {
-        inner: &mut *handle.cast::<Inner>(),
-    })
+    Ok(&mut *handle.cast::<Inner>())
 }
 
 /// The created controller behind a handle (for the actuator mapping).
@@ -230,7 +181,6 @@ pub unsafe extern "C" fn tvmd_create(
         AnyAllocator::from_choice(blueprint.allocator.clone())
     }) {
         Ok(_) => {
-            core::ptr::addr_of_mut!((*inner).seal).write_volatile(seal_of(inner));
             core::ptr::addr_of_mut!((*inner).magic).write(MAGIC);
             storage
                 .cast::<u8>()
@@ -264,7 +214,7 @@ pub unsafe extern "C" fn tvmd_step(
     if let Err(status) = checked_size::<TvmdOutput>(out.size) {
         return status;
     }
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => {
             out.held(status, 0, &[]);
@@ -326,7 +276,7 @@ pub unsafe extern "C" fn tvmd_set_failures(
             return status;
         }
     }
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -385,7 +335,7 @@ pub unsafe extern "C" fn tvmd_hover_capability(
 #[no_mangle]
 pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
     match inner_mut(handle) {
-        Ok(mut inner) => {
+        Ok(inner) => {
             inner.controller.reset();
             TVMD_OK
         }
@@ -393,11 +343,9 @@ pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
     }
 }
 
-/// The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
-/// the storage are intact and the controller's bytes match the seal the last entry point left
-/// (a checksum of them), `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED` otherwise. Every
-/// other entry point makes the same check first, so a handle a stray write changed is refused
-/// before anything in it is used: no entry point hangs or crashes whatever the storage holds.
+/// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
+/// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
+/// otherwise (every other entry point makes the same check first).
 ///
 /// # Safety
 /// `handle` as for [`tvmd_step`].
@@ -422,7 +370,7 @@ pub unsafe extern "C" fn tvmd_check(handle: *const TvmdController) -> TvmdStatus
 #[no_mangle]
 pub unsafe extern "C" fn tvmd_set_landed(handle: *mut TvmdController, landed: u32) -> TvmdStatus {
     match inner_mut(handle) {
-        Ok(mut inner) => {
+        Ok(inner) => {
             inner.controller.set_landed(landed != 0);
             TVMD_OK
         }

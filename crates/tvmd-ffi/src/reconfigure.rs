@@ -59,7 +59,7 @@ pub unsafe extern "C" fn tvmd_reconfigure(
     if let Err(status) = checked_size::<TvmdConfig>(config.size) {
         return status;
     }
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -91,7 +91,7 @@ pub unsafe extern "C" fn tvmd_set_gains(
     let Some(gains) = gains.as_ref() else {
         return TVMD_ERR_NULL_POINTER;
     };
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -111,7 +111,7 @@ pub unsafe extern "C" fn tvmd_set_relaxation(
     handle: *mut TvmdController,
     relaxation: f32,
 ) -> TvmdStatus {
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -136,7 +136,7 @@ pub unsafe extern "C" fn tvmd_set_rate_limits(
     enabled: u32,
     limits: *const f32,
 ) -> TvmdStatus {
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -175,7 +175,7 @@ pub unsafe extern "C" fn tvmd_seed_commands(
     if commands.is_null() {
         return TVMD_ERR_NULL_POINTER;
     }
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };

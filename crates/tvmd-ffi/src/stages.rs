@@ -209,7 +209,7 @@ unsafe fn law_into(
     reference: *const TvmdReference,
     out: &mut TvmdLawOutput,
 ) -> TvmdStatus {
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => return status,
     };
@@ -279,7 +279,7 @@ pub unsafe extern "C" fn tvmd_allocate(
     if let Err(status) = checked_size::<TvmdAllocationOutput>(out.size) {
         return status;
     }
-    let mut inner = match inner_mut(handle) {
+    let inner = match inner_mut(handle) {
         Ok(inner) => inner,
         Err(status) => {
             out.held(status, 0, &[]);
