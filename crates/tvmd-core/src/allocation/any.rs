@@ -6,9 +6,9 @@ use super::{
     Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
-use crate::effectiveness::Effectiveness;
-use crate::error::ConfigError;
-use crate::real::Real;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::error::ConfigError;
+use crate::foundation::real::Real;
 
 #[cfg(feature = "clarabel")]
 use super::names::{CLARABEL, CLARABEL_SEQUENTIAL};

@@ -8,8 +8,8 @@ use super::names::{
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 use super::WeightedPseudoInverse;
-use crate::error::{ConfigError, ConfigField};
-use crate::real::Real;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::real::Real;
 
 /// Options of [`super::AnyAllocator::from_name`]; each applies to one allocator only.
 #[derive(Clone, Copy, Debug, PartialEq)]
