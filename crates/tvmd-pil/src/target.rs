@@ -2,7 +2,7 @@
 //! (`embedded/target-tests`, bin `tvmd-pil`) on an emulated Cortex-M4F (QEMU `mps2-an386`) or
 //! Cortex-M7 (`mps2-an500`), while the simulator keeps the physics.
 //!
-//! [`PilCore`] is a [`CoreEngine`]`<f32>`: [`super::TvmdController`] drives it exactly as it
+//! [`PilCore`] is a [`CoreEngine`]`<f32>`: the simulator's controller adapter drives it exactly as it
 //! drives the in-process core (failure masks, landing, diagnostics). Over QEMU's first serial
 //! port (the boards' CMSDK UART0, on QEMU's stdin/stdout) the host sends the controller's
 //! configuration once ([`CoreConfig`]), then a failure mask when it changes and each period's
@@ -17,21 +17,12 @@ use std::time::{Duration, Instant};
 
 use tvmd_core::{FailureMask, Reference, RigidState};
 
-use super::engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-use super::MAX_AGENTS;
-use crate::error::BoxedError;
-use crate::SimError;
+use crate::engine::{BoxedError, CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle, MAX_AGENTS};
+use crate::error::{PilError, BUILD_COMMAND, FIRMWARE_ENV};
+use crate::frame;
+use crate::link::QemuLink;
 use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 
-pub mod frame;
-mod link;
-
-pub use link::QemuLink;
-
-/// Environment variable naming the PIL firmware ELF.
-pub const FIRMWARE_ENV: &str = "TVMD_PIL_FIRMWARE";
-/// The command that builds the PIL firmware.
-pub const BUILD_COMMAND: &str = "bash scripts/pil.sh build";
 /// Longest wait for the firmware to boot and for the configuration's answer.
 pub const START_TIMEOUT: Duration = Duration::from_secs(30);
 /// Longest wait for the answer to one request (a cycle takes well under a millisecond of
@@ -87,72 +78,6 @@ impl std::str::FromStr for PilTarget {
             .into_iter()
             .find(|t| t.as_str() == s)
             .ok_or_else(|| PilError::UnknownTarget(s.to_string()))
-    }
-}
-
-/// Errors of a processor-in-the-loop flight.
-#[derive(Debug, thiserror::Error)]
-pub enum PilError {
-    /// No such target.
-    #[error("unknown PIL target `{0}` (known: cortex-m4, cortex-m7)")]
-    UnknownTarget(String),
-    /// The firmware ELF was not found.
-    #[error(
-        "PIL firmware not found (looked for {searched}); build it with `{BUILD_COMMAND}`, or \
-         set {FIRMWARE_ENV} to its ELF"
-    )]
-    FirmwareMissing {
-        /// The paths looked at.
-        searched: String,
-    },
-    /// `qemu-system-arm` is not on `PATH`.
-    #[error(
-        "`qemu-system-arm` not found on PATH: install it (Debian/Ubuntu: `sudo apt-get install \
-         qemu-system-arm`; `bash scripts/target.sh` installs it too)"
-    )]
-    QemuMissing,
-    /// Starting or talking to QEMU failed.
-    #[error("I/O error on the PIL link: {0}")]
-    Io(#[from] std::io::Error),
-    /// No complete frame arrived in time.
-    #[error("no answer in time")]
-    Timeout,
-    /// QEMU closed the link (it exited).
-    #[error("the link closed")]
-    Closed,
-    /// A frame's checksum is wrong.
-    #[error("frame checksum mismatch (received {got:#010x}, computed {want:#010x})")]
-    Checksum {
-        /// CRC-32 in the frame.
-        got: u32,
-        /// CRC-32 of the frame's bytes.
-        want: u32,
-    },
-    /// Bytes that are not the expected frame: the two sides are out of step.
-    #[error("link desynchronised: {0}")]
-    Desync(String),
-    /// The target refused a request (malformed, out of order, or a configuration it cannot
-    /// build).
-    #[error("the target reported: {0}")]
-    Target(String),
-    /// A link error, with what the host was doing and QEMU's state.
-    #[error("{target}: {during}: {source} ({qemu})")]
-    Link {
-        /// The target's label.
-        target: String,
-        /// What the host waited for.
-        during: String,
-        /// The error.
-        #[source]
-        source: Box<PilError>,
-        /// QEMU's status and stderr.
-        qemu: String,
-    },
-}
-
-impl From<PilError> for SimError {
-    fn from(e: PilError) -> Self {
-        SimError::Pil(Box::new(e))
     }
 }
 

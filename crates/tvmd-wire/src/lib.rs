@@ -69,7 +69,7 @@ pub const fn recorded_words(n: usize) -> usize {
 /// held ones, the rest zero).
 pub const STATUS_CYCLE_ERROR: u32 = 0xff;
 
-/// First word of a cycle recording (`"TVRC"`; format in `tvmd_sim::control::recording`).
+/// First word of a cycle recording (`"TVRC"`; format in `tvmd_pil::recording`).
 pub const RECORDING_MAGIC: u32 = u32::from_le_bytes(*b"TVRC");
 /// Format version of a cycle recording (2: the configuration carries the law, [`LAW_WORDS`],
 /// and an event may set the landed hold, [`EVENT_LANDED_SET`]).
