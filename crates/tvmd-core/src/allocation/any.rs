@@ -34,7 +34,8 @@ const NAMES: &[&str] = &[
     WEIGHTED_PSEUDO_INVERSE,
 ];
 
-/// One of the crate's allocators, chosen at run time.
+/// One of the crate's allocators, chosen at run time. Its checked-but-not-made counterpart is
+/// the small `Choice` of [`AllocatorChoice`] (module `choice`, which says why the two stay two).
 ///
 /// ```
 /// use tvmd_core::{AnyAllocator, Allocator};
