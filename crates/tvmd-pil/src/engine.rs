@@ -60,7 +60,7 @@ pub trait CoreEngine<T: Real> {
     ) -> Result<CycleAnswer<T>, BoxedError>;
 
     /// [`tvmd_core::Controller::fault_report`] of the last cycle (`None` by default: an
-    /// engine without the detector, e.g. the processor-in-the-loop firmware).
+    /// engine without the detector).
     fn fault_report(&self) -> Option<FaultReport<T>> {
         None
     }

@@ -17,7 +17,7 @@
 //! neither), the [`wire::INPUT_WORDS`] input words and the
 //! [`wire::recorded_words`]`(n)` output words.
 
-use tvmd_core::{FailureMask, Reference, RigidState};
+use tvmd_core::{FailureMask, FaultMasking, FaultReport, Reference, RigidState};
 
 use crate::engine::{BoxedError, CoreEngine, CycleAnswer, FailureAnswer, MAX_AGENTS};
 use crate::error::PilError;
@@ -116,6 +116,14 @@ impl<E: CoreEngine<f32>> CoreEngine<f32> for Recorder<E> {
         self.cycles += 1;
         Ok(answer)
     }
+
+    fn fault_report(&self) -> Option<FaultReport<f32>> {
+        self.inner.fault_report()
+    }
+
+    fn fault_masking(&self) -> Option<FaultMasking<f32>> {
+        self.inner.fault_masking()
+    }
 }
 
 /// A parsed recording.
@@ -167,7 +175,7 @@ impl CycleRecording {
             (|| Some([r.u32()?, r.u32()?, r.u32()?, r.u32()?, r.u32()?]))();
         let [magic, version, n, cycles, c] = header.ok_or_else(|| bad("truncated header"))?;
         if magic != MAGIC || version != VERSION {
-            return Err(bad("not a version-1 recording"));
+            return Err(bad("not a version-3 recording"));
         }
         let config = CoreConfig::get(&mut r).ok_or_else(|| bad("malformed configuration"))?;
         if config.n != n as usize || wire::config_words(config.n) != c as usize {

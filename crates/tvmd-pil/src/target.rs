@@ -15,7 +15,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use tvmd_core::{FailureMask, Reference, RigidState};
+use tvmd_core::{FailureMask, FaultMasking, FaultReport, Reference, RigidState};
 
 use crate::engine::{BoxedError, CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle, MAX_AGENTS};
 use crate::error::{PilError, BUILD_COMMAND, FIRMWARE_ENV};
@@ -130,6 +130,8 @@ pub struct PilCore {
     target: PilTarget,
     n: usize,
     failures: FailureMask<MAX_AGENTS>,
+    /// The detector's report and masking of the last cycle, as the target answered them.
+    fault: Option<wire::FaultAnswer>,
     seq: u16,
 }
 
@@ -143,6 +145,7 @@ impl PilCore {
             target,
             n: config.n,
             failures: FailureMask::none(),
+            fault: None,
             seq: 0,
         };
         let ready = core.receive("the firmware's boot frame", START_TIMEOUT)?;
@@ -274,21 +277,45 @@ impl CoreEngine<f32> for PilCore {
         let mut r = Reader::new(&words);
         match reply.kind {
             wire::KIND_OUTPUT => {
-                let out = wire::get_output(&mut r, self.n)
-                    .filter(|_| r.remaining() == 0)
-                    .ok_or_else(|| PilError::Desync("malformed cycle output".into()))?;
+                let out = wire::get_output(&mut r, self.n);
+                let fault = wire::get_fault_answer(&mut r).filter(|_| r.remaining() == 0);
+                let (Some(out), Some(fault)) = (out, fault) else {
+                    return Err(PilError::Desync("malformed cycle output".into()).into());
+                };
+                self.answered(fault);
                 Ok(Ok(out))
             }
             wire::KIND_SKIPPED => {
-                let commands = wire::get_commands(&mut r, self.n)
-                    .ok_or_else(|| PilError::Desync("malformed skipped cycle".into()))?;
+                let commands = wire::get_commands(&mut r, self.n);
+                let fault = wire::get_fault_answer(&mut r);
+                let (Some(commands), Some(fault)) = (commands, fault) else {
+                    return Err(PilError::Desync("malformed skipped cycle".into()).into());
+                };
+                self.answered(fault);
                 Ok(Err(SkippedCycle {
-                    message: reply.text(4 * self.n),
+                    message: reply.text(4 * self.n + wire::FAULT_ANSWER_WORDS),
                     commands,
                 }))
             }
             k => Err(self.unexpected("a cycle's answer", k).into()),
         }
+    }
+
+    fn fault_report(&self) -> Option<FaultReport<f32>> {
+        self.fault.and_then(|f| f.report)
+    }
+
+    fn fault_masking(&self) -> Option<FaultMasking<f32>> {
+        self.fault.and_then(|f| f.masking)
+    }
+}
+
+impl PilCore {
+    /// A cycle's fault answer: the detector's report and masking, and the mask in force (which
+    /// the detector may have set on the target).
+    fn answered(&mut self, fault: wire::FaultAnswer) {
+        self.failures = fault.failures;
+        self.fault = Some(fault);
     }
 }
 
