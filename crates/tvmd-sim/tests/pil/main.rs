@@ -241,7 +241,7 @@ fn pil_flight_with_fault_detection_and_a_round_cap_matches_the_host() {
     let host = run_scenario(&s, None, None).unwrap();
     let pil = run_scenario_on(&s, Some(PilTarget::CortexM4), None, None).unwrap();
     assert_eq!(pil.summary.cycle_errors, 0);
-    let detected = |r: &tvmd_sim::sim::RunResult| r.summary.fault.clone().unwrap();
+    let detected = |r: &tvmd_sim::sim::RunResult| r.summary.fault.unwrap();
     let (h, p) = (detected(&host), detected(&pil));
     eprintln!("fault summary: host {h:?}, cortex-m4 {p:?}");
     assert!(h.masked.is_some(), "{h:?}");
