@@ -1,10 +1,16 @@
-//! Elliptic-cone approximation of the attainable force space (AFS), eqs. (7)-(8).
+//! Elliptic-cone approximation of the attainable force space (AFS), eqs. (7)-(8), and the stages
+//! that read it: the force projection ([`projection`], eqs. 10, 13), the attitude planner
+//! ([`planner`], eqs. 9, 11) and the hover capability of a degraded team ([`hover`]).
 
 use nalgebra::Vector3;
 
-use crate::error::{ConfigError, ConfigField};
-use crate::linalg::norm;
-use crate::real::{count, to_f64, Real};
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::linalg::norm;
+use crate::foundation::real::{count, to_f64, Real};
+
+pub mod hover;
+pub mod planner;
+pub mod projection;
 
 /// The AFS relaxation `s in (0, 1]`: gimbal limits are shrunk to `s sigma` when planning, which
 /// leaves attitude-control authority in reserve (paper, eq. 8).
@@ -96,7 +102,7 @@ impl<T: Real> AttainableForceSpace<T> {
         if n_x > n {
             return Err(ConfigError::AgentCount { n, n_x });
         }
-        crate::limits::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
+        crate::agent::limits::AgentLimits::new(sigma_x, sigma_y, max_thrust)?;
         Ok(Self {
             n,
             n_x,

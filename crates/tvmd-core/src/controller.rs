@@ -3,8 +3,8 @@
 
 use nalgebra::Vector3;
 
-/// The roll `R_x(phi)`, at its old path (now in [`crate::rotation`]).
-pub use crate::rotation::roll;
+/// The roll `R_x(phi)`, at its old path (now in [`crate::foundation::rotation`]).
+pub use crate::foundation::rotation::roll;
 
 mod build;
 mod cycle;
@@ -13,7 +13,7 @@ mod guard;
 mod reconfigure;
 mod settings;
 
-pub use crate::fault_detection::{
+pub use crate::fault::detection::{
     FaultDetection, FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_MODEL_ERROR, FAULT_PERSISTENCE,
     FAULT_THRESHOLD,
 };
@@ -26,19 +26,19 @@ pub use settings::{
     POSITION_FREQUENCY,
 };
 
-use crate::admissible::{admissible_sets, AdmissibleSet};
+use crate::afs::hover::{hover_capability, HoverCapability};
+use crate::afs::planner::{AttitudePlanner, PlannerOutput};
+use crate::afs::projection::ForceProjection;
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
+use crate::agent::admissible::{admissible_sets, AdmissibleSet};
+use crate::agent::command::AgentCommand;
+use crate::agent::effectiveness::Effectiveness;
 use crate::allocation::{Allocation, Allocator, NullSpaceReport};
-use crate::attitude_rate::{AttitudeRateState, PlannedRates};
-use crate::command::AgentCommand;
-use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, InputError};
-use crate::hover::{hover_capability, HoverCapability};
+use crate::foundation::error::{ConfigError, InputError};
+use crate::foundation::real::Real;
+use crate::law::attitude_rate::{AttitudeRateState, PlannedRates};
+use crate::law::offset_free::{Compensation, OffsetFreeState};
 use crate::law::{Gains, LawOutput, Plant, RigidState};
-use crate::offset_free::{Compensation, OffsetFreeState};
-use crate::planner::{AttitudePlanner, PlannerOutput};
-use crate::projection::ForceProjection;
-use crate::real::Real;
 use crate::team::{FailureMask, TeamConfig};
 
 /// Every quantity of one control period.
@@ -59,9 +59,9 @@ pub struct ControlOutput<T: Real, const N: usize> {
     pub null_space: NullSpaceReport<T>,
     /// Per-agent commands inside `E_f` (idle for failed agents and unused slots).
     pub commands: [AgentCommand<T>; N],
-    /// Largest clamp the inversion applied ([`crate::admissible::AdmissibleSet::excess`]: rad,
+    /// Largest clamp the inversion applied ([`crate::agent::admissible::AdmissibleSet::excess`]: rad,
     /// or relative to the largest thrust; at most
-    /// [`crate::command::command_tolerance`] when the allocator keeps its contract).
+    /// [`crate::agent::command::command_tolerance`] when the allocator keeps its contract).
     pub command_clamp: T,
 }
 
@@ -136,7 +136,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     }
 
     /// Tells the controller which agents failed, and classifies the working agents: whether
-    /// they can hold hover with a margin ([`crate::hover`]), so a caller can decide to land.
+    /// they can hold hover with a margin ([`crate::afs::hover`]), so a caller can decide to land.
     /// The classification is computed here, once per mask, and kept
     /// ([`Self::hover_capability`]). Errors (and keeps the old mask) if the remaining team
     /// cannot produce every wrench.

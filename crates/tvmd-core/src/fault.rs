@@ -1,5 +1,6 @@
 //! Knowing an agent failed from the vehicle's motion: detection and isolation from the wrench
-//! residual (`docs/method.md`, "Beyond the paper: agent faults").
+//! residual (`docs/method.md`, "Beyond the paper: agent faults"); the controller's settings of
+//! it are [`detection`].
 //!
 //! The residual `r = [r_tau; r_f]` (body frame `{C}`) is the wrench the team did not deliver as
 //! commanded: the disturbance observer's estimate ([`crate::DisturbanceObserver`]) of the
@@ -36,10 +37,11 @@
 
 use nalgebra::{Matrix6x3, Vector3, Vector6};
 
-use crate::error::{positive, ConfigError, ConfigField};
-use crate::failure::FailureMask;
-use crate::real::{lit, sqrt, Real};
+use crate::agent::failure::FailureMask;
+use crate::foundation::error::{positive, ConfigError, ConfigField};
+use crate::foundation::real::{lit, sqrt, Real};
 
+pub mod detection;
 mod fit;
 mod verdict;
 use fit::{fit, none, share, unsquare, Fit, WeightedResidual};

@@ -1,12 +1,25 @@
 //! The full-pose geometric control law (eq. 12 and the Lyapunov function `Phi`), with the
 //! paper's dynamics `G xi_dot = C(xi) xi + u + g_C` (eqs. 2-3), z up.
+//!
+//! Beyond the paper, each optional and off in [`crate::ControllerSettings::paper`]: offset-free
+//! tracking ([`offset_free`]: a [`disturbance`] observer or [`integral`] action, under
+//! [`anti_windup`]), gains that fit any team ([`gain_schedule`], [`natural_gains`]) and the
+//! planned attitude's rates ([`attitude_rate`]).
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use crate::definite::is_symmetric_pd;
-use crate::error::{ConfigError, ConfigField, InputError};
-use crate::real::{lit, Real};
-use crate::rotation::{validate_rotation as rotation, vee};
+use crate::foundation::definite::is_symmetric_pd;
+use crate::foundation::error::{ConfigError, ConfigField, InputError};
+use crate::foundation::real::{lit, Real};
+use crate::foundation::rotation::{validate_rotation as rotation, vee};
+
+pub mod anti_windup;
+pub mod attitude_rate;
+pub mod disturbance;
+pub mod gain_schedule;
+pub mod integral;
+pub mod natural_gains;
+pub mod offset_free;
 
 /// Controller gains. `K_xi = blockdiag(K_Omega, K_v)`: the paper's `K_xi` is diagonal, and a
 /// block-diagonal one keeps the force request independent of the planned attitude (the order of `docs/method.md`).

@@ -3,34 +3,31 @@
 //! Full-pose tracking control for over-actuated, thrust-vectoring modular team UAVs (TVMD):
 //! several agents, each a coaxial rotor on a two-axis gimbal, bolted into one rigid vehicle.
 //!
-//! Pipeline of one control period, each stage a pure function of explicit inputs:
+//! The source reads as the method, one room per stage over a small foundation:
 //!
-//! 1. [`team`]: the configuration `Xi` and presets, over [`limits`] and [`failure`] masks
-//!    ([`rotation`] holds the shared rotations).
-//! 2. [`effectiveness`]: `M(Xi)`, the wrench the agents produce (eq. 4).
-//! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8).
-//! 4. [`projection`]: the force projection `K_f` (eqs. 12-13).
-//! 5. [`planner`]: the bisection attitude planner (eqs. 9-11).
-//! 6. [`law`]: the geometric full-pose control law (eq. 12) and Lyapunov values.
-//! 7. [`allocation`]: allocators behind one [`Allocator`] trait, over [`admissible`] sets.
-//! 8. [`command`]: inversion to gimbal angles and rotor speeds inside `E_f` (eq. 6), via
-//!    [`gimbal`] (eq. 1).
+//! 1. [`foundation`]: the scalar [`Real`], rotations, the small dense solvers, the typed
+//!    errors.
+//! 2. [`agent`]: one agent and the team's wrench: the gimbal's thrust direction (eq. 1), the
+//!    limits (eqs. 5-6), the admissible set `E_f` (eq. 6), the effectiveness `M(Xi)` (eq. 4),
+//!    the inversion to gimbal angles and rotor speeds, the failure mask.
+//! 3. [`afs`]: the elliptic-cone approximation of the attainable force space (eqs. 7-8) and
+//!    what reads it: the force projection `K_f` (eqs. 10, 13), the attitude planner (eqs. 9,
+//!    11), the hover capability of a degraded team.
+//! 4. [`law`]: the geometric full-pose control law (eq. 12) and Lyapunov values; beyond the
+//!    paper, each optional and off in [`ControllerSettings::paper`]: offset-free tracking
+//!    (a disturbance observer or integral action under anti-windup), gains that fit any team
+//!    and the planned attitude's rates.
+//! 5. [`allocation`]: allocators behind one [`Allocator`] trait, over the admissible sets.
+//! 6. [`fault`]: agent faults detected and isolated from the wrench residual, and their
+//!    settings.
+//! 7. [`team`]: the configuration `Xi` and presets, which builds the stages' inputs.
+//! 8. [`controller`]: [`Controller`] composes the stages into one `step` per control period.
 //!
-//! [`Controller`] composes them into one `step` per control period; [`hover`] classifies a
-//! degraded team when its failure mask is set (can the working agents hold hover, and with
-//! what margin).
-//!
-//! Beyond the paper, each optional and off in [`ControllerSettings::paper`]: offset-free
-//! tracking ([`offset_free`]: a [`disturbance`] observer or [`integral`] action, under
-//! [`anti_windup`]), gains that fit any team ([`gain_schedule`], [`natural_gains`]) and the
-//! planned attitude's rates ([`attitude_rate`]); agent faults detected and isolated from the
-//! wrench residual ([`fault`]).
-//!
-//! Imports run one way: the leaves ([`real`], [`rotation`], [`error`], [`limits`],
-//! [`failure`], [`gimbal`]) import no stage; a stage imports only leaves and earlier stages
-//! (e.g. [`projection`] and [`planner`] import [`afs`]; [`allocation`] imports [`admissible`]
-//! and [`effectiveness`]); no stage imports [`team`]; only [`team`] and [`controller`] compose
-//! stages. See `docs/architecture.md`.
+//! Imports run one way, down this list: the foundation imports no room, a stage imports only
+//! the foundation, [`agent`] and the stages it reads (e.g. [`afs`] reads [`agent`]); no stage
+//! imports [`team`]; only [`team`] and [`controller`] compose stages. The stages' modules keep
+//! their earlier paths at the crate's root (`tvmd_core::planner`, `tvmd_core::admissible`,
+//! ...), re-exported below. See `docs/architecture.md`.
 //!
 //! `no_std`, no allocator, generic over [`Real`] (`f32` or `f64`), fixed capacity `N` agents.
 #![no_std]
@@ -51,34 +48,23 @@ extern crate std;
 /// The nalgebra version the API uses, re-exported so users match it.
 pub use nalgebra;
 
-pub mod admissible;
 pub mod afs;
+pub mod agent;
 pub mod allocation;
-pub mod anti_windup;
-pub mod attitude_rate;
-pub mod command;
 pub mod controller;
-mod definite;
-pub mod disturbance;
-pub mod effectiveness;
-pub mod error;
-pub mod failure;
 pub mod fault;
-pub mod fault_detection;
-pub mod gain_schedule;
-pub mod gimbal;
-pub mod hover;
-pub mod integral;
+pub mod foundation;
 pub mod law;
-pub mod limits;
-mod linalg;
-pub mod natural_gains;
-pub mod offset_free;
-pub mod planner;
-pub mod projection;
-pub mod real;
-pub mod rotation;
 pub mod team;
+
+// The earlier paths of the stages' modules (`tvmd_core::planner::...`), kept for users.
+pub use afs::{hover, planner, projection};
+pub use agent::{admissible, command, effectiveness, failure, gimbal, limits};
+pub use fault::detection as fault_detection;
+pub use foundation::{error, real, rotation};
+pub use law::{
+    anti_windup, attitude_rate, disturbance, gain_schedule, integral, natural_gains, offset_free,
+};
 
 pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};

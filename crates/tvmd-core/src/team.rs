@@ -3,19 +3,19 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use crate::admissible::AdmissibleSet;
+use crate::afs::hover::{hover_capability, HoverCapability};
 use crate::afs::AttainableForceSpace;
-use crate::definite::{is_symmetric_pd, is_symmetric_psd};
-use crate::effectiveness::{agent_block, check_gram_rank, Effectiveness};
-use crate::error::{ConfigError, ConfigField, MassOf};
-/// The failure mask, at its old path (now in [`crate::failure`]).
-pub use crate::failure::FailureMask;
-use crate::hover::{hover_capability, HoverCapability};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::{agent_block, check_gram_rank, Effectiveness};
+/// The failure mask, at its old path (now in [`crate::agent::failure`]).
+pub use crate::agent::failure::FailureMask;
+/// The agent limits, at their old path (now in [`crate::agent::limits`]).
+pub use crate::agent::limits::AgentLimits;
+use crate::foundation::definite::{is_symmetric_pd, is_symmetric_psd};
+use crate::foundation::error::{ConfigError, ConfigField, MassOf};
+use crate::foundation::linalg::weighted_gram;
+use crate::foundation::real::{count, lit, Real};
 use crate::law::Plant;
-/// The agent limits, at their old path (now in [`crate::limits`]).
-pub use crate::limits::AgentLimits;
-use crate::linalg::weighted_gram;
-use crate::real::{count, lit, Real};
 
 /// One agent of the team: its frame in the team CoM frame `{C}`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,7 +157,7 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
             if agent.mass <= T::zero() {
                 return Err(ConfigError::NonPositiveMass {
                     of: MassOf::Agent(i),
-                    value: crate::real::to_f64(agent.mass),
+                    value: crate::foundation::real::to_f64(agent.mass),
                 });
             }
             if !is_symmetric_psd(&agent.inertia) {
@@ -329,7 +329,7 @@ impl<T: Real, const N: usize> TeamConfig<T, N> {
     }
 
     /// Whether the working agents can hold hover at gravity `gravity` with a margin (see
-    /// [`crate::hover`]): the hover wrench `[0, 0, 0, 0, 0, m_C g]` strictly inside their
+    /// [`crate::afs::hover`]): the hover wrench `[0, 0, 0, 0, 0, m_C g]` strictly inside their
     /// attainable wrench set. A rank-deficient degraded team is reported not capable.
     ///
     /// Errors: [`ConfigError::FailureIndex`] or [`ConfigError::NoAgents`] for the mask;
@@ -388,7 +388,7 @@ fn validate_navigator<T: Real>(navigator: &Navigator<T>) -> Result<(), ConfigErr
     if navigator.mass < T::zero() {
         return Err(ConfigError::NonPositiveMass {
             of: MassOf::Navigator,
-            value: crate::real::to_f64(navigator.mass),
+            value: crate::foundation::real::to_f64(navigator.mass),
         });
     }
     if !is_symmetric_psd(&navigator.inertia) {

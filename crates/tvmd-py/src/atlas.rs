@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use tvmd_core::team::presets::Preset;
+use tvmd_core::Preset;
 use tvmd_studies::afs_atlas::{run_until, AtlasRequest};
 
 use crate::convert::{count, indices, record_to_py, Int};

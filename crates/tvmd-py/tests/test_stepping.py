@@ -193,3 +193,30 @@ def test_a_tvmd_team_flies_in_run_and_in_the_simulation():
     np.testing.assert_allclose(by_team.position, by_name.position, atol=1e-9)
     with pytest.raises(TypeError, match="team"):
         sim.Simulation(team=6)
+
+
+def test_a_nan_in_one_teams_action_fails_only_that_team():
+    """As the Rust batch: a non-finite action is its team's error; the others step, and the
+    failed team's simulation is unchanged (its next finite step starts where it stood)."""
+    batch = sim.SimulationBatch("hover", count=3, jobs=2)
+    start = batch.reset(seeds=[1, 2, 3])
+    hover = np.zeros((3, 6))
+    hover[:, 5] = batch.mass * G
+    wrenches = hover.copy()
+    wrenches[1, 2] = np.nan
+    out = batch.step_wrench(wrenches)
+    assert out["errors"][0] is None and out["errors"][2] is None
+    assert "non-finite wrench component 2" in out["errors"][1]
+    assert np.isnan(out["position"][1]).all()
+    assert np.isfinite(out["position"][[0, 2]]).all()
+    assert (out["t"][[0, 2]] > start["t"][[0, 2]]).all()
+    again = batch.step_wrench(hover, active=[False, True, False])
+    assert again["errors"] == [None, None, None]
+    assert again["t"][1] == out["t"][0]
+    commands = np.zeros((3, batch.n_agents, 3))
+    commands[:, :, 2] = batch.mass * G / batch.n_agents
+    commands[2, 0, 0] = np.inf
+    out = batch.step(commands)
+    assert out["errors"][0] is None and out["errors"][1] is None
+    assert out["errors"][2] is not None and "non-finite" in out["errors"][2]
+    assert np.isfinite(out["position"][[0, 1]]).all()

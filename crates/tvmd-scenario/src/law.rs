@@ -21,6 +21,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::checks::check_pos;
+use crate::name_or::NameOr;
 use crate::ScenarioError;
 
 /// The names `law` may hold as a string: `"paper"` ([`LawConfig::paper`]) and `"offset-free"`
@@ -264,44 +265,6 @@ impl std::str::FromStr for LawConfig {
 
 // What TOML may hold. Tables are read with every field optional, so that a missing or
 // misplaced field is named in the error.
-
-/// A name or a table, read so that the table's own errors (an unknown key, a bad kind) reach
-/// the message with their path, which an untagged enum would replace by "no variant matched".
-enum NameOr<T> {
-    Name(String),
-    Table(T),
-}
-
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for NameOr<T> {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Visit<T>(std::marker::PhantomData<T>);
-        impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Visit<T> {
-            type Value = NameOr<T>;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a name or a table")
-            }
-            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
-                Ok(NameOr::Name(v.into()))
-            }
-            fn visit_map<A: serde::de::MapAccess<'de>>(
-                self,
-                map: A,
-            ) -> Result<Self::Value, A::Error> {
-                T::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(NameOr::Table)
-            }
-        }
-        d.deserialize_any(Visit(std::marker::PhantomData))
-    }
-}
-
-impl<T: Serialize> Serialize for NameOr<T> {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match self {
-            NameOr::Name(n) => s.serialize_str(n),
-            NameOr::Table(t) => t.serialize(s),
-        }
-    }
-}
 
 type LawInput = NameOr<LawTable>;
 type OffsetFreeInput = NameOr<OffsetFreeTable>;

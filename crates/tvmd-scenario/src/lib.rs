@@ -89,6 +89,7 @@ mod families;
 mod fault_detection;
 mod law;
 mod log_settings;
+mod name_or;
 mod null_space;
 mod overrides;
 mod plant;

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use tvmd_core::{NullSpaceObjective, NullSpaceStage, Real};
 
 use crate::error::invalid;
+use crate::name_or::NameOr;
 use crate::ScenarioError;
 
 /// Default iteration cap of the stage.
@@ -46,12 +47,7 @@ pub struct NullSpaceConfig {
 }
 
 /// What TOML may hold: the string form or a table.
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum NullSpaceInput {
-    Spec(String),
-    Table(NullSpaceTable),
-}
+type NullSpaceInput = NameOr<NullSpaceTable>;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -66,8 +62,8 @@ impl TryFrom<NullSpaceInput> for NullSpaceConfig {
 
     fn try_from(input: NullSpaceInput) -> Result<Self, String> {
         match input {
-            NullSpaceInput::Spec(s) => s.parse(),
-            NullSpaceInput::Table(t) => Ok(Self {
+            NameOr::Name(s) => s.parse(),
+            NameOr::Table(t) => Ok(Self {
                 objective: kind(&t.objective)?,
                 tilt: t.tilt,
                 iterations: t.iterations.unwrap_or(DEFAULT_NULL_SPACE_ITERATIONS),
@@ -201,5 +197,21 @@ mod tests {
         let zero = NullSpaceConfig { iterations: 0, ..m };
         assert_eq!(field(zero), "null_space.iterations");
         assert!(t.stage::<f32>().is_ok());
+    }
+
+    #[test]
+    fn a_bad_table_names_its_key() {
+        #[derive(Debug, Deserialize)]
+        struct Doc {
+            #[allow(dead_code)]
+            null_space: NullSpaceConfig,
+        }
+        let e = toml::from_str::<Doc>("null_space = { objective = \"margin\", tilts = 0.1 }")
+            .unwrap_err();
+        assert!(e.to_string().contains("tilts"), "{e}");
+        let e = toml::from_str::<Doc>("null_space = { objective = \"sideways\" }").unwrap_err();
+        assert!(e.to_string().contains("sideways"), "{e}");
+        let doc: Doc = toml::from_str("null_space = \"inward-tilt=0.1\"").unwrap();
+        assert_eq!(doc.null_space.tilt, Some(0.1));
     }
 }

@@ -4,8 +4,8 @@ use tvmd_log::LogError;
 use tvmd_plant::PhysicsError;
 use tvmd_scenario::ScenarioError;
 
-/// Boxed error returned by a flight controller.
-pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
+pub use tvmd_pil::BoxedError;
+use tvmd_pil::PilError;
 
 /// Errors of a run: its scenario, its plant, its log, its controller, or the batch around it.
 ///
@@ -57,5 +57,11 @@ impl SimError {
             field: field.into(),
             reason: reason.into(),
         })
+    }
+}
+
+impl From<PilError> for SimError {
+    fn from(e: PilError) -> Self {
+        SimError::Pil(Box::new(e))
     }
 }

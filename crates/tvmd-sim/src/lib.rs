@@ -9,8 +9,9 @@
 //! - [`diagnostics`]: what a controller reports per period (the diagnostics schema);
 //! - [`flight`]: the controller interface [`FlightController`];
 //! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller, in
-//!   f64 or f32, in process or on a processor in the loop, and its allocation stage as the
-//!   wrench action of a stepped simulation ([`WrenchAllocation`]);
+//!   f64 or f32, in process or on a processor in the loop (the engines, the PIL link and the
+//!   cycle recorder are crate `tvmd-pil`, re-exported as [`pil`]), and its allocation stage as
+//!   the wrench action of a stepped simulation ([`WrenchAllocation`]);
 //! - [`sink`]: the loop's listener [`TickSink`] and what it hands over per tick;
 //! - [`sim`]: the loop ([`Simulation`]: run to its end with a controller, or stepped one
 //!   controller period at a time with commands or a body wrench, [`Observation`],

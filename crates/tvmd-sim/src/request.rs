@@ -12,10 +12,10 @@ use tvmd_scenario::{
     Scenario,
 };
 
-use crate::control::pil::PilTarget;
 use crate::runner::RunSpec;
 use crate::sim::SampleRetention;
 use crate::SimError;
+use tvmd_pil::PilTarget;
 
 /// The scenario of a run request.
 #[derive(Clone, Debug, Default, PartialEq)]

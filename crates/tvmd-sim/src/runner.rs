@@ -8,8 +8,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::control::pil::PilTarget;
-use crate::control::recording::{CycleRecording, Recorder};
+use crate::control::recording::Recorder;
 use crate::control::TvmdController;
 use crate::control::{core_of_scenario, wire_config, AnyTvmdController, CoreController};
 use crate::error::BoxedError;
@@ -21,6 +20,7 @@ use crate::sink::TickSink;
 use crate::tick_log::McapSink;
 use crate::SimError;
 use tvmd_log::{LiveOptions, RunLog, METADATA_SCENARIO};
+use tvmd_pil::{CycleRecording, PilTarget};
 use tvmd_scenario::{Precision, Scenario};
 
 /// A controller that reports the time of every call to a callback (for progress bars).

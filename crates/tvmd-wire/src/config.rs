@@ -1,18 +1,21 @@
 //! The f32 controller's configuration as words, and the controller built from it.
 
+use tvmd_core::allocation::AllocatorOptions;
 use tvmd_core::nalgebra::{Matrix3, Vector3};
 use tvmd_core::{
-    AgentLimits, AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings, Gains,
-    Navigator, RateLimits, Relaxation, TeamConfig,
+    AgentLimits, AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings,
+    FaultDetection, Gains, Navigator, RateLimits, Relaxation, TeamConfig,
 };
 
+use crate::fault::{get_fault_detection, put_fault_detection};
 use crate::{LawWords, Reader, WireController, Writer, AGENTS, ALLOCATOR_NAME_BYTES};
 
 /// Everything the simulator's f32 controller is built from, each value already rounded to f32
 /// exactly as the simulator rounds it (module `config`): the team (agent positions, quarter
 /// turns, masses, limits, navigator), the gains (`K_xi` diagonal in the order `[Omega; v]`),
-/// relaxation `s`, gravity, period, optional rate limits, the allocator's name and the law
-/// beyond the paper ([`LawWords`]).
+/// relaxation `s`, gravity, period, optional rate limits, the allocator's name, the law
+/// beyond the paper ([`LawWords`]), the fault detection and the allocator's round cap: every
+/// setting the simulator's f32 controller flies with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CoreConfig {
     /// Agents used (`<=` [`AGENTS`]).
@@ -37,6 +40,11 @@ pub struct CoreConfig {
     pub allocator: [u8; ALLOCATOR_NAME_BYTES],
     /// Gain schedule, offset-free action and planned rates ([`LawWords::PAPER`]: the paper's).
     pub law: LawWords,
+    /// The controller's fault detection, if any.
+    pub fault_detection: Option<FaultDetection<f32>>,
+    /// The exact-boundary redistribution's round cap, if any
+    /// (`AllocatorOptions::max_rounds`).
+    pub max_rounds: Option<u32>,
 }
 
 impl CoreConfig {
@@ -65,7 +73,12 @@ impl CoreConfig {
         self.allocator
             .chunks(4)
             .try_for_each(|c| w.u32(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))?;
-        self.law.put(w)
+        self.law.put(w)?;
+        put_fault_detection(w, self.fault_detection.as_ref())?;
+        match self.max_rounds {
+            Some(k) => w.u32(1).and_then(|()| w.u32(k)),
+            None => w.f32s(&[0.0; 2]),
+        }
     }
 
     /// Reads a configuration written by [`CoreConfig::put`].
@@ -86,6 +99,12 @@ impl CoreConfig {
             c.copy_from_slice(&r.u32()?.to_le_bytes());
         }
         let law = LawWords::get(r)?;
+        let fault_detection = get_fault_detection(r)?;
+        let max_rounds = match (r.u32()?, r.u32()?) {
+            (0, _) => None,
+            (1, k) => Some(k),
+            _ => return None,
+        };
         Some(Self {
             n,
             agents,
@@ -98,6 +117,8 @@ impl CoreConfig {
             rate_limits: (flag == 1).then_some(rates),
             allocator,
             law,
+            fault_detection,
+            max_rounds,
         })
     }
 
@@ -139,10 +160,14 @@ impl CoreConfig {
             gain_schedule: tvmd_core::GainSchedule::AsGiven,
             offset_free: None,
             attitude_rate: None,
-            fault_detection: None,
+            fault_detection: self.fault_detection,
         };
         self.law.apply(&mut settings)?;
-        let alloc = AnyAllocator::from_name(self.allocator_name(), &Default::default())?;
+        let options = AllocatorOptions {
+            max_rounds: self.max_rounds,
+            ..Default::default()
+        };
+        let alloc = AnyAllocator::from_name(self.allocator_name(), &options)?;
         Controller::new(team, settings, alloc)
     }
 }

@@ -12,8 +12,9 @@ pub const FRAME_HEADER_BYTES: usize = 12;
 /// Largest payload of a frame.
 pub const MAX_PAYLOAD_BYTES: usize = 2048;
 /// Protocol version, the payload of `KIND_READY` (2: the configuration carries the law and
-/// `KIND_SET_LANDED` exists).
-pub const PROTOCOL_VERSION: u32 = 2;
+/// `KIND_SET_LANDED` exists; 3: the configuration carries the fault detection and the round
+/// cap, and a cycle's answer ends with its [`FaultAnswer`]).
+pub const PROTOCOL_VERSION: u32 = 3;
 /// Host: configure the controller ([`CoreConfig`] words). Reply `KIND_CONFIGURED` or
 /// `KIND_REFUSED`.
 pub const KIND_CONFIGURE: u16 = 1;
@@ -30,9 +31,10 @@ pub const KIND_READY: u16 = 0x80;
 pub const KIND_CONFIGURED: u16 = 0x81;
 /// Target: mask accepted ([`put_hover`] words).
 pub const KIND_HOVER: u16 = 0x82;
-/// Target: the cycle's output ([`put_output`] words).
+/// Target: the cycle's output ([`put_output`] words, then the [`put_fault_answer`] words).
 pub const KIND_OUTPUT: u16 = 0x83;
-/// Target: the cycle was skipped (held commands, [`put_commands`] words, then the message).
+/// Target: the cycle was skipped (held commands, [`put_commands`] words, the
+/// [`put_fault_answer`] words, then the message).
 pub const KIND_SKIPPED: u16 = 0x84;
 /// Target: configuration or mask refused (the message).
 pub const KIND_REFUSED: u16 = 0x85;

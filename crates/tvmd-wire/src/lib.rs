@@ -10,7 +10,8 @@
 //!
 //! Modules: [`words`] (the word cursors), [`config`] (the controller's configuration, with
 //! [`law`], the law beyond the paper),
-//! [`cycle`] (a cycle's inputs and outputs, the recording's events, failure masks) and
+//! [`cycle`] (a cycle's inputs and outputs, the recording's events, failure masks), [`fault`]
+//! (the fault detection's settings and a cycle's fault answer) and
 //! [`frame`] (processor-in-the-loop frames and their CRC-32).
 
 #![no_std]
@@ -18,12 +19,14 @@
 
 mod config;
 mod cycle;
+mod fault;
 mod frame;
 mod law;
 mod words;
 
 pub use config::CoreConfig;
 pub use cycle::*;
+pub use fault::*;
 pub use frame::*;
 pub use law::*;
 pub use words::{Reader, Writer};
@@ -49,8 +52,18 @@ pub const ALLOCATOR_NAME_BYTES: usize = 32;
 /// Words of a [`CoreConfig`] of `n` agents.
 pub const fn config_words(n: usize) -> usize {
     // n, then per agent x, y, z, quarter turns, mass; limits 3; navigator 1 + 9; gains 3 + 3 +
-    // 6; relaxation, gravity, period; rate-limit flag + 2; allocator name; the law.
-    1 + 5 * n + 3 + 10 + 12 + 3 + 3 + ALLOCATOR_NAME_BYTES / 4 + LAW_WORDS
+    // 6; relaxation, gravity, period; rate-limit flag + 2; allocator name; the law; fault
+    // detection; round-cap flag + 1.
+    1 + 5 * n
+        + 3
+        + 10
+        + 12
+        + 3
+        + 3
+        + ALLOCATOR_NAME_BYTES / 4
+        + LAW_WORDS
+        + FAULT_DETECTION_WORDS
+        + 2
 }
 
 /// Words of a whole [`ControlOutput`] of `n` agents ([`put_output`]).
@@ -69,11 +82,12 @@ pub const fn recorded_words(n: usize) -> usize {
 /// held ones, the rest zero).
 pub const STATUS_CYCLE_ERROR: u32 = 0xff;
 
-/// First word of a cycle recording (`"TVRC"`; format in `tvmd_sim::control::recording`).
+/// First word of a cycle recording (`"TVRC"`; format in `tvmd_pil::recording`).
 pub const RECORDING_MAGIC: u32 = u32::from_le_bytes(*b"TVRC");
 /// Format version of a cycle recording (2: the configuration carries the law, [`LAW_WORDS`],
-/// and an event may set the landed hold, [`EVENT_LANDED_SET`]).
-pub const RECORDING_VERSION: u32 = 2;
+/// and an event may set the landed hold, [`EVENT_LANDED_SET`]; 3: the configuration carries
+/// the fault detection, [`FAULT_DETECTION_WORDS`], and the allocator's round cap).
+pub const RECORDING_VERSION: u32 = 3;
 /// Words of a cycle recording's header (magic, version, agents, cycles, configuration words).
 pub const RECORDING_HEADER_WORDS: usize = 5;
 /// Recording event flag: a failure mask was set before this cycle.

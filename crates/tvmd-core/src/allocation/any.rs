@@ -6,9 +6,9 @@ use super::{
     Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution, PseudoInverse,
     RedistributedPseudoInverse, WeightedPseudoInverse,
 };
-use crate::effectiveness::Effectiveness;
-use crate::error::ConfigError;
-use crate::real::Real;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::error::ConfigError;
+use crate::foundation::real::Real;
 
 #[cfg(feature = "clarabel")]
 use super::names::{CLARABEL, CLARABEL_SEQUENTIAL};
@@ -34,7 +34,8 @@ const NAMES: &[&str] = &[
     WEIGHTED_PSEUDO_INVERSE,
 ];
 
-/// One of the crate's allocators, chosen at run time.
+/// One of the crate's allocators, chosen at run time. Its checked-but-not-made counterpart is
+/// the small `Choice` of [`AllocatorChoice`] (module `choice`, which says why the two stay two).
 ///
 /// ```
 /// use tvmd_core::{AnyAllocator, Allocator};

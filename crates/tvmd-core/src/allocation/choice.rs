@@ -8,8 +8,8 @@ use super::names::{
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 use super::WeightedPseudoInverse;
-use crate::error::{ConfigError, ConfigField};
-use crate::real::Real;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::real::Real;
 
 /// Options of [`super::AnyAllocator::from_name`]; each applies to one allocator only.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +58,14 @@ impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
 pub struct AllocatorChoice<T: Real, const N: usize>(Choice<T, N>);
 
 /// The allocator a choice makes ([`super::AnyAllocator::from_choice`]).
+///
+/// Why a second enum of one variant per allocator beside [`super::AnyAllocator`]: a choice must
+/// stay small, and an allocator cannot. The exact-boundary redistribution's workspace (its
+/// held sets and factorizations, kilobytes at 16 agents) lives in the allocator, so a caller
+/// on a flight controller's stack checks a choice here and has the allocator made in its own
+/// storage afterwards (`Controller::init_in`, the C interface's `tvmd_create`). A variant
+/// added to one enum does not compile until [`super::AnyAllocator::from_choice`] maps it to the
+/// other.
 #[derive(Clone, Debug)]
 pub(super) enum Choice<T: Real, const N: usize> {
     PseudoInverse,

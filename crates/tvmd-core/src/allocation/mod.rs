@@ -35,11 +35,13 @@ pub use redistributed::RedistributedPseudoInverse;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use crate::admissible::AdmissibleSet;
-use crate::effectiveness::Effectiveness;
-use crate::gimbal::GimbalCommand;
-use crate::linalg::{max_abs, norm, solve_gram, weighted_gram, wrench_parts, GramSolver};
-use crate::real::{sqrt, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::Effectiveness;
+use crate::agent::gimbal::GimbalCommand;
+use crate::foundation::linalg::{
+    max_abs, norm, solve_gram, weighted_gram, wrench_parts, GramSolver,
+};
+use crate::foundation::real::{sqrt, Real};
 
 /// What an allocator is asked to do.
 #[derive(Clone, Copy, Debug)]

@@ -5,10 +5,10 @@ use nalgebra::Vector3;
 use super::{
     gram_of, outside, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
 };
-use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, ConfigField};
-use crate::linalg::GramSolver;
-use crate::real::Real;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::linalg::GramSolver;
+use crate::foundation::real::Real;
 
 /// `f = M^T (M M^T)^-1 u_d` through the 6x6 Gram matrix (`O(n)`), then each agent outside its
 /// admissible set is clamped onto it (so the result is admissible but the wrench may be off;
@@ -149,8 +149,8 @@ fn saturated_pseudo_inverse<T: Real, const N: usize>(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::admissible::AdmissibleSet;
-    use crate::failure::FailureMask;
+    use crate::agent::admissible::AdmissibleSet;
+    use crate::agent::failure::FailureMask;
     use crate::team::presets;
     use nalgebra::Vector6;
 

@@ -3,14 +3,14 @@
 use nalgebra::Vector3;
 
 use super::{pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator};
-use crate::admissible::AdmissibleSet;
-use crate::effectiveness::Effectiveness;
-use crate::gimbal::GimbalCommand;
-use crate::real::Real;
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::Effectiveness;
+use crate::agent::gimbal::GimbalCommand;
+use crate::foundation::real::Real;
 
 /// The redistributed pseudo-inverse (Jin 2005; `docs/method.md`, "Allocation"): solve the pseudo-inverse
 /// over the free agents; if some leave their admissible set, saturate the one that leaves it
-/// furthest (largest normalized excess, see [`crate::admissible::AdmissibleSet::violation`]),
+/// furthest (largest normalized excess, see [`crate::agent::admissible::AdmissibleSet::violation`]),
 /// fix it, and redistribute the remaining wrench over the others. At most `n` rounds; agents
 /// still outside after the last round are clamped. Failed agents never take part.
 ///

@@ -7,17 +7,17 @@
 use core::mem::{ManuallyDrop, MaybeUninit};
 use core::ptr::{addr_of_mut, read};
 
-use crate::admissible::AdmissibleSet;
+use crate::afs::hover::{hover_capability, HoverCapability, HoverLimit};
+use crate::afs::planner::AttitudePlanner;
 use crate::afs::{AttainableForceSpace, Relaxation};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::command::AgentCommand;
 use crate::allocation::Allocator;
-use crate::attitude_rate::AttitudeRateState;
-use crate::command::AgentCommand;
-use crate::error::ConfigError;
-use crate::hover::{hover_capability, HoverCapability, HoverLimit};
+use crate::foundation::error::ConfigError;
+use crate::foundation::real::Real;
+use crate::law::attitude_rate::AttitudeRateState;
+use crate::law::offset_free::OffsetFreeState;
 use crate::law::{Gains, Plant};
-use crate::offset_free::OffsetFreeState;
-use crate::planner::AttitudePlanner;
-use crate::real::Real;
 use crate::team::{FailureMask, TeamConfig};
 
 use super::detection::FaultMonitor;

@@ -9,19 +9,19 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 
 use super::guard::{check_range, first_non_finite, first_non_finite_allocation};
 use super::{ControlOutput, Controller, CycleError};
+use crate::afs::planner::{PlannerOutput, PlannerStatus};
+use crate::afs::projection::{project_force_in, ForceProjection};
+use crate::agent::command::{invert, AgentCommand};
 use crate::allocation::{Allocation, AllocationRequest, Allocator, NullSpaceReport};
-use crate::anti_windup::Saturation;
-use crate::attitude_rate::PlannedRates;
-use crate::command::{invert, AgentCommand};
-use crate::error::InputError;
+use crate::foundation::error::InputError;
+use crate::foundation::linalg::norm;
+use crate::foundation::real::Real;
+use crate::foundation::rotation::validate_rotation;
+use crate::law::anti_windup::Saturation;
+use crate::law::attitude_rate::PlannedRates;
+use crate::law::offset_free::CycleRecord;
 use crate::law::{attitude_law, control_wrench, force_request, AttitudeLaw, LawOutput};
 use crate::law::{Reference, RigidState};
-use crate::linalg::norm;
-use crate::offset_free::CycleRecord;
-use crate::planner::{PlannerOutput, PlannerStatus};
-use crate::projection::{project_force_in, ForceProjection};
-use crate::real::Real;
-use crate::rotation::validate_rotation;
 
 /// What the law stage produces ([`Controller::law`]): the planner's `R_d`, the projection, `f_r`
 /// and the law, whose `law.u_d = [u_tau_d; u_fd]` (`{C}`) is the body wrench for
@@ -50,7 +50,7 @@ pub struct AllocationStage<T: Real, const N: usize> {
     pub torque_error: T,
     /// Per-agent commands inside `E_f` (idle for failed agents and unused slots).
     pub commands: [AgentCommand<T>; N],
-    /// Largest clamp the inversion applied ([`crate::admissible::AdmissibleSet::excess`]: rad,
+    /// Largest clamp the inversion applied ([`crate::agent::admissible::AdmissibleSet::excess`]: rad,
     /// or relative to the largest thrust).
     pub command_clamp: T,
 }

@@ -9,25 +9,25 @@
 //! [`Controller::fault_masking`] reports). `docs/method.md`, "Beyond the paper: agent faults".
 //!
 //! The settings ([`crate::FaultDetection`]) and how their noise is resolved for the team are in
-//! [`crate::fault_detection`].
+//! [`crate::fault::detection`].
 
 use nalgebra::{Vector3, Vector6};
 
 use super::{Controller, ControllerSettings};
+use crate::afs::hover::HoverCapability;
+use crate::agent::command::AgentCommand;
 use crate::allocation::{Allocation, Allocator};
-use crate::command::AgentCommand;
-use crate::error::{ConfigError, ConfigField};
+use crate::fault::detection::{
+    FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
+};
 use crate::fault::{
     loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
 };
-use crate::fault_detection::{
-    FaultResponse, FAULT_ACTUATOR_LAG, FAULT_BASELINE_BANDWIDTH, FAULT_JUMP_SHARE,
-};
-use crate::hover::HoverCapability;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::linalg::{wrench_parts, EuclideanNorm};
+use crate::foundation::real::{lit, sin_cos, Real};
+use crate::law::offset_free::OffsetFree;
 use crate::law::RigidState;
-use crate::linalg::{wrench_parts, EuclideanNorm};
-use crate::offset_free::OffsetFree;
-use crate::real::{lit, sin_cos, Real};
 use crate::team::TeamConfig;
 
 /// A mask the controller set itself on a confirmed loss ([`FaultResponse::Mask`]).
@@ -383,7 +383,7 @@ mod tests {
         assert_eq!(forces(&c), [Vector3::zeros(); 4]);
         let at = Vector3::new(0.0, 0.0, 1.5);
         let mut reference = Reference::hover(at);
-        reference.attitude = crate::rotation::roll(0.3);
+        reference.attitude = crate::foundation::rotation::roll(0.3);
         let out = c.step(&RigidState::at_rest(at), &reference).unwrap();
         // The allocation's forces, which the sent commands carry up to the inversion's
         // round-off.

@@ -4,11 +4,11 @@
 use nalgebra::Vector3;
 
 use super::ControlOutput;
+use crate::agent::command::AgentCommand;
 use crate::allocation::Allocation;
-use crate::command::AgentCommand;
-use crate::error::InputError;
+use crate::foundation::error::InputError;
+use crate::foundation::real::{count, lit, sqrt, to_f64, Real};
 use crate::law::{Gains, Reference, RigidState};
-use crate::real::{count, lit, sqrt, to_f64, Real};
 use crate::team::TeamConfig;
 
 /// [`InputError::OutOfRange`] for the first vector input with a component beyond `limit`

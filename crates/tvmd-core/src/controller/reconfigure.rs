@@ -3,14 +3,14 @@
 //! [`Controller::seed_commands`] for a mode switch (the commands the vehicle flies now become
 //! the held ones).
 
+use crate::afs::planner::AttitudePlanner;
 use crate::afs::Relaxation;
+use crate::agent::command::AgentCommand;
+use crate::agent::limits::RateLimits;
 use crate::allocation::Allocator;
-use crate::command::AgentCommand;
-use crate::error::{ConfigError, InputError};
+use crate::foundation::error::{ConfigError, InputError};
+use crate::foundation::real::{lit, Real};
 use crate::law::Gains;
-use crate::limits::RateLimits;
-use crate::planner::AttitudePlanner;
-use crate::real::{lit, Real};
 
 use super::guard::input_limit;
 use super::Controller;

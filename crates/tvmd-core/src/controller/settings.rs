@@ -2,17 +2,17 @@
 //! team and the allocator.
 
 use crate::afs::Relaxation;
+use crate::agent::limits::RateLimits;
 use crate::allocation::NullSpaceStage;
-use crate::attitude_rate::AttitudeRateFilter;
-use crate::disturbance::DisturbanceObserver;
-use crate::error::{ConfigError, ConfigField};
-use crate::fault_detection::FaultDetection;
-use crate::gain_schedule::GainSchedule;
+use crate::fault::detection::FaultDetection;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::real::{lit, Real};
+use crate::law::attitude_rate::AttitudeRateFilter;
+use crate::law::disturbance::DisturbanceObserver;
+use crate::law::gain_schedule::GainSchedule;
+use crate::law::natural_gains::NaturalGains;
+use crate::law::offset_free::OffsetFree;
 use crate::law::Gains;
-use crate::limits::RateLimits;
-use crate::natural_gains::NaturalGains;
-use crate::offset_free::OffsetFree;
-use crate::real::{lit, Real};
 
 /// Shortest control period (s) a controller accepts (1 MHz): below it the rates the rate
 /// limits, the observer and the planned-rate filter derive would be meaningless.

@@ -9,7 +9,7 @@
 //!   leaves `r.r - q^T P^-1 q + (f^T P^-1 q)^2 / (f^T P^-1 f)`.
 //!
 //! Every block is `M_i = [[p_i]x R_i; R_i]` with `R_i` a rotation
-//! ([`crate::effectiveness::agent_block`]), so `M_f^T M_tau = [p']x` with `p' = R_i^T p_i`, and
+//! ([`crate::agent::effectiveness::agent_block`]), so `M_f^T M_tau = [p']x` with `p' = R_i^T p_i`, and
 //! `P = w_tau^2 (|p'|^2 I - p' p'^T) + w_f^2 I` (`w_tau`, `w_f`: the torque and force weights),
 //! whose inverse is `(I + (w_tau^2 / w_f^2) p' p'^T) / (w_tau^2 |p'|^2 + w_f^2)`
 //! (Sherman-Morrison), so every `x^T P^-1 y` is a few dot products. About 100 flops an agent,
@@ -25,7 +25,7 @@
 use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use super::FaultKind;
-use crate::real::{fmax, fmin, sqrt, Real};
+use crate::foundation::real::{fmax, fmin, sqrt, Real};
 
 /// The period's weighted residual, shared by every agent's fit.
 pub(super) struct WeightedResidual<T: Real> {
@@ -180,8 +180,8 @@ pub(super) fn unsquare<T: Real>(misfit2: T) -> T {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::effectiveness::agent_block;
-    use crate::linalg::EuclideanNorm;
+    use crate::agent::effectiveness::agent_block;
+    use crate::foundation::linalg::EuclideanNorm;
     use rand::{rngs::StdRng, Rng, SeedableRng};
 
     /// The misfits by the fits' definitions, in six dimensions: the loss by its clamped

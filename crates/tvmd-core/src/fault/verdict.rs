@@ -1,6 +1,6 @@
 //! The detector's verdict and report types ([`crate::fault`]).
 
-use crate::real::Real;
+use crate::foundation::real::Real;
 
 /// What an isolated agent's residual looks like.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -546,14 +546,19 @@ class SimulationBatch:
         """Holds each team's (B, 6) body wrench ``[u_tau; u_f]`` (N m, N) for one controller
         period (only the ``active`` teams step, all by default); every team's observation.
 
+        A team whose wrench is not finite (NaN, inf) fails alone: its ``errors`` entry says
+        which component, its arrays are NaN, its simulation is unchanged, and the other teams
+        step (as the Rust batch does).
+
         Raises:
-            ValueError: not (B, 6) finite values, ``active`` not B flags.
+            ValueError: not (B, 6) values, ``active`` not B flags.
         """
     def step(
         self, commands: ArrayLike, *, active: Optional[list[bool]] = None, rotor_speeds: bool = False
     ) -> dict[str, Any]:
         """Holds each team's (B, n, 3) or (B, n, 4) per-agent commands (as ``Simulation.step``)
-        for one controller period; every team's observation."""
+        for one controller period; every team's observation. A team whose commands are not
+        finite fails alone (its ``errors`` entry), as with ``step_wrench``."""
     @property
     def n_teams(self) -> int:
         """The number of teams ``B``."""

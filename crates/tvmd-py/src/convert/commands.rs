@@ -1,6 +1,8 @@
 //! The actions of `tvmd.sim.Simulation`: per-agent commands (`step`) and a body wrench
 //! (`step_wrench`), checked here (shape, finite values, rotor speeds not negative) so that a bad
-//! action raises `ValueError` naming the argument and never reaches the simulator.
+//! action raises `ValueError` naming the argument and never reaches the simulator. A batch's
+//! values are not checked for finiteness here: a non-finite value is its team's error in the
+//! simulator's batch (`errors`), and the other teams step, as in Rust.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -31,7 +33,8 @@ pub(crate) fn commands_arg(
 }
 
 /// The commands of a batch step for `b` teams of `n` agents: `(b, n, 3)` or `(b, n, 4)`, each
-/// team's `(n, ...)` as [`commands_arg`] reads it.
+/// team's `(n, ...)` as [`commands_arg`] reads it but for finiteness (a team's non-finite
+/// command is that team's error in the batch).
 pub(crate) fn batch_commands_arg(
     obj: &Bound<'_, PyAny>,
     b: usize,
@@ -48,7 +51,6 @@ pub(crate) fn batch_commands_arg(
             return Err(shape_error(name, &want, shape));
         }
     };
-    check_finite(a.iter(), name)?;
     let values: Vec<f64> = a.iter().copied().collect();
     values
         .chunks_exact(n * cols)
@@ -99,11 +101,10 @@ fn rows(
         .collect()
 }
 
-/// `(b, 6)` body wrenches of a batch step, every value finite.
+/// `(b, 6)` body wrenches of a batch step (a team's non-finite wrench is that team's error in
+/// the batch).
 pub(crate) fn batch_wrench_arg(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<[f64; 6]>> {
-    let name = "wrenches";
-    let w = table::<6>(obj, name, Some(b))?;
-    check_finite(w.iter().flat_map(|w| w.iter()), name)?;
+    let w = table::<6>(obj, "wrenches", Some(b))?;
     Ok(w.into_iter().map(Into::into).collect())
 }
 

@@ -279,34 +279,21 @@ pub fn hover_roll_limit(scenario: &Scenario, s: f64) -> Result<f64, SimError> {
 /// ([`tvmd_wire::CoreConfig`]): every value rounded exactly as [`team_config`],
 /// [`controller_settings`] and [`allocator`] round it. Errors name the scenario field, as
 /// [`super::TvmdController::from_scenario`]'s do. The law (`[law]`) crosses as
-/// [`tvmd_wire::LawWords`] of the f32 settings.
+/// [`tvmd_wire::LawWords`] of the f32 settings, with the fault detection and the allocator's
+/// round cap: every setting the f32 controller flies with.
 pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimError> {
     use tvmd_wire::{CoreConfig, LawWords, AGENTS, ALLOCATOR_NAME_BYTES};
-    // Refused rather than flown without them: the words do not carry these settings yet.
-    let uncarried = [
-        (
-            scenario.fault_detection.is_some(),
-            "fault_detection",
-            "the fault detector",
-        ),
-        (
-            scenario.allocator_max_rounds.is_some(),
-            "allocator_max_rounds",
-            "the allocator's round cap",
-        ),
-    ];
-    if let Some((_, field, what)) = uncarried.iter().find(|(given, ..)| *given) {
+    // Refused rather than flown without it: the target's firmware is built without the stage
+    // (tvmd-core without its `null-space` feature, as the C interface).
+    if scenario.null_space.is_some() {
         return Err(invalid(
-            field,
-            format!(
-                "{what} is not carried to an emulated target (PIL) or into a cycle recording \
-                 yet: fly it in process"
-            ),
+            "null_space",
+            "the null-space stage is not built into the target's firmware: fly it in process",
         ));
     }
     team_config::<f32>(scenario)?;
     let settings = controller_settings::<f32>(scenario)?;
-    allocator::<f32>(&scenario.allocator, None)?;
+    allocator::<f32>(&scenario.allocator, scenario.allocator_max_rounds)?;
     let body = scenario.team_body()?;
     let mut agents = [([0.0f32; 3], 0, 0.0f32); AGENTS];
     for (slot, a) in agents.iter_mut().zip(&body.agents) {
@@ -340,5 +327,7 @@ pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimErro
         rate_limits: scenario.controller_rate_limits.map(|r| r.map(to_core)),
         allocator,
         law: LawWords::of(&settings),
+        fault_detection: settings.fault_detection,
+        max_rounds: scenario.allocator_max_rounds,
     })
 }

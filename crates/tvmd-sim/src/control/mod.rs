@@ -27,7 +27,7 @@
 //! 5. converts the commands and every part of [`Diagnostics`] (planner, control law,
 //!    allocation, Lyapunov values) back to f64 (exact).
 
-use tvmd_core::{AnyAllocator, FailureMask};
+use tvmd_core::FailureMask;
 
 use crate::diagnostics::{Diagnostics, FaultDiagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
@@ -39,11 +39,13 @@ use tvmd_scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
 mod config;
 mod convert;
 mod diagnostics;
-pub mod engine;
 mod landing;
-pub mod pil;
-pub mod recording;
 pub mod wrench;
+
+/// The core's engines, the PIL link and the cycle recorder: crate `tvmd-pil`.
+pub use tvmd_pil as pil;
+pub use tvmd_pil::{engine, recording};
+pub use tvmd_pil::{CoreController, CoreOutput, MAX_AGENTS};
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
 pub use landing::{Landing, Touchdown, LANDED_HEIGHT};
@@ -55,15 +57,6 @@ pub use config::{
 };
 pub use convert::{core_reference, core_state, sim_command, CoreFloat};
 pub use diagnostics::fault_diagnostics;
-
-/// Agent capacity of the controller the simulator runs (the core's const generic `N`).
-pub const MAX_AGENTS: usize = 16;
-
-/// The core controller type the simulator runs, in `T` (f32: the type a flight controller runs).
-pub type CoreController<T> = tvmd_core::Controller<T, MAX_AGENTS, AnyAllocator<T, MAX_AGENTS>>;
-
-/// The core's output of one cycle.
-pub type CoreOutput<T> = tvmd_core::ControlOutput<T, MAX_AGENTS>;
 
 /// The core controller of a scenario in `T` and its agent count, as
 /// [`TvmdController::from_scenario`] builds it.

@@ -151,10 +151,10 @@ fn the_wire_configuration_carries_the_law() {
     assert!(words.build().is_err());
 }
 
-/// The scenario's round cap reaches the allocator in process; the words do not carry it yet,
-/// so PIL and the recorder refuse it rather than fly without it.
+/// The scenario's round cap reaches the allocator in process and through the words (PIL and
+/// the recorder build the same capped allocator).
 #[test]
-fn the_allocators_round_cap_is_flown_in_process_and_refused_by_the_words() {
+fn the_allocators_round_cap_is_flown_in_process_and_carried_by_the_words() {
     use tvmd_core::AnyAllocator;
     use tvmd_sim::control::{core_of_scenario, wire_config};
     let mut s = Scenario {
@@ -166,8 +166,13 @@ fn the_allocators_round_cap_is_flown_in_process_and_refused_by_the_words() {
         panic!("the default allocator is the exact-boundary redistribution");
     };
     assert_eq!(a.max_rounds(), Some(2));
-    let e = wire_config(&s).unwrap_err();
-    assert!(e.to_string().contains("allocator_max_rounds"), "{e}");
+    let words = wire_config(&s).unwrap();
+    assert_eq!(words.max_rounds, Some(2));
+    let built = words.build().unwrap();
+    let AnyAllocator::ExactBoundaryRedistribution(a) = built.allocator() else {
+        panic!("the words build the exact-boundary redistribution");
+    };
+    assert_eq!(a.max_rounds(), Some(2));
     s.allocator_max_rounds = None;
-    assert!(wire_config(&s).is_ok());
+    assert_eq!(wire_config(&s).unwrap().max_rounds, None);
 }

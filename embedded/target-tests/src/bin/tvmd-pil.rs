@@ -221,6 +221,12 @@ fn serve(kind: u16, seq: u16, words: &[u32], ctl: &mut Option<(WireController, u
                     Ok(o) => (Ok(()), wire::put_output(&mut w, &o, *n)),
                     Err(e) => (Err(e), wire::put_commands(&mut w, &e.commands, *n)),
                 };
+                let fault = wire::FaultAnswer {
+                    report: c.fault_report().copied(),
+                    masking: c.fault_masking(),
+                    failures: *c.failures(),
+                };
+                let written = written.and_then(|()| wire::put_fault_answer(&mut w, &fault));
                 let len = w.len();
                 let words = out.get(..len).unwrap_or(&[]);
                 match (reply, written) {

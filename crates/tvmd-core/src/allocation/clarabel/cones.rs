@@ -2,8 +2,8 @@
 //! cones on its force (see [`super::ClarabelAllocator`], "Why the constraints lie inside").
 
 use super::settings::{ACTIVE_TOL, FEASIBLE_TOL, MAX_TAN_ANGLE};
-use crate::admissible::AdmissibleSet;
-use crate::real::{to_f64, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::foundation::real::{to_f64, Real};
 
 /// One side of the `eta_x` window.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -210,7 +210,7 @@ impl Shape {
 pub(super) mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::admissible::Interval;
+    use crate::agent::admissible::Interval;
 
     /// `E_f` of eq. (6) with `sigma_x = pi/6`, `sigma_y = pi/4`, `T in [0, 10]`.
     pub(in crate::allocation::clarabel) fn symmetric() -> Bounds {

@@ -27,9 +27,9 @@ use nalgebra::Vector3;
 
 use super::{Allocation, AllocationRequest, Allocator, RedistributedPseudoInverse};
 #[cfg(doc)]
-use crate::admissible::AdmissibleSet;
-use crate::error::{ConfigError, ConfigField};
-use crate::real::{lit, to_f64, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::real::{lit, to_f64, Real};
 use cache::Cache;
 use qp::Problem;
 pub use report::{ClarabelStatus, FallbackReason, SolveReport};

@@ -7,7 +7,7 @@ use nalgebra::{Matrix6, Vector3};
 
 use super::cones::lerp;
 use super::qp::Problem;
-use crate::linalg::{solve_gram, weighted_gram};
+use crate::foundation::linalg::{solve_gram, weighted_gram};
 
 impl<const N: usize> Problem<N> {
     /// The regularised least-squares forces of the agents marked free, the others held at

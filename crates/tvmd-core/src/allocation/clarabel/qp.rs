@@ -8,7 +8,7 @@ use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use super::cones::{Bounds, Shape, XBound};
 use crate::allocation::AllocationRequest;
-use crate::real::{to_f64, Real};
+use crate::foundation::real::{to_f64, Real};
 
 /// A working agent in the problem: its capacity slot, weighted block and bounds.
 #[derive(Clone, Copy, Debug)]

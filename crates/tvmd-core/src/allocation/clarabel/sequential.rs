@@ -17,13 +17,13 @@ use super::qp::Problem;
 use super::report::{ClarabelStatus, FallbackReason};
 use super::sequential_report::{SequentialReport, StopReason};
 use super::{within_range, ClarabelAllocator};
+#[cfg(doc)]
+use crate::agent::admissible::AdmissibleSet;
 use crate::allocation::RedistributedPseudoInverse;
 use crate::allocation::{outside, Allocation, AllocationRequest, Allocator};
-use crate::error::{ConfigError, ConfigField};
-use crate::linalg::norm;
-use crate::real::{eps, lit, to_f64, Real};
-#[cfg(doc)]
-use crate::AdmissibleSet;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::linalg::norm;
+use crate::foundation::real::{eps, lit, to_f64, Real};
 
 /// Default step limit.
 const DEFAULT_MAX_STEPS: u32 = 5;

@@ -4,8 +4,8 @@
 use nalgebra::{Matrix6x3, Vector3, Vector6};
 
 use super::constraint::{Constraint, CONSTRAINTS};
-use crate::linalg::norm;
-use crate::real::{lit, Real};
+use crate::foundation::linalg::norm;
+use crate::foundation::real::{lit, Real};
 
 /// Constraints an agent is held on (bit `k` for constraint `k`), with the orthonormal normals of
 /// their tangent planes at the agent's current force.
@@ -194,10 +194,10 @@ fn lower_downdate<T: Real>(gram: &mut nalgebra::Matrix6<T>, v: &Vector6<T>) {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::admissible::AdmissibleSet;
+    use crate::agent::admissible::AdmissibleSet;
+    use crate::agent::gimbal::GimbalCommand;
+    use crate::agent::limits::Interval;
     use crate::allocation::exact_boundary::constraint::constraints;
-    use crate::gimbal::GimbalCommand;
-    use crate::limits::Interval;
 
     #[test]
     fn held_normals_are_removed_from_steps_and_three_fix_the_agent() {

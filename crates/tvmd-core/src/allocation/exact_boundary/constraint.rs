@@ -14,10 +14,10 @@
 
 use nalgebra::Vector3;
 
-use crate::admissible::AdmissibleSet;
-use crate::limits::Interval;
-use crate::linalg::{max_abs, norm};
-use crate::real::{eps, fmax, lit, sin_cos, sqrt, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::limits::Interval;
+use crate::foundation::linalg::{max_abs, norm};
+use crate::foundation::real::{eps, fmax, lit, sin_cos, sqrt, Real};
 
 /// Number of constraints of one agent.
 pub(in crate::allocation) const CONSTRAINTS: usize = 6;
@@ -290,7 +290,7 @@ pub(in crate::allocation) fn constraints<T: Real>(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
     use super::*;
-    use crate::gimbal::GimbalCommand;
+    use crate::agent::gimbal::GimbalCommand;
 
     fn set() -> AdmissibleSet<f64> {
         AdmissibleSet::new(

@@ -18,11 +18,11 @@ use super::{
     outside_fast, redistributed::redistribute, working_mask, Allocation, AllocationRequest,
     Allocator,
 };
-use crate::admissible::AdmissibleSet;
-use crate::effectiveness::Effectiveness;
-use crate::gimbal::GimbalCommand;
-use crate::linalg::{max_abs, norm};
-use crate::real::{eps, fmax, lit, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::Effectiveness;
+use crate::agent::gimbal::GimbalCommand;
+use crate::foundation::linalg::{max_abs, norm};
+use crate::foundation::real::{eps, fmax, lit, Real};
 
 /// Incremental allocation on the exact admissible boundary.
 ///

@@ -8,10 +8,10 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 use super::active::ActiveSet;
 use super::constraint::{Constraint, Ray, CONSTRAINTS};
 use super::cost::WalkCost;
-use crate::admissible::AdmissibleSet;
-use crate::effectiveness::Effectiveness;
-use crate::linalg::{norm, solve_gram};
-use crate::real::{eps, fmax, sqrt, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::linalg::{norm, solve_gram};
+use crate::foundation::real::{eps, fmax, sqrt, Real};
 
 /// The walk's state over the agents.
 pub(super) struct Walk<'a, T: Real, const N: usize> {

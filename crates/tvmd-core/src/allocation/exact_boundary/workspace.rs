@@ -6,8 +6,8 @@
 use super::active::ActiveSet;
 use super::constraint::{constraints, Constraint, CONSTRAINTS};
 use super::walk::offset;
-use crate::admissible::AdmissibleSet;
-use crate::real::Real;
+use crate::agent::admissible::AdmissibleSet;
+use crate::foundation::real::Real;
 
 /// Scratch of one allocation, and the constraints of the sets it last saw.
 #[derive(Clone, Copy, Debug)]

@@ -15,9 +15,9 @@ pub use report::NullSpaceReport;
 
 use nalgebra::Vector3;
 
-use crate::effectiveness::Effectiveness;
-use crate::error::{ConfigError, ConfigField};
-use crate::real::Real;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::real::Real;
 
 /// Largest iteration cap [`NullSpaceStage::new`] accepts.
 pub const MAX_NULL_SPACE_ITERATIONS: u32 = 64;
@@ -127,9 +127,9 @@ impl<T: Real> NullSpaceStage<T> {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::admissible::AdmissibleSet;
+    use crate::agent::admissible::AdmissibleSet;
+    use crate::agent::limits::Interval;
     use crate::allocation::{outside, AllocationRequest, Allocator, RedistributedPseudoInverse};
-    use crate::limits::Interval;
     use nalgebra::Vector6;
 
     fn team() -> (Effectiveness<f64, 4>, [AdmissibleSet<f64>; 4]) {

@@ -1,7 +1,7 @@
 //! What the null-space stage maximizes: each agent's normalized margin to the boundary of its
 //! admissible set `E_f` (eq. 6), or the alignment of each thrust with a configured inward tilt.
 
-use crate::real::Real;
+use crate::foundation::real::Real;
 
 /// The objective of a [`super::NullSpaceStage`].
 #[derive(Clone, Copy, Debug, PartialEq)]

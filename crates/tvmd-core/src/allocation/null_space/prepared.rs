@@ -5,10 +5,10 @@ use nalgebra::Vector3;
 
 use super::super::exact_boundary::constraint::{constraints, Constraint, CONSTRAINTS};
 use super::NullSpaceObjective;
-use crate::admissible::AdmissibleSet;
-use crate::effectiveness::Effectiveness;
-use crate::linalg::norm;
-use crate::real::{count, eps, lit, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::linalg::norm;
+use crate::foundation::real::{count, eps, lit, Real};
 
 /// Sharpness `kappa` of the soft minimum of the margins (margins are fractions of a range, so
 /// `1 / kappa = 1/32` is the scale below which a difference of margins counts as "the same").
@@ -232,8 +232,8 @@ fn tilt_target<T: Real>(block: &nalgebra::Matrix6x3<T>, angle: T) -> Vector3<T> 
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::gimbal::GimbalCommand;
-    use crate::limits::Interval;
+    use crate::agent::gimbal::GimbalCommand;
+    use crate::agent::limits::Interval;
 
     fn set() -> AdmissibleSet<f64> {
         AdmissibleSet::new(

@@ -4,11 +4,11 @@ use nalgebra::Vector3;
 
 #[cfg(feature = "null-space")]
 use super::super::exact_boundary::active::ActiveSet;
-use crate::effectiveness::Effectiveness;
-use crate::linalg::norm;
+use crate::agent::effectiveness::Effectiveness;
+use crate::foundation::linalg::norm;
 #[cfg(feature = "null-space")]
-use crate::linalg::solve_gram;
-use crate::real::{eps, lit, Real};
+use crate::foundation::linalg::solve_gram;
+use crate::foundation::real::{eps, lit, Real};
 
 /// The step direction in `null(M)` for gradient `g`, with every agent that sits on a boundary
 /// of its set kept from crossing it (`active[i]` holds those constraints, updated at the

@@ -13,8 +13,8 @@ use crate::allocation::exact_boundary::constraint::{
 };
 use crate::allocation::exact_boundary::per_set;
 use crate::allocation::{outside, working_mask, Allocation, AllocationRequest};
-use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, Real};
+use crate::foundation::linalg::{max_abs, norm};
+use crate::foundation::real::{eps, lit, Real};
 
 /// Halvings of a step before the stage gives up on it.
 const HALVINGS: u32 = 8;
@@ -180,7 +180,7 @@ impl<T: Real> NullSpaceStage<T> {
 fn hold_boundaries<T: Real, const N: usize>(
     objective: &Prepared<T, N>,
     bounds: &[[Constraint<T>; CONSTRAINTS]; N],
-    sets: &[crate::admissible::AdmissibleSet<T>; N],
+    sets: &[crate::agent::admissible::AdmissibleSet<T>; N],
     working: &[bool; N],
     forces: &[Vector3<T>; N],
 ) -> [ActiveSet<T>; N] {

@@ -1,6 +1,6 @@
 //! What the null-space stage changed in one period.
 
-use crate::real::Real;
+use crate::foundation::real::Real;
 
 /// The null-space stage's account of one period ([`super::NullSpaceStage::refine`]), reported
 /// in [`crate::ControlOutput::null_space`].

@@ -11,7 +11,7 @@
 //! paper's simulation).
 
 use super::{paper_limits, ConfigError, Real, TeamConfig, PAPER_AGENT_MASS, PAPER_HALF_SIDE};
-use crate::real::{count, lit};
+use crate::foundation::real::{count, lit};
 use crate::team::{AgentSpec, Navigator};
 use nalgebra::Vector3;
 
@@ -352,7 +352,7 @@ pub(super) fn layout_team<T: Real, const N: usize>(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::failure::FailureMask;
+    use crate::agent::failure::FailureMask;
     use crate::team::Arrangement;
 
     #[test]

@@ -79,7 +79,8 @@ pub fn ring<T: Real, const N: usize>(
     }
     let mut agents = [AgentSpec::placeholder(); N];
     for (i, agent) in agents.iter_mut().take(n).enumerate() {
-        let phase = T::two_pi() * crate::real::count::<T>(i) / crate::real::count::<T>(n);
+        let phase = T::two_pi() * crate::foundation::real::count::<T>(i)
+            / crate::foundation::real::count::<T>(n);
         let m = if inconsistent { (i % 2) as i32 } else { 0 };
         *agent = AgentSpec::new(
             Vector3::new(radius * phase.cos(), radius * phase.sin(), T::zero()),
@@ -187,7 +188,7 @@ pub fn a8_con<T: Real, const N: usize>() -> Result<TeamConfig<T, N>, ConfigError
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::failure::FailureMask;
+    use crate::agent::failure::FailureMask;
 
     fn check_layout<const N: usize>(team: &TeamConfig<f64, N>, n: usize, n_x: usize) {
         let none = FailureMask::none();

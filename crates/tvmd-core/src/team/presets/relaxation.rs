@@ -3,7 +3,7 @@
 use super::certified::CERTIFIED;
 use super::Preset;
 use crate::afs::Relaxation;
-use crate::real::{lit, Real};
+use crate::foundation::real::{lit, Real};
 
 impl Preset {
     /// The certified relaxation `s*` of the AFS atlas (`docs/afs-atlas.md`) for this team with

@@ -7,7 +7,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::real::{eps, lit, sqrt, Real};
+use crate::foundation::real::{eps, lit, sqrt, Real};
 
 /// `true` if `j` is finite, symmetric (to `64 eps` of its largest entry) and positive
 /// semi-definite: every principal minor `>= -64 eps` after scaling (Sylvester's criterion on

@@ -7,7 +7,7 @@
 use nalgebra::storage::Storage;
 use nalgebra::{Dim, Matrix, Matrix3, Matrix6, Matrix6x3, SVector, Vector3, Vector6};
 
-use crate::real::{eps, fmax, lit, sqrt, Real};
+use crate::foundation::real::{eps, fmax, lit, sqrt, Real};
 
 /// The torque part `u_tau` (rows 0-2) and the force part `u_f` (rows 3-5) of a wrench
 /// `u = [u_tau; u_f]`, by destructuring the storage: a view's `into_owned` keeps a length

@@ -9,9 +9,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::error::{positive, ConfigError, ConfigField};
+use crate::foundation::error::{positive, ConfigError, ConfigField};
+use crate::foundation::real::Real;
 use crate::law::Gains;
-use crate::real::Real;
 
 /// Closed-loop natural frequencies `w` (rad/s) and damping ratios `zeta` per axis of position
 /// and attitude, validated (each finite and positive). [`NaturalGains::gains`] turns them into

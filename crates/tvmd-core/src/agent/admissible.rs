@@ -3,13 +3,13 @@
 
 use nalgebra::Vector3;
 
-use crate::error::{ConfigError, ConfigField};
-use crate::gimbal::{thrust_direction, GimbalCommand};
-use crate::limits::AgentLimits;
-/// The interval and rate limits, at their old paths (now in [`crate::limits`]).
-pub use crate::limits::{Interval, RateLimits};
-use crate::linalg::max_abs;
-use crate::real::{fmax, sin_cos, Real};
+use crate::agent::gimbal::{thrust_direction, GimbalCommand};
+use crate::agent::limits::AgentLimits;
+/// The interval and rate limits, at their old paths (now in [`crate::agent::limits`]).
+pub use crate::agent::limits::{Interval, RateLimits};
+use crate::foundation::error::{ConfigError, ConfigField};
+use crate::foundation::linalg::max_abs;
+use crate::foundation::real::{fmax, sin_cos, Real};
 
 /// Each agent's admissible set for one period: `base` everywhere, narrowed around each agent's
 /// previous command by `rate_limits = (rates, dt)` when given
@@ -165,7 +165,7 @@ impl<T: Real> AdmissibleSet<T> {
     }
 
     /// [`Self::saturate`] with the gimbal inverse of [`GimbalCommand::from_force_fast`] and the
-    /// clamped direction's sines and cosines from [`crate::real::sin_cos`]: the same bits in
+    /// clamped direction's sines and cosines from [`crate::foundation::real::sin_cos`]: the same bits in
     /// `f64`; in `f32` within 2 ulp, without `libm`'s `sincosf` (software `f64` on a
     /// Cortex-M4F, about 2,200 instructions a call). The
     /// exact-boundary redistribution's; the paper's allocator keeps [`Self::saturate`]'s bits.

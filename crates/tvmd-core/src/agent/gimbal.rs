@@ -3,9 +3,9 @@
 
 use nalgebra::Vector3;
 
-use crate::linalg::EuclideanNorm;
-use crate::linalg::{max_abs, plain_is_exact};
-use crate::real::{asin, sqrt, Real};
+use crate::foundation::linalg::EuclideanNorm;
+use crate::foundation::linalg::{max_abs, plain_is_exact};
+use crate::foundation::real::{asin, sqrt, Real};
 
 /// `a_hat(eta_x, eta_y) = [cos eta_x sin eta_y, -sin eta_x, cos eta_x cos eta_y]` (eq. 1), the
 /// unit thrust direction in the agent frame.
@@ -48,7 +48,7 @@ impl<T: Real> GimbalCommand<T> {
         Self::inverse(force, |s| s.asin())
     }
 
-    /// [`Self::from_force`] with `asin` from [`crate::real::asin`]: the same bits in `f64`; in
+    /// [`Self::from_force`] with `asin` from [`crate::foundation::real::asin`]: the same bits in `f64`; in
     /// `f32` within 2 ulp without `libm`'s software-`f64` branch (a Cortex-M4F). The
     /// exact-boundary redistribution's; the paper's allocator keeps [`Self::from_force`]'s bits.
     pub(crate) fn from_force_fast(force: &Vector3<T>) -> Self {

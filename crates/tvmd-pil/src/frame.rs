@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::Instant;
 
-use super::PilError;
+use crate::error::PilError;
 use tvmd_wire::{frame_crc, frame_header, FRAME_HEADER_BYTES, FRAME_MAGIC, MAX_PAYLOAD_BYTES};
 
 /// One frame: kind, sequence number, payload.

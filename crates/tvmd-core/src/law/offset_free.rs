@@ -5,11 +5,11 @@
 
 use nalgebra::{Vector3, Vector6};
 
-use crate::anti_windup::Saturation;
-use crate::disturbance::{DisturbanceObserver, ObserverState};
-use crate::integral::{IntegralAction, IntegralState};
+use crate::foundation::real::Real;
+use crate::law::anti_windup::Saturation;
+use crate::law::disturbance::{DisturbanceObserver, ObserverState};
+use crate::law::integral::{IntegralAction, IntegralState};
 use crate::law::{Plant, RigidState};
-use crate::real::Real;
 
 /// Which offset-free action the controller runs (`None` in
 /// [`crate::ControllerSettings::offset_free`]: the paper's law, no state).

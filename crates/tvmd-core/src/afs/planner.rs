@@ -4,11 +4,11 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::error::{ConfigError, ConfigField, InputError};
-use crate::linalg::EuclideanNorm;
-use crate::linalg::{columns, norm, normalize};
-use crate::real::{eps, lit, sqrt, Real};
-use crate::rotation::validate_rotation;
+use crate::foundation::error::{ConfigError, ConfigField, InputError};
+use crate::foundation::linalg::EuclideanNorm;
+use crate::foundation::linalg::{columns, norm, normalize};
+use crate::foundation::real::{eps, lit, sqrt, Real};
+use crate::foundation::rotation::validate_rotation;
 
 /// How the planner reached its output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -139,7 +139,7 @@ impl<T: Real> AttitudePlanner<T> {
     /// Plans `R_d` for the reference attitude `r_r` and the inertial force request `f_r`
     /// (eq. 9: `f_r = t_Tf R u_fr`). Errors: [`InputError::NonFinite`] for a non-finite input,
     /// [`InputError::NotRotation`] when `r_r` is not a rotation (the check of
-    /// [`crate::rotation::validate_rotation`]).
+    /// [`crate::foundation::rotation::validate_rotation`]).
     pub fn plan(
         &self,
         afs: &AttainableForceSpace<T>,
@@ -366,7 +366,7 @@ impl<T: Real> Tilt<T> {
 
     /// `b_zd(theta) = rot(b_zr, k, theta)`.
     fn direction(&self, theta: T) -> Vector3<T> {
-        let (s, c) = crate::real::sin_cos(theta);
+        let (s, c) = crate::foundation::real::sin_cos(theta);
         // `v / ||v||` as nalgebra's `normalize`, the same bits, with the FPU's square root.
         let v = self.b_zr * c + self.k_cross_bz * s;
         v / v.euclidean_norm()

@@ -3,8 +3,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::error::InputError;
-use crate::real::{lit, Real};
+use crate::foundation::error::InputError;
+use crate::foundation::real::{lit, Real};
 
 /// Checks that `r` is a rotation: finite ([`InputError::NonFinite`]), `R^T R = I` and
 /// `det R = 1` within `1e-3` ([`InputError::NotRotation`]), both naming `field`. The one

@@ -2,10 +2,10 @@
 
 use nalgebra::Vector3;
 
-use crate::admissible::AdmissibleSet;
-use crate::gimbal::GimbalCommand;
-use crate::limits::AgentLimits;
-use crate::real::{eps, lit, Real};
+use crate::agent::admissible::AdmissibleSet;
+use crate::agent::gimbal::GimbalCommand;
+use crate::agent::limits::AgentLimits;
+use crate::foundation::real::{eps, lit, Real};
 
 /// One agent's actuator command.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -4,15 +4,15 @@
 //!
 //! The state is the integral term itself, a force in `{I}` and a torque in `{C}`:
 //! `c_f <- c_f - dt K_Ix e_x`, `c_tau <- c_tau - dt K_IR e_R`, each updated through the
-//! anti-windup rule ([`crate::anti_windup`]) and added to the requested wrench before the
+//! anti-windup rule ([`crate::law::anti_windup`]) and added to the requested wrench before the
 //! planner and the projection. At an equilibrium of the closed loop the state is constant, so
 //! `e_x = 0` and `e_R = 0` there: a constant disturbance leaves no steady error.
 
 use nalgebra::Vector3;
 
-use crate::anti_windup::{guarded, Saturation};
-use crate::error::{positive, ConfigError, ConfigField};
-use crate::real::Real;
+use crate::foundation::error::{positive, ConfigError, ConfigField};
+use crate::foundation::real::Real;
+use crate::law::anti_windup::{guarded, Saturation};
 
 /// Integral gains `K_Ix` (N/(m s), per axis of `{I}`) and `K_IR` (N m/(rad s), per axis of
 /// `{C}`) and the bound on the integral torque (N m). Validated: each finite and positive.

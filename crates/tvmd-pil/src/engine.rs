@@ -1,19 +1,28 @@
 //! Where the core's cycle runs: [`CoreEngine`], implemented by the in-process
 //! [`CoreController`] and by the processor-in-the-loop link (module `pil`), and wrapped by the
-//! cycle recorder (module `recording`). [`super::TvmdController`] drives any of them alike.
+//! cycle recorder (module `recording`). The simulator's `TvmdController` drives any of them alike.
 
 use tvmd_core::{
-    AgentCommand, FailureMask, FaultMasking, FaultReport, HoverCapability, Reference, RigidState,
+    AgentCommand, AnyAllocator, FailureMask, FaultMasking, FaultReport, HoverCapability, Real,
+    Reference, RigidState,
 };
 
-use super::convert::CoreFloat;
-use super::{CoreController, CoreOutput, MAX_AGENTS};
-use crate::error::BoxedError;
+/// Agent capacity of the controller the simulator runs (the core's const generic `N`).
+pub const MAX_AGENTS: usize = 16;
+
+/// The core controller type the simulator runs, in `T` (f32: the type a flight controller runs).
+pub type CoreController<T> = tvmd_core::Controller<T, MAX_AGENTS, AnyAllocator<T, MAX_AGENTS>>;
+
+/// The core's output of one cycle.
+pub type CoreOutput<T> = tvmd_core::ControlOutput<T, MAX_AGENTS>;
+
+/// Boxed error of an engine (and of the simulator's flight controllers): what ends a run.
+pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// A cycle the core skipped: its message (the [`tvmd_core::CycleError`]'s) and the commands
 /// it holds.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SkippedCycle<T: CoreFloat> {
+pub struct SkippedCycle<T: Real> {
     /// `CycleError`'s message.
     pub message: String,
     /// The commands held.
@@ -29,7 +38,7 @@ pub type CycleAnswer<T> = Result<CoreOutput<T>, SkippedCycle<T>>;
 
 /// A core controller in `T`, wherever it runs. The outer `Result` is the engine's own failure
 /// (a broken link to a target), which ends the run; the inner one is the core's answer.
-pub trait CoreEngine<T: CoreFloat> {
+pub trait CoreEngine<T: Real> {
     /// [`tvmd_core::Controller::set_failures`].
     fn set_failures(
         &mut self,
@@ -51,7 +60,7 @@ pub trait CoreEngine<T: CoreFloat> {
     ) -> Result<CycleAnswer<T>, BoxedError>;
 
     /// [`tvmd_core::Controller::fault_report`] of the last cycle (`None` by default: an
-    /// engine without the detector, e.g. the processor-in-the-loop firmware).
+    /// engine without the detector).
     fn fault_report(&self) -> Option<FaultReport<T>> {
         None
     }
@@ -62,7 +71,7 @@ pub trait CoreEngine<T: CoreFloat> {
     }
 }
 
-impl<T: CoreFloat> CoreEngine<T> for CoreController<T> {
+impl<T: Real> CoreEngine<T> for CoreController<T> {
     fn set_failures(
         &mut self,
         mask: FailureMask<MAX_AGENTS>,

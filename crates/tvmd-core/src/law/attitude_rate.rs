@@ -13,10 +13,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::error::{positive, ConfigError, ConfigField};
-use crate::linalg::{clamp_norm, norm};
-use crate::real::{lit, Real};
-use crate::rotation::vee;
+use crate::foundation::error::{positive, ConfigError, ConfigField};
+use crate::foundation::linalg::{clamp_norm, norm};
+use crate::foundation::real::{lit, Real};
+use crate::foundation::rotation::vee;
 
 /// Settings of the planned-rate filter: bandwidth `w` (rad/s) and the largest rate `max_rate`
 /// (rad/s) a jump of `R_d` may stand for. Validated (each finite and positive).
@@ -160,7 +160,7 @@ pub(crate) fn log_so3<T: Real>(q: &Matrix3<T>) -> Vector3<T> {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
-    use crate::rotation::roll;
+    use crate::foundation::rotation::roll;
 
     fn exp_so3(v: Vector3<f64>) -> Matrix3<f64> {
         nalgebra::Rotation3::new(v).into_inner()

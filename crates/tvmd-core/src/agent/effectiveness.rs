@@ -4,12 +4,12 @@
 
 use nalgebra::{Matrix6, Matrix6x3, Vector3, Vector6};
 
-use crate::error::ConfigError;
-use crate::linalg::{max_diagonal, weighted_gram, GramSolver, Ldlt};
-use crate::real::{eps, lit, to_f64, Real};
+use crate::foundation::error::ConfigError;
+use crate::foundation::linalg::{max_diagonal, weighted_gram, GramSolver, Ldlt};
+use crate::foundation::real::{eps, lit, to_f64, Real};
 
-/// `R_z(m pi/2)`, at its old path (now in [`crate::rotation`]).
-pub use crate::rotation::quarter_turn;
+/// `R_z(m pi/2)`, at its old path (now in [`crate::foundation::rotation`]).
+pub use crate::foundation::rotation::quarter_turn;
 
 /// `M_i = [[p_i]x R_z(psi_i); R_z(psi_i)]`, agent `i`'s block of eq. (4), rows `[torque; force]`.
 pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix6x3<T> {

@@ -8,9 +8,9 @@
 //! the largest agent distance `||p_i||`, so one setting fits every team (a loss of one of `n`
 //! agents at hover is about `1 / (n epsilon)` noise units in force alone).
 
-use crate::error::ConfigError;
 use crate::fault::FaultDetector;
-use crate::real::{lit, Real};
+use crate::foundation::error::ConfigError;
+use crate::foundation::real::{lit, Real};
 
 /// Relative model error `epsilon` of [`FaultDetection::recommended`].
 pub const FAULT_MODEL_ERROR: f64 = 0.015;

@@ -5,10 +5,10 @@
 
 use nalgebra::Matrix3;
 
-use crate::error::ConfigError;
+use crate::foundation::error::ConfigError;
+use crate::foundation::real::{lit, Real};
+use crate::law::natural_gains::NaturalGains;
 use crate::law::Gains;
-use crate::natural_gains::NaturalGains;
-use crate::real::{lit, Real};
 
 /// How the controller turns its settings into the gains of eq. (12).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,7 +75,7 @@ impl<T: Real> GainSchedule<T> {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::error::ConfigField;
+    use crate::foundation::error::ConfigField;
     use nalgebra::Vector3;
 
     #[test]

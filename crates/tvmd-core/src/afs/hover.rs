@@ -20,12 +20,12 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::admissible::{AdmissibleSet, Interval};
-use crate::effectiveness::Effectiveness;
-use crate::gimbal::GimbalCommand;
-use crate::linalg::EuclideanNorm;
-use crate::linalg::GramSolver;
-use crate::real::{eps, lit, sqrt, Real};
+use crate::agent::admissible::{AdmissibleSet, Interval};
+use crate::agent::effectiveness::Effectiveness;
+use crate::agent::gimbal::GimbalCommand;
+use crate::foundation::linalg::EuclideanNorm;
+use crate::foundation::linalg::GramSolver;
+use crate::foundation::real::{eps, lit, sqrt, Real};
 
 /// Reweighting rounds of the certifying allocation (Lawson's iteration for the minimax slack).
 pub const HOVER_ITERATIONS: usize = 24;

@@ -3,9 +3,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
-use crate::linalg::EuclideanNorm;
-use crate::linalg::{max_abs, norm};
-use crate::real::{eps, lit, sqrt, Real};
+use crate::foundation::linalg::EuclideanNorm;
+use crate::foundation::linalg::{max_abs, norm};
+use crate::foundation::real::{eps, lit, sqrt, Real};
 
 /// The projected force and the factors of `K_f = diag(t_eta t_Tf, t_eta t_Tf, t_Tf)`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,7 @@
 //! (`embedded/target-tests`, bin `tvmd-pil`) on an emulated Cortex-M4F (QEMU `mps2-an386`) or
 //! Cortex-M7 (`mps2-an500`), while the simulator keeps the physics.
 //!
-//! [`PilCore`] is a [`CoreEngine`]`<f32>`: [`super::TvmdController`] drives it exactly as it
+//! [`PilCore`] is a [`CoreEngine`]`<f32>`: the simulator's controller adapter drives it exactly as it
 //! drives the in-process core (failure masks, landing, diagnostics). Over QEMU's first serial
 //! port (the boards' CMSDK UART0, on QEMU's stdin/stdout) the host sends the controller's
 //! configuration once ([`CoreConfig`]), then a failure mask when it changes and each period's
@@ -15,23 +15,14 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use tvmd_core::{FailureMask, Reference, RigidState};
+use tvmd_core::{FailureMask, FaultMasking, FaultReport, Reference, RigidState};
 
-use super::engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-use super::MAX_AGENTS;
-use crate::error::BoxedError;
-use crate::SimError;
+use crate::engine::{BoxedError, CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle, MAX_AGENTS};
+use crate::error::{PilError, BUILD_COMMAND, FIRMWARE_ENV};
+use crate::frame;
+use crate::link::QemuLink;
 use tvmd_wire::{self as wire, CoreConfig, Reader, Writer};
 
-pub mod frame;
-mod link;
-
-pub use link::QemuLink;
-
-/// Environment variable naming the PIL firmware ELF.
-pub const FIRMWARE_ENV: &str = "TVMD_PIL_FIRMWARE";
-/// The command that builds the PIL firmware.
-pub const BUILD_COMMAND: &str = "bash scripts/pil.sh build";
 /// Longest wait for the firmware to boot and for the configuration's answer.
 pub const START_TIMEOUT: Duration = Duration::from_secs(30);
 /// Longest wait for the answer to one request (a cycle takes well under a millisecond of
@@ -90,72 +81,6 @@ impl std::str::FromStr for PilTarget {
     }
 }
 
-/// Errors of a processor-in-the-loop flight.
-#[derive(Debug, thiserror::Error)]
-pub enum PilError {
-    /// No such target.
-    #[error("unknown PIL target `{0}` (known: cortex-m4, cortex-m7)")]
-    UnknownTarget(String),
-    /// The firmware ELF was not found.
-    #[error(
-        "PIL firmware not found (looked for {searched}); build it with `{BUILD_COMMAND}`, or \
-         set {FIRMWARE_ENV} to its ELF"
-    )]
-    FirmwareMissing {
-        /// The paths looked at.
-        searched: String,
-    },
-    /// `qemu-system-arm` is not on `PATH`.
-    #[error(
-        "`qemu-system-arm` not found on PATH: install it (Debian/Ubuntu: `sudo apt-get install \
-         qemu-system-arm`; `bash scripts/target.sh` installs it too)"
-    )]
-    QemuMissing,
-    /// Starting or talking to QEMU failed.
-    #[error("I/O error on the PIL link: {0}")]
-    Io(#[from] std::io::Error),
-    /// No complete frame arrived in time.
-    #[error("no answer in time")]
-    Timeout,
-    /// QEMU closed the link (it exited).
-    #[error("the link closed")]
-    Closed,
-    /// A frame's checksum is wrong.
-    #[error("frame checksum mismatch (received {got:#010x}, computed {want:#010x})")]
-    Checksum {
-        /// CRC-32 in the frame.
-        got: u32,
-        /// CRC-32 of the frame's bytes.
-        want: u32,
-    },
-    /// Bytes that are not the expected frame: the two sides are out of step.
-    #[error("link desynchronised: {0}")]
-    Desync(String),
-    /// The target refused a request (malformed, out of order, or a configuration it cannot
-    /// build).
-    #[error("the target reported: {0}")]
-    Target(String),
-    /// A link error, with what the host was doing and QEMU's state.
-    #[error("{target}: {during}: {source} ({qemu})")]
-    Link {
-        /// The target's label.
-        target: String,
-        /// What the host waited for.
-        during: String,
-        /// The error.
-        #[source]
-        source: Box<PilError>,
-        /// QEMU's status and stderr.
-        qemu: String,
-    },
-}
-
-impl From<PilError> for SimError {
-    fn from(e: PilError) -> Self {
-        SimError::Pil(Box::new(e))
-    }
-}
-
 /// Where the PIL firmware is looked for: [`FIRMWARE_ENV`] if set (and then only there), else
 /// `$CARGO_TARGET_DIR` and the standard build directories of `embedded/target-tests` in this
 /// repository.
@@ -205,6 +130,8 @@ pub struct PilCore {
     target: PilTarget,
     n: usize,
     failures: FailureMask<MAX_AGENTS>,
+    /// The detector's report and masking of the last cycle, as the target answered them.
+    fault: Option<wire::FaultAnswer>,
     seq: u16,
 }
 
@@ -218,6 +145,7 @@ impl PilCore {
             target,
             n: config.n,
             failures: FailureMask::none(),
+            fault: None,
             seq: 0,
         };
         let ready = core.receive("the firmware's boot frame", START_TIMEOUT)?;
@@ -349,21 +277,45 @@ impl CoreEngine<f32> for PilCore {
         let mut r = Reader::new(&words);
         match reply.kind {
             wire::KIND_OUTPUT => {
-                let out = wire::get_output(&mut r, self.n)
-                    .filter(|_| r.remaining() == 0)
-                    .ok_or_else(|| PilError::Desync("malformed cycle output".into()))?;
+                let out = wire::get_output(&mut r, self.n);
+                let fault = wire::get_fault_answer(&mut r).filter(|_| r.remaining() == 0);
+                let (Some(out), Some(fault)) = (out, fault) else {
+                    return Err(PilError::Desync("malformed cycle output".into()).into());
+                };
+                self.answered(fault);
                 Ok(Ok(out))
             }
             wire::KIND_SKIPPED => {
-                let commands = wire::get_commands(&mut r, self.n)
-                    .ok_or_else(|| PilError::Desync("malformed skipped cycle".into()))?;
+                let commands = wire::get_commands(&mut r, self.n);
+                let fault = wire::get_fault_answer(&mut r);
+                let (Some(commands), Some(fault)) = (commands, fault) else {
+                    return Err(PilError::Desync("malformed skipped cycle".into()).into());
+                };
+                self.answered(fault);
                 Ok(Err(SkippedCycle {
-                    message: reply.text(4 * self.n),
+                    message: reply.text(4 * self.n + wire::FAULT_ANSWER_WORDS),
                     commands,
                 }))
             }
             k => Err(self.unexpected("a cycle's answer", k).into()),
         }
+    }
+
+    fn fault_report(&self) -> Option<FaultReport<f32>> {
+        self.fault.and_then(|f| f.report)
+    }
+
+    fn fault_masking(&self) -> Option<FaultMasking<f32>> {
+        self.fault.and_then(|f| f.masking)
+    }
+}
+
+impl PilCore {
+    /// A cycle's fault answer: the detector's report and masking, and the mask in force (which
+    /// the detector may have set on the target).
+    fn answered(&mut self, fault: wire::FaultAnswer) {
+        self.failures = fault.failures;
+        self.fault = Some(fault);
     }
 }
 

@@ -1,6 +1,6 @@
 //! Which agents of a team have failed.
 
-use crate::error::ConfigError;
+use crate::foundation::error::ConfigError;
 
 /// Which agents have failed. A failed agent leaves `n`, `n_x` / `n_y` and `M` (paper's degraded
 /// team); it is commanded to zero thrust.

@@ -5,8 +5,8 @@
 
 use nalgebra::Vector3;
 
-use crate::linalg::clamp_norm;
-use crate::real::{sqrt, Real};
+use crate::foundation::linalg::clamp_norm;
+use crate::foundation::real::{sqrt, Real};
 
 /// Which parts of the requested wrench the team could not deliver in one period.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

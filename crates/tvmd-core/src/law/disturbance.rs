@@ -19,11 +19,11 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use crate::anti_windup::{guarded, Saturation};
-use crate::error::{positive, ConfigError, ConfigField};
+use crate::foundation::error::{positive, ConfigError, ConfigField};
+use crate::foundation::linalg::wrench_parts;
+use crate::foundation::real::Real;
+use crate::law::anti_windup::{guarded, Saturation};
 use crate::law::{Plant, RigidState};
-use crate::linalg::wrench_parts;
-use crate::real::Real;
 
 /// Observer bandwidths `L_f`, `L_tau` (rad/s) and the bound on the torque estimate (N m).
 /// Validated: each finite and positive.

@@ -1,8 +1,8 @@
 //! Limits of one agent: gimbal limits and thrust range (eq. 6), the rotor model (eq. 5), gimbal
 //! rate limits, and the intervals admissible sets are made of.
 
-use crate::error::{ConfigError, ConfigField, GimbalAxis};
-use crate::real::{fmax, fmin, sqrt, Real};
+use crate::foundation::error::{ConfigError, ConfigField, GimbalAxis};
+use crate::foundation::real::{fmax, fmin, sqrt, Real};
 
 /// Limits shared by every agent: gimbal limits (eq. 6), thrust range and the rotor model
 /// `T = rho d^4 c_l omega^2` (eq. 5).
@@ -90,7 +90,7 @@ impl<T: Real> AgentLimits<T> {
             if value <= T::zero() {
                 return Err(ConfigError::NonPositiveThrust {
                     field,
-                    value: crate::real::to_f64(value),
+                    value: crate::foundation::real::to_f64(value),
                 });
             }
         }
@@ -148,7 +148,7 @@ impl<T: Real> AgentLimits<T> {
             if value <= T::zero() || value > half_pi {
                 return Err(ConfigError::GimbalLimit {
                     axis,
-                    value: crate::real::to_f64(value),
+                    value: crate::foundation::real::to_f64(value),
                 });
             }
         }
@@ -168,13 +168,13 @@ impl<T: Real> AgentLimits<T> {
             if value <= T::zero() {
                 return Err(ConfigError::NonPositiveThrust {
                     field,
-                    value: crate::real::to_f64(value),
+                    value: crate::foundation::real::to_f64(value),
                 });
             }
         }
         if self.min_thrust < T::zero() || self.min_thrust >= self.max_thrust {
             return Err(ConfigError::IdleThrust {
-                value: crate::real::to_f64(self.min_thrust),
+                value: crate::foundation::real::to_f64(self.min_thrust),
             });
         }
         Ok(())

@@ -9,8 +9,8 @@ use std::sync::mpsc::channel;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use super::frame::{self, ByteSource, ChannelSource, Frame};
-use super::PilError;
+use crate::error::PilError;
+use crate::frame::{self, ByteSource, ChannelSource, Frame};
 
 /// The emulator binary.
 pub const QEMU: &str = "qemu-system-arm";
