@@ -33,10 +33,11 @@ type Field = dyn Fn(&TeamStep) -> [f64; 3];
 /// A `(3, 3)` value of a team's step.
 type Matrix = dyn Fn(&TeamStep) -> nalgebra::Matrix3<f64>;
 
-/// The `(B, ...)` arrays of every team's step (NaN for a team whose step failed).
+/// The `(B, ...)` arrays of every team's step of `n` agents (NaN for a team whose step failed).
 fn arrays<'py>(
     py: Python<'py>,
     steps: &[Result<TeamStep, SimError>],
+    n: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let b = steps.len();
     let nan3 = [f64::NAN; 3];
@@ -79,13 +80,8 @@ fn arrays<'py>(
             .collect();
         out.set_item(name, shaped(py, values, &[b, 3, 3])?)?;
     }
-    // (B, n, 3): what the plant clamped off each team's last commands (NaN for a failed team).
-    let n = steps
-        .iter()
-        .flatten()
-        .map(|s| s.saturation.len())
-        .max()
-        .unwrap_or(0);
+    // (B, n, 3): what the plant clamped off each team's last commands (NaN for a failed team,
+    // so the shape holds when every team failed).
     let saturation: Vec<f64> = (0..b)
         .flat_map(|k| {
             let clamped = ok(k).map(|s| s.saturation.as_slice()).unwrap_or_default();
@@ -125,7 +121,7 @@ impl PySimulationBatch {
         let steps = py
             .detach(|| batch.step(action, active.as_deref()))
             .map_err(value_error)?;
-        arrays(py, &steps)
+        arrays(py, &steps, self.n)
     }
 }
 

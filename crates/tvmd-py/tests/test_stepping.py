@@ -220,3 +220,13 @@ def test_a_nan_in_one_teams_action_fails_only_that_team():
     assert out["errors"][0] is None and out["errors"][1] is None
     assert out["errors"][2] is not None and "non-finite" in out["errors"][2]
     assert np.isfinite(out["position"][[0, 1]]).all()
+
+
+def test_a_batch_whose_every_team_failed_keeps_its_shapes():
+    # Issues 57 and 58 together: every array keeps (B, n, ...) when no team stepped.
+    batch = sim.SimulationBatch("hover", count=2, jobs=1)
+    batch.reset()
+    out = batch.step(np.full((2, batch.n_agents, 3), np.nan))
+    assert all(e is not None for e in out["errors"])
+    assert out["saturation"].shape == (2, batch.n_agents, 3)
+    assert np.isnan(out["saturation"]).all() and out["position"].shape == (2, 3)
