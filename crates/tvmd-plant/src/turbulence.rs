@@ -85,6 +85,29 @@ pub struct DrydenParameters {
     pub length_vertical: f64,
 }
 
+impl DrydenParameters {
+    /// The spectrum, intensity and scale length of axis `axis` (0 `u`, 1 `v`, else `w`).
+    fn axis(&self, axis: usize) -> (Spectrum, f64, f64) {
+        match axis {
+            0 => (
+                Spectrum::FirstOrder,
+                self.sigma_horizontal,
+                self.length_horizontal,
+            ),
+            1 => (
+                Spectrum::SecondOrder,
+                self.sigma_horizontal,
+                self.length_horizontal,
+            ),
+            _ => (
+                Spectrum::SecondOrder,
+                self.sigma_vertical,
+                self.length_vertical,
+            ),
+        }
+    }
+}
+
 impl Turbulence {
     /// The standard's turbulence with `W20 = wind_speed_20ft` at `altitude` (m), seed 0.
     pub fn standard(wind_speed_20ft: f64, altitude: f64) -> Self {
@@ -129,30 +152,7 @@ impl Turbulence {
         } else {
             (1.0, 0.0)
         };
-        let u = self.component(
-            t,
-            0,
-            Spectrum::FirstOrder,
-            p.sigma_horizontal,
-            p.length_horizontal,
-            speed,
-        );
-        let v = self.component(
-            t,
-            1,
-            Spectrum::SecondOrder,
-            p.sigma_horizontal,
-            p.length_horizontal,
-            speed,
-        );
-        let w = self.component(
-            t,
-            2,
-            Spectrum::SecondOrder,
-            p.sigma_vertical,
-            p.length_vertical,
-            speed,
-        );
+        let [u, v, w] = [0, 1, 2].map(|axis| self.component(t, axis, &p, speed));
         [cu * u - su * v, su * u + cu * v, w]
     }
 
@@ -160,36 +160,18 @@ impl Turbulence {
     /// tests and the docs: a few percent under `sigma^2` (the tails outside the grid).
     pub fn realized_variance(&self, axis: usize, speed: f64) -> f64 {
         let p = self.parameters();
-        let (spectrum, sigma, length) = match axis {
-            0 => (
-                Spectrum::FirstOrder,
-                p.sigma_horizontal,
-                p.length_horizontal,
-            ),
-            1 => (
-                Spectrum::SecondOrder,
-                p.sigma_horizontal,
-                p.length_horizontal,
-            ),
-            _ => (Spectrum::SecondOrder, p.sigma_vertical, p.length_vertical),
-        };
+        let (spectrum, sigma, length) = p.axis(axis);
         terms(spectrum, sigma, length, speed.max(MIN_SPEED))
             .map(|(_, a)| 0.5 * a * a)
             .sum()
     }
 
-    fn component(
-        &self,
-        t: f64,
-        axis: u64,
-        spectrum: Spectrum,
-        sigma: f64,
-        length: f64,
-        speed: f64,
-    ) -> f64 {
+    /// Axis `axis` (0 `u`, 1 `v`, 2 `w`) of the realization at `t`.
+    fn component(&self, t: f64, axis: usize, p: &DrydenParameters, speed: f64) -> f64 {
+        let (spectrum, sigma, length) = p.axis(axis);
         terms(spectrum, sigma, length, speed)
             .enumerate()
-            .map(|(k, (omega, a))| a * (omega * t + phase(self.seed, axis, k as u64)).cos())
+            .map(|(k, (omega, a))| a * (omega * t + phase(self.seed, axis as u64, k as u64)).cos())
             .sum()
     }
 }
@@ -211,11 +193,15 @@ fn terms(
     speed: f64,
 ) -> impl Iterator<Item = (f64, f64)> {
     let corner = speed / length;
-    let (lo, hi) = ((corner * 1e-2).ln(), (corner * 1e2).ln());
-    let step = (hi - lo) / TERMS as f64;
-    (0..TERMS).map(move |k| {
-        let omega = (lo + (k as f64 + 0.5) * step).exp();
-        let cell = (lo + (k as f64 + 1.0) * step).exp() - (lo + k as f64 * step).exp();
+    // Cells of one ratio `r` from `corner / 100` to `100 corner`, each sampled at its geometric
+    // middle: the edges by multiplication, not one exponential each.
+    let ratio = (4.0 * std::f64::consts::LN_10 / TERMS as f64).exp();
+    let middle = ratio.sqrt();
+    let mut edge = corner * 1e-2;
+    (0..TERMS).map(move |_| {
+        let omega = edge * middle;
+        let cell = edge * (ratio - 1.0);
+        edge *= ratio;
         let x2 = (omega / corner).powi(2);
         let shape = match spectrum {
             Spectrum::FirstOrder => 2.0 / (1.0 + x2),
