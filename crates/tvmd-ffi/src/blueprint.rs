@@ -11,7 +11,8 @@ use tvmd_core::allocation::{
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 use tvmd_core::{
-    AgentSpec, ConfigError, ControllerSettings, Navigator, RateLimits, Relaxation, TeamConfig,
+    AgentSpec, ConfigError, ControllerSettings, GainSchedule, Navigator, RateLimits, Relaxation,
+    TeamConfig,
 };
 
 use crate::status::*;
@@ -99,19 +100,20 @@ unsafe fn settings(
     } else {
         None
     };
-    let law = config.law.to_core()?;
-    at.write(ControllerSettings {
+    let mut settings = ControllerSettings {
         gains: config.gains.to_core()?,
         relaxation: Relaxation::new(config.relaxation)?,
         gravity: config.gravity,
         period: config.period,
         rate_limits,
         null_space: None,
-        gain_schedule: law.gain_schedule,
-        offset_free: law.offset_free,
-        attitude_rate: law.attitude_rate,
+        gain_schedule: GainSchedule::AsGiven,
+        offset_free: None,
+        attitude_rate: None,
         fault_detection: config.fault.to_core()?,
-    });
+    };
+    config.law.apply(&mut settings)?;
+    at.write(settings);
     Ok(())
 }
 

@@ -2,15 +2,27 @@
 //! [`crate::types::TvmdConfig`]) and its conversion to the core's settings: the gain schedule,
 //! the offset-free action and the planned-rate filter (`docs/method.md`, "Beyond the paper").
 //!
+//! `TvmdLaw` is the C ABI's named-field layout of [`LawWords`], the one flat encoding of the
+//! law (crate `tvmd-wire`, also carried by the PIL link and the cycle recordings): both ways
+//! go through it, and only the C check of the mode words is this module's.
+//!
 //! A zero-initialized `TvmdLaw` is the paper's law (gains as given, no offset-free action, the
 //! reference's rates). `tvmd_config_default` fills the offset-free law, the library's default.
 
-use tvmd_core::{
-    AttitudeRateFilter, ControllerSettings, DisturbanceObserver, GainSchedule, IntegralAction,
-    NaturalGains, OffsetFree,
-};
+use tvmd_core::ControllerSettings;
+use tvmd_wire::LawWords;
 
 use crate::status::ConvertError;
+
+// The C constants are literals (cbindgen writes them to the header) and the words' own.
+const _: () = assert!(
+    TVMD_GAINS_AS_GIVEN == tvmd_wire::GAINS_AS_GIVEN
+        && TVMD_GAINS_TEAM_SCALED == tvmd_wire::GAINS_TEAM_SCALED
+        && TVMD_GAINS_NATURAL == tvmd_wire::GAINS_NATURAL
+        && TVMD_OFFSET_FREE_OFF == tvmd_wire::OFFSET_FREE_OFF
+        && TVMD_OFFSET_FREE_OBSERVER == tvmd_wire::OFFSET_FREE_OBSERVER
+        && TVMD_OFFSET_FREE_INTEGRAL == tvmd_wire::OFFSET_FREE_INTEGRAL
+);
 
 /// `law.gain_schedule`: the gains `config.gains` as given (the paper's reading of eq. 12).
 pub const TVMD_GAINS_AS_GIVEN: u32 = 0;
@@ -77,91 +89,74 @@ pub struct TvmdLaw {
     pub attitude_rate_max: f32,
 }
 
-/// The core's settings a [`TvmdLaw`] describes.
-pub(crate) struct Law {
-    pub(crate) gain_schedule: GainSchedule<f32>,
-    pub(crate) offset_free: Option<OffsetFree<f32>>,
-    pub(crate) attitude_rate: Option<AttitudeRateFilter<f32>>,
-}
-
 impl TvmdLaw {
-    /// The core's settings; every value a mode uses is validated by the core's constructor.
-    pub(crate) fn to_core(self) -> Result<Law, ConvertError> {
-        let gain_schedule = match self.gain_schedule {
-            TVMD_GAINS_AS_GIVEN => GainSchedule::AsGiven,
-            TVMD_GAINS_TEAM_SCALED => GainSchedule::TeamScaled,
-            TVMD_GAINS_NATURAL => GainSchedule::Natural(NaturalGains::new(
-                self.position_frequency,
-                self.position_damping,
-                self.attitude_frequency,
-                self.attitude_damping,
-            )?),
-            _ => return Err(ConvertError::EnumValue),
-        };
-        let offset_free = match self.offset_free {
-            TVMD_OFFSET_FREE_OFF => None,
-            TVMD_OFFSET_FREE_OBSERVER => Some(OffsetFree::Observer(DisturbanceObserver::new(
-                self.force_bandwidth,
-                self.torque_bandwidth,
-                self.max_torque,
-            )?)),
-            TVMD_OFFSET_FREE_INTEGRAL => Some(OffsetFree::Integral(IntegralAction::new(
-                self.integral_k_x,
-                self.integral_k_r,
-                self.max_torque,
-            )?)),
-            _ => return Err(ConvertError::EnumValue),
-        };
-        let attitude_rate = if self.attitude_rate != 0 {
-            Some(AttitudeRateFilter::new(
-                self.attitude_rate_bandwidth,
-                self.attitude_rate_max,
-            )?)
-        } else {
-            None
-        };
-        Ok(Law {
-            gain_schedule,
-            offset_free,
-            attitude_rate,
+    /// The law as [`LawWords`], the one flat encoding of the law's settings (the PIL link and
+    /// the cycle recordings carry it too), after the check only C needs: a mode word outside
+    /// its constants is [`ConvertError::EnumValue`] (`TVMD_ERR_ENUM_VALUE`).
+    fn words(&self) -> Result<LawWords, ConvertError> {
+        if self.gain_schedule > TVMD_GAINS_NATURAL || self.offset_free > TVMD_OFFSET_FREE_INTEGRAL {
+            return Err(ConvertError::EnumValue);
+        }
+        // Element by element: the link check proves this path panic-free.
+        let [a, b, c, d] = [
+            self.position_frequency,
+            self.position_damping,
+            self.attitude_frequency,
+            self.attitude_damping,
+        ];
+        let natural = [
+            a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2],
+        ];
+        let (x, r) = (self.integral_k_x, self.integral_k_r);
+        let values = [
+            self.force_bandwidth,
+            self.torque_bandwidth,
+            x[0],
+            x[1],
+            x[2],
+            r[0],
+            r[1],
+            r[2],
+            self.max_torque,
+        ];
+        Ok(LawWords {
+            gain_schedule: self.gain_schedule,
+            natural,
+            offset_free: self.offset_free,
+            offset_free_values: values,
+            attitude_rate: (self.attitude_rate != 0)
+                .then_some([self.attitude_rate_bandwidth, self.attitude_rate_max]),
         })
+    }
+
+    /// Sets the gain schedule, offset-free action and planned rates of `settings` to this law;
+    /// every value a mode uses is validated by the core's constructor ([`LawWords::apply`]).
+    pub(crate) fn apply(&self, settings: &mut ControllerSettings<f32>) -> Result<(), ConvertError> {
+        Ok(self.words()?.apply(settings)?)
     }
 
     /// The law of `settings` (the numbers of a mode that is off stay zero).
     pub(crate) fn from_core(settings: &ControllerSettings<f32>) -> Self {
-        let mut law = Self::default();
-        law.gain_schedule = match &settings.gain_schedule {
-            GainSchedule::AsGiven => TVMD_GAINS_AS_GIVEN,
-            GainSchedule::TeamScaled => TVMD_GAINS_TEAM_SCALED,
-            GainSchedule::Natural(natural) => {
-                law.position_frequency = natural.position_frequency().into();
-                law.position_damping = natural.position_damping().into();
-                law.attitude_frequency = natural.attitude_frequency().into();
-                law.attitude_damping = natural.attitude_damping().into();
-                TVMD_GAINS_NATURAL
-            }
-        };
-        law.offset_free = match &settings.offset_free {
-            None => TVMD_OFFSET_FREE_OFF,
-            Some(OffsetFree::Observer(o)) => {
-                law.force_bandwidth = o.force_bandwidth();
-                law.torque_bandwidth = o.torque_bandwidth();
-                law.max_torque = o.max_torque();
-                TVMD_OFFSET_FREE_OBSERVER
-            }
-            Some(OffsetFree::Integral(i)) => {
-                law.integral_k_x = i.k_x().into();
-                law.integral_k_r = i.k_r().into();
-                law.max_torque = i.max_torque();
-                TVMD_OFFSET_FREE_INTEGRAL
-            }
-        };
-        if let Some(filter) = &settings.attitude_rate {
-            law.attitude_rate = 1;
-            law.attitude_rate_bandwidth = filter.bandwidth();
-            law.attitude_rate_max = filter.max_rate();
+        let w = LawWords::of(settings);
+        let [p0, p1, p2, q0, q1, q2, a0, a1, a2, b0, b1, b2] = w.natural;
+        let [f, t, x0, x1, x2, r0, r1, r2, max_torque] = w.offset_free_values;
+        let [attitude_rate_bandwidth, attitude_rate_max] = w.attitude_rate.unwrap_or_default();
+        Self {
+            gain_schedule: w.gain_schedule,
+            position_frequency: [p0, p1, p2],
+            position_damping: [q0, q1, q2],
+            attitude_frequency: [a0, a1, a2],
+            attitude_damping: [b0, b1, b2],
+            offset_free: w.offset_free,
+            force_bandwidth: f,
+            torque_bandwidth: t,
+            integral_k_x: [x0, x1, x2],
+            integral_k_r: [r0, r1, r2],
+            max_torque,
+            attitude_rate: u32::from(w.attitude_rate.is_some()),
+            attitude_rate_bandwidth,
+            attitude_rate_max,
         }
-        law
     }
 
     /// The paper's law (every mode off) carrying the numbers of the library's default law, so
@@ -182,8 +177,16 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::panic)]
     use super::*;
 
+    use tvmd_core::{GainSchedule, OffsetFree};
+
+    /// The core's settings of `law` (on the paper's), or its error.
+    fn to_core(law: &TvmdLaw) -> Result<ControllerSettings<f32>, ConvertError> {
+        let mut settings = ControllerSettings::paper();
+        law.apply(&mut settings).map(|()| settings)
+    }
+
     fn status(law: &TvmdLaw) -> crate::status::TvmdStatus {
-        match law.to_core() {
+        match to_core(law) {
             Ok(_) => crate::status::TVMD_OK,
             Err(e) => e.status(),
         }
@@ -192,13 +195,13 @@ mod tests {
     #[test]
     fn the_default_round_trips_and_zeros_are_the_paper() {
         let default = ControllerSettings::<f32>::offset_free_law();
-        let law = TvmdLaw::from_core(&default).to_core().unwrap();
+        let law = to_core(&TvmdLaw::from_core(&default)).unwrap();
         assert_eq!(law.gain_schedule, default.gain_schedule);
         assert_eq!(law.offset_free, default.offset_free);
         assert_eq!(law.attitude_rate, default.attitude_rate);
         let paper = ControllerSettings::<f32>::paper();
         for zero_or_paper in [TvmdLaw::default(), TvmdLaw::paper()] {
-            let law = zero_or_paper.to_core().unwrap();
+            let law = to_core(&zero_or_paper).unwrap();
             assert_eq!(law.gain_schedule, paper.gain_schedule);
             assert_eq!((law.offset_free, law.attitude_rate), (None, None));
         }
@@ -214,7 +217,7 @@ mod tests {
         law.force_bandwidth = f32::NAN; // the observer's, unused here
         law.gain_schedule = TVMD_GAINS_TEAM_SCALED;
         law.position_frequency = [-1.0; 3]; // the natural gains', unused here
-        let core = law.to_core().unwrap();
+        let core = to_core(&law).unwrap();
         let Some(OffsetFree::Integral(i)) = core.offset_free else {
             panic!("integral expected");
         };

@@ -16,7 +16,8 @@
 //! | `/tf` | `foxglove.FrameTransform` | pose of frame `team` in frame `world` |
 //! | `/scene` | `foxglove.SceneUpdate` | one entity per agent (cube at `p_i`, thrust arrow) |
 //!
-//! The `tvmd.*` messages are declared in [`proto`]; the `foxglove.*` ones are the SDK's.
+//! The `tvmd.*` messages are declared in [`proto`], the values a controller reports for them in
+//! [`diagnostics`]; the `foxglove.*` ones are the SDK's.
 //! The scenario's `[log]` table (`tvmd_scenario::LogSettings`) thins the heavy topics. A metadata record
 //! [`METADATA_SCENARIO`] may hold the scenario of the run, [`METADATA_RESULT`] its summary; [`read`]
 //! reads a log back.
@@ -34,6 +35,7 @@
 
 mod channels;
 mod convert;
+pub mod diagnostics;
 mod error;
 mod kind;
 pub mod live;

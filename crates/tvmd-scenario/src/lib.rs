@@ -81,6 +81,8 @@ mod builtin;
 mod certified;
 mod checks;
 mod controller;
+pub mod core_config;
+pub mod core_float;
 mod disturbances;
 mod error;
 mod experiment;

@@ -244,7 +244,7 @@ impl Scenario {
     }
 
     /// The scenario named by a command-line or Python argument: a TOML file if `name_or_path`
-    /// ends in `.toml` or names an existing file, else a built-in (see [`BUILTIN_NAMES`]).
+    /// ends in `.toml` or names an existing file, else a built-in (see [`crate::BUILTIN_NAMES`]).
     /// Errors: [`ScenarioError::File`] for a file that cannot be read, [`ScenarioError::ScenarioParse`] /
     /// [`ScenarioError::InvalidScenario`] naming the field, [`ScenarioError::UnknownScenario`].
     pub fn load(name_or_path: &str) -> Result<Self, ScenarioError> {

@@ -6,7 +6,8 @@
 //! Modules, in import order (a module uses only modules above it):
 //! - [`error`] ([`SimError`], [`BoxedError`]) and [`pool`] (a scoped worker pool, results in
 //!   input order);
-//! - [`diagnostics`]: what a controller reports per period (the diagnostics schema);
+//! - [`diagnostics`]: what a controller reports per period (the diagnostics schema, crate
+//!   `tvmd-log`'s, re-exported);
 //! - [`flight`]: the controller interface [`FlightController`];
 //! - [`control`]: the tvmd controller ([`tvmd_core::Controller`]) as a flight controller, in
 //!   f64 or f32, in process or on a processor in the loop (the engines, the PIL link and the
@@ -30,7 +31,6 @@
 #![warn(missing_docs)]
 
 pub mod control;
-pub mod diagnostics;
 pub mod error;
 pub mod flight;
 pub mod load;
@@ -44,7 +44,6 @@ pub mod tick_log;
 pub use control::pil::{self, PilError, PilTarget};
 pub use control::recording::{self, CycleRecording};
 pub use control::{AnyTvmdController, TvmdController, WrenchAllocation, MAX_AGENTS};
-pub use diagnostics::Diagnostics;
 pub use error::{BoxedError, SimError};
 pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use load::{load_run, LoadedRun};
@@ -56,4 +55,5 @@ pub use sim::{
 };
 pub use sink::{LoggedTick, SceneRecord, Tick, TickSink};
 pub use tick_log::McapSink;
+pub use tvmd_log::diagnostics::{self, Diagnostics};
 pub use tvmd_plant::GRAVITY;

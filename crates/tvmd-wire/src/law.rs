@@ -60,15 +60,15 @@ impl LawWords {
             GainSchedule::TeamScaled => law.gain_schedule = GAINS_TEAM_SCALED,
             GainSchedule::Natural(n) => {
                 law.gain_schedule = GAINS_NATURAL;
-                let parts = [
+                // Element by element: the C interface reaches this, and its link proves no
+                // panic path (no slice lengths to check).
+                let [a, b, c, d] = [
                     n.position_frequency(),
                     n.position_damping(),
                     n.attitude_frequency(),
                     n.attitude_damping(),
                 ];
-                for (slot, v) in law.natural.chunks_mut(3).zip(parts) {
-                    slot.copy_from_slice(v.as_slice());
-                }
+                law.natural = [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z];
             }
         }
         match &settings.offset_free {
@@ -81,9 +81,8 @@ impl LawWords {
             }
             Some(OffsetFree::Integral(i)) => {
                 law.offset_free = OFFSET_FREE_INTEGRAL;
-                law.offset_free_values[2..5].copy_from_slice(i.k_x().as_slice());
-                law.offset_free_values[5..8].copy_from_slice(i.k_r().as_slice());
-                law.offset_free_values[8] = i.max_torque();
+                let (x, r) = (i.k_x(), i.k_r());
+                law.offset_free_values = [0.0, 0.0, x.x, x.y, x.z, r.x, r.y, r.z, i.max_torque()];
             }
         }
         law.attitude_rate = settings

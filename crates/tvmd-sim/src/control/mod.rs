@@ -48,7 +48,7 @@ pub use tvmd_pil::{engine, recording};
 pub use tvmd_pil::{CoreController, CoreOutput, MAX_AGENTS};
 
 pub use engine::{CoreEngine, CycleAnswer, FailureAnswer, SkippedCycle};
-pub use landing::{Landing, Touchdown, LANDED_HEIGHT};
+pub use landing::{Landing, Touchdown, LANDED_HEIGHT, TOUCHDOWN_HEIGHT};
 pub use wrench::WrenchAllocation;
 
 pub use config::{
@@ -63,9 +63,10 @@ pub use diagnostics::fault_diagnostics;
 pub fn core_of_scenario<T: CoreFloat>(
     scenario: &Scenario,
 ) -> Result<(CoreController<T>, usize), SimError> {
-    let team = config::team_config::<T>(scenario)?;
+    let team = config::team_config::<T, MAX_AGENTS>(scenario)?;
     let settings = config::controller_settings::<T>(scenario)?;
-    let alloc = config::allocator::<T>(&scenario.allocator, scenario.allocator_max_rounds)?;
+    let alloc =
+        config::allocator::<T, MAX_AGENTS>(&scenario.allocator, scenario.allocator_max_rounds)?;
     let n = team.len();
     let inner = CoreController::new(team, settings, alloc).map_err(config::config_error)?;
     Ok((inner, n))

@@ -1,7 +1,7 @@
-//! The diagnostics schema: what a controller may report at each tick, recorded in the samples
-//! and logged on `/planner`, `/control`, `/allocation`, `/lyapunov` and `/fault` (see the module
-//! `log`).
-//! The field names are the MCAP messages' and stay stable.
+//! The diagnostics schema: what a flight controller may report at each tick, recorded in the
+//! simulator's samples and logged on `/planner`, `/control`, `/allocation`, `/lyapunov`,
+//! `/hover` and `/fault` (messages of [`crate::proto`]). The field names are the MCAP messages'
+//! and stay stable; tvmd-sim re-exports the module as `tvmd_sim::diagnostics`.
 
 use serde::{Deserialize, Serialize};
 
