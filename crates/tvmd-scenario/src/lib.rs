@@ -101,7 +101,7 @@ mod team;
 mod validate;
 
 pub use air::{Air, Gust, DRAG_AREA_PER_AGENT};
-pub use builtin::BUILTIN_NAMES;
+pub use builtin::{BUILTIN_NAMES, RELAXATION_LANDING_SPOT};
 pub use controller::{GainsConfig, Precision, ALLOCATOR_NAMES};
 pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise, MAX_FEEDBACK_LATENCY};
 pub use error::ScenarioError;
