@@ -61,7 +61,8 @@ fn bench_team<const N: usize>(c: &mut Criterion, t: &TeamRequests) {
         });
     }
     group.finish();
-    // The default allocator's costliest request of the team.
+    // The default allocator's costliest request of the team (its walk capped at
+    // DEFAULT_MAX_ROUNDS).
     let costliest = wrenches
         .iter()
         .map(|w| {

@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use tvmd::core::nalgebra::Vector3;
 use tvmd::core::team::presets;
+use tvmd::core::RoundCap;
 use tvmd::core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, ClarabelAllocator,
     ExactBoundaryRedistribution, FailureMask, GimbalCommand, RedistributedPseudoInverse,
@@ -95,7 +96,9 @@ fn main() {
             let others = [
                 qp.allocate(&request),
                 RedistributedPseudoInverse.allocate(&request),
-                ExactBoundaryRedistribution::new().allocate(&request),
+                ExactBoundaryRedistribution::new()
+                    .with_round_cap(RoundCap::Uncapped)
+                    .allocate(&request),
             ];
             let norm = wrench.norm();
             counts[0] += usize::from(exact(&a, norm));

@@ -230,6 +230,30 @@
 #define TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION 3
 
 /*
+ `allocator_round_cap`: the library's default cap of the exact-boundary redistribution's
+ walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (and, with any other allocator, no cap
+ to give: the only value they take).
+ */
+#define TVMD_ROUND_CAP_DEFAULT 0
+
+/*
+ `allocator_round_cap`: exactly `allocator_max_rounds` walk rounds per period (`0`: the
+ walk's start alone, the redistributed pseudo-inverse or the previous forces).
+ */
+#define TVMD_ROUND_CAP_ROUNDS 1
+
+/*
+ `allocator_round_cap`: no cap beyond the walk's own `2 n + 4` rounds (research: about
+ 275,000 Cortex-M4F instructions for the worst n = 4 allocation).
+ */
+#define TVMD_ROUND_CAP_UNCAPPED 2
+
+/*
+ Walk rounds of `TVMD_ROUND_CAP_DEFAULT` (the core's `DEFAULT_MAX_ROUNDS`).
+ */
+#define TVMD_DEFAULT_MAX_ROUNDS 2
+
+/*
  `planner_status`: `R_r^T f_r` already in the AFS, `R_d = R_r`.
  */
 #define TVMD_PLANNER_ALREADY_FEASIBLE 0
@@ -625,10 +649,15 @@ typedef struct TvmdConfig {
    */
   float agent_weights[TVMD_MAX_AGENTS];
   /*
-   Non-zero: cap the exact-boundary redistribution's walk at this many rounds per period
-   (a bound on its work: the best admissible forces found so far, with their true `e_f`);
-   zero: no cap (the walk's own `2 n + 4`). With another allocator a non-zero value is
-   refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`).
+   One of `TVMD_ROUND_CAP_*`: how the exact-boundary redistribution's walk is capped per
+   period (a bound on its work: the best admissible forces found so far, with their true
+   `e_f`). Zero is the library's default cap; with another allocator anything else is
+   refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`); an unknown value is `TVMD_ERR_ENUM_VALUE`.
+   */
+  uint32_t allocator_round_cap;
+  /*
+   Walk rounds per period with `TVMD_ROUND_CAP_ROUNDS` (any number, `0` included);
+   ignored otherwise.
    */
   uint32_t allocator_max_rounds;
   /*
@@ -1276,7 +1305,8 @@ TvmdStatus tvmd_actuator_commands(const struct TvmdController *handle,
  `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
  damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
  (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
- (20 rad/s, 5 rad/s bound). This law holds its setpoint under model error and unmodelled
+ (20 rad/s, 5 rad/s bound), with the exact-boundary redistribution's walk capped at
+ `TVMD_DEFAULT_MAX_ROUNDS` rounds per period (`TVMD_ROUND_CAP_DEFAULT`). This law holds its setpoint under model error and unmodelled
  forces, where the paper's law leaves a steady error. The caller sets `config->size` first.
 
  # Safety
@@ -1289,7 +1319,8 @@ TvmdStatus tvmd_config_default(struct TvmdConfig *config);
  square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
  `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
  no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
- and Python interfaces) and the paper's law: gains as given, no offset-free action, the
+ and Python interfaces, its walk capped at `TVMD_DEFAULT_MAX_ROUNDS` rounds) and the paper's
+ law: gains as given, no offset-free action, the
  reference's rates (every `law` mode off; its numbers are those of `tvmd_config_default`, so
  switching one mode on starts from the library's values). The caller sets `config->size`
  first.

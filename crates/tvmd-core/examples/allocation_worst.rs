@@ -12,6 +12,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use allocation_set::{teams, SetTeam};
+use tvmd_core::RoundCap;
 use tvmd_core::{AdmissibleSet, AllocationRequest, Allocator, ExactBoundaryRedistribution, Real};
 
 fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
@@ -34,7 +35,8 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
                 wrench: w,
             };
             for cap in 0..40 {
-                let mut a = ExactBoundaryRedistribution::<T, N>::new().with_max_rounds(Some(cap));
+                let mut a = ExactBoundaryRedistribution::<T, N>::new()
+                    .with_round_cap(RoundCap::Rounds(cap));
                 let out = a.allocate(&request);
                 let r = w - e.wrench(&out.forces);
                 println!(
@@ -62,7 +64,8 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
                 wrench: t.requests[k].1.cast::<T>(),
             };
             for _ in 0..reps {
-                let mut a = ExactBoundaryRedistribution::<T, N>::new().with_max_rounds(cap);
+                let mut a = ExactBoundaryRedistribution::<T, N>::new()
+                    .with_round_cap(RoundCap::from_limit(cap));
                 black_box(a.allocate(black_box(&request)));
             }
         }
@@ -77,7 +80,8 @@ fn team<T: Real, const N: usize>(t: &SetTeam, reps: usize, cap: Option<u32>) {
         let mut best = f64::INFINITY;
         let mut rounds = 0;
         for _ in 0..reps {
-            let mut a = ExactBoundaryRedistribution::<T, N>::new().with_max_rounds(cap);
+            let mut a = ExactBoundaryRedistribution::<T, N>::new()
+                .with_round_cap(RoundCap::from_limit(cap));
             let t0 = Instant::now();
             let out = black_box(a.allocate(black_box(&request)));
             best = best.min(t0.elapsed().as_secs_f64() * 1e6);
@@ -140,7 +144,7 @@ fn run<T: Real>(reps: usize, cap: Option<u32>) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let reps = args.iter().find_map(|a| a.parse().ok()).unwrap_or(200usize);
-    // `cap=K`: the walk capped at K rounds (`with_max_rounds`).
+    // `cap=K`: the walk capped at K rounds (`with_round_cap`).
     let cap = args
         .iter()
         .find_map(|a| a.strip_prefix("cap=").and_then(|k| k.parse().ok()));

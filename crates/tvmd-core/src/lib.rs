@@ -71,7 +71,7 @@ pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::{
     Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
     ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
-    PseudoInverse, RedistributedPseudoInverse, WalkCost, WeightedPseudoInverse,
+    PseudoInverse, RedistributedPseudoInverse, RoundCap, WalkCost, WeightedPseudoInverse,
 };
 #[cfg(feature = "clarabel")]
 pub use allocation::{ClarabelAllocator, SequentialConvexAllocator};

@@ -12,6 +12,7 @@ use tvmd_core::allocation::{
 };
 use tvmd_core::error::ConfigField;
 use tvmd_core::team::presets;
+use tvmd_core::RoundCap;
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllocator, ConfigError,
     ExactBoundaryRedistribution, FailureMask, GimbalCommand, Real, RedistributedPseudoInverse,
@@ -130,7 +131,9 @@ fn attainable_requests_are_met_where_the_pyramid_misses_them() {
             assert!(report.objective <= report.start_objective);
             steps = steps.max(report.steps);
             let q = qp.allocate(&request);
-            let ebr = ExactBoundaryRedistribution::new().allocate(&request);
+            let ebr = ExactBoundaryRedistribution::new()
+                .with_round_cap(RoundCap::Uncapped)
+                .allocate(&request);
             let is_exact = relative(&a, &u) <= 1e-9;
             exact += usize::from(is_exact);
             exact_rpi += usize::from(relative(&rpi, &u) <= 1e-9);

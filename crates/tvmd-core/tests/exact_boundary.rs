@@ -6,6 +6,7 @@ use nalgebra::{Vector3, Vector6};
 use proptest::prelude::*;
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use tvmd_core::team::presets;
+use tvmd_core::RoundCap;
 use tvmd_core::{
     AdmissibleSet, Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution,
     FailureMask, GimbalCommand, Real, RedistributedPseudoInverse, TeamConfig,
@@ -89,7 +90,9 @@ fn attainable_requests_are_met_more_often_than_by_the_redistributed_pseudo_inver
                 wrench: u,
             };
             let rpi = RedistributedPseudoInverse.allocate(&request);
-            let a = ExactBoundaryRedistribution::new().allocate(&request);
+            let a = ExactBoundaryRedistribution::new()
+                .with_round_cap(RoundCap::Uncapped)
+                .allocate(&request);
             assert_admissible(&a, &sets, &team);
             assert!(torque_first(&a, &u) <= torque_first(&rpi, &u) * (1.0 + 1e-12) + 1e-12);
             total += 1;
@@ -158,7 +161,7 @@ proptest! {
         }
         let wrench = Vector6::from(u) * scale;
         let request = AllocationRequest { effectiveness: &e, sets: &sets, wrench };
-        let mut allocator = ExactBoundaryRedistribution::new();
+        let mut allocator = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
         for _ in 0..repeat {
             let a = allocator.allocate(&request);
             assert_admissible(&a, &sets, &team);
@@ -178,7 +181,7 @@ proptest! {
 #[test]
 fn non_finite_requests_give_admissible_forces() {
     let (team, e, sets) = team_sets_request(0);
-    let mut allocator = ExactBoundaryRedistribution::new();
+    let mut allocator = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         let wrench = Vector6::new(0.0, 0.0, 0.0, 1.0, bad, 20.0);
         let a = allocator.allocate(&AllocationRequest {
@@ -200,7 +203,7 @@ fn a_slowly_moving_request_starts_from_the_previous_forces() {
     let (mut warm_exact, mut fresh_exact) = (0, 0);
     let (mut warm_rounds, mut fresh_rounds) = (0, 0);
     for _ in 0..20 {
-        let mut allocator = ExactBoundaryRedistribution::new();
+        let mut allocator = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
         let base: Vec<GimbalCommand<f64>> = (0..4)
             .map(|_| admissible_command(&mut rng, &sets[0]))
             .collect();
@@ -219,7 +222,9 @@ fn a_slowly_moving_request_starts_from_the_previous_forces() {
                 wrench,
             };
             let warm = allocator.allocate(&request);
-            let fresh = ExactBoundaryRedistribution::new().allocate(&request);
+            let fresh = ExactBoundaryRedistribution::new()
+                .with_round_cap(RoundCap::Uncapped)
+                .allocate(&request);
             assert_admissible(&warm, &sets, &team);
             assert_eq!(allocator.previous(), Some(&warm.forces));
             if k > 0 {
@@ -261,7 +266,7 @@ fn a_repeated_request_met_last_period_keeps_its_forces() {
             sets: &sets,
             wrench,
         };
-        let mut allocator = ExactBoundaryRedistribution::new();
+        let mut allocator = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
         let first = allocator.allocate(&request);
         let rpi = RedistributedPseudoInverse.allocate(&request);
         // Met to the walk's own stopping tolerance (`64 eps` of the request's largest entry).
@@ -290,7 +295,7 @@ fn reset_and_configure_forget_the_previous_forces() {
         sets: &sets,
         wrench,
     };
-    let mut a = ExactBoundaryRedistribution::new();
+    let mut a = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
     a.allocate(&request);
     assert!(a.previous().is_some());
     Allocator::<f64, CAP>::reset(&mut a);
@@ -320,11 +325,13 @@ fn f32_agrees_with_f64_on_attainable_requests() {
             *f = admissible_command(&mut rng, &s64[0]).force();
         }
         let u = e64.wrench(&forces);
-        let a32 = ExactBoundaryRedistribution::new().allocate(&AllocationRequest {
-            effectiveness: &e32,
-            sets: &s32,
-            wrench: u.cast::<f32>(),
-        });
+        let a32 = ExactBoundaryRedistribution::new()
+            .with_round_cap(RoundCap::Uncapped)
+            .allocate(&AllocationRequest {
+                effectiveness: &e32,
+                sets: &s32,
+                wrench: u.cast::<f32>(),
+            });
         for f in a32.forces.iter().take(4) {
             assert!(f.iter().all(|x| x.is_finite()));
             assert!(s32[0].contains(&GimbalCommand::from_force(f), 1e-5));
@@ -352,11 +359,13 @@ fn a_zero_width_window_clamps_round_off_only() {
     let eta_y = sets[0].eta_y();
     assert_eq!(eta_y.lo, eta_y.hi, "the window is a point");
     let wrench = Vector6::new(0.353_033_07, 0.0, 0.0, 0.0, 0.0, -0.917_253_85);
-    let a = ExactBoundaryRedistribution::new().allocate(&AllocationRequest {
-        effectiveness: &e,
-        sets: &sets,
-        wrench,
-    });
+    let a = ExactBoundaryRedistribution::new()
+        .with_round_cap(RoundCap::Uncapped)
+        .allocate(&AllocationRequest {
+            effectiveness: &e,
+            sets: &sets,
+            wrench,
+        });
     let tol = tvmd_core::command::command_tolerance::<f32>();
     for (f, set) in a.forces.iter().zip(&sets).take(team.len()) {
         let (_, clamp) = tvmd_core::command::invert(f, set, team.limits());
@@ -398,7 +407,7 @@ proptest! {
         }
         let wrench = Vector6::from(u) * scale;
         let request = AllocationRequest { effectiveness: &e, sets: &sets, wrench };
-        let mut allocator = ExactBoundaryRedistribution::new();
+        let mut allocator = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped);
         for _ in 0..repeat {
             let a = allocator.allocate(&request);
             for (i, (f, set)) in a.forces.iter().zip(&sets).enumerate().take(team.len()) {

@@ -9,6 +9,7 @@
 mod allocation_set;
 
 use allocation_set::{teams, SetTeam};
+use tvmd_core::RoundCap;
 use tvmd_core::{
     AdmissibleSet, AllocationRequest, Allocator, ExactBoundaryRedistribution, GimbalCommand,
     RedistributedPseudoInverse, WalkCost,
@@ -22,7 +23,8 @@ fn check<const N: usize>(t: &SetTeam, cap: Option<u32>) -> (WalkCost, usize) {
     let e = config.effectiveness(&mask);
     let sets = [AdmissibleSet::from_limits(config.limits()); N];
     let bound = WalkCost::bound(e.working_count(), cap.unwrap_or(u32::MAX));
-    let mut warm = ExactBoundaryRedistribution::<f64, N>::new().with_max_rounds(cap);
+    let cap = RoundCap::from_limit(cap);
+    let mut warm = ExactBoundaryRedistribution::<f64, N>::new().with_round_cap(cap);
     let mut seen = WalkCost::default();
     let mut exact = 0;
     for (kind, w) in &t.requests {
@@ -31,7 +33,7 @@ fn check<const N: usize>(t: &SetTeam, cap: Option<u32>) -> (WalkCost, usize) {
             sets: &sets,
             wrench: *w,
         };
-        let mut cold = ExactBoundaryRedistribution::<f64, N>::new().with_max_rounds(cap);
+        let mut cold = ExactBoundaryRedistribution::<f64, N>::new().with_round_cap(cap);
         for a in [&mut cold, &mut warm] {
             let out = a.allocate(&request);
             let c = a.last_cost();
@@ -149,11 +151,13 @@ fn the_cap_is_an_allocator_option_of_the_exact_boundary_redistribution_only() {
     use tvmd_core::allocation::AllocatorOptions;
     use tvmd_core::{AnyAllocator, ConfigError, ConfigField};
     let capped = AllocatorOptions::<f64, 4> {
-        max_rounds: Some(3),
+        max_rounds: Some(RoundCap::Rounds(3)),
         ..AllocatorOptions::default()
     };
     match AnyAllocator::from_name("exact-boundary-redistribution", &capped) {
-        Ok(AnyAllocator::ExactBoundaryRedistribution(a)) => assert_eq!(a.max_rounds(), Some(3)),
+        Ok(AnyAllocator::ExactBoundaryRedistribution(a)) => {
+            assert_eq!(a.round_cap(), RoundCap::Rounds(3))
+        }
         other => panic!("{other:?}"),
     }
     assert_eq!(

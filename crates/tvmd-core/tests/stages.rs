@@ -11,7 +11,7 @@ use tvmd_core::rotation::roll;
 use tvmd_core::team::presets;
 use tvmd_core::{
     Controller, ControllerSettings, ExactBoundaryRedistribution, InputError,
-    RedistributedPseudoInverse, Reference,
+    RedistributedPseudoInverse, Reference, RoundCap,
 };
 
 fn truth() -> Truth {
@@ -123,9 +123,20 @@ fn allocate_meets_a_wrench_and_refuses_a_bad_one() {
     let held = c.allocate(&bad).unwrap_err();
     assert_eq!(held.error, InputError::NonFinite { field: "wrench" });
     assert_eq!(held.commands, out.commands);
-    // Straight down: no thrust can push the team down; the answer says so in `e_f` (the
-    // whole request missed), never as a silent success.
+    // Straight down: no thrust can push the team down, and the answer says so, never as a
+    // silent success. The default walk (capped at 2 rounds) ends with every agent idle: the
+    // request is refused as unattainable and the last commands are held.
     let down = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, -weight);
-    let missed = c.allocate(&down).unwrap();
+    let refused = c.allocate(&down).unwrap_err();
+    assert_eq!(refused.error, InputError::Unattainable { field: "wrench" });
+    assert_eq!(refused.commands, out.commands);
+    // Uncapped, the walk ends on some thrust and reports the whole request missed in `e_f`.
+    let mut uncapped = Controller::new(
+        presets::a4_inc::<f64, 4>().unwrap(),
+        ControllerSettings::paper(),
+        ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped),
+    )
+    .unwrap();
+    let missed = uncapped.allocate(&down).unwrap();
     assert!((missed.allocation.e_f - weight).abs() < 1e-3, "{missed:?}");
 }

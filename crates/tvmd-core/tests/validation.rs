@@ -322,7 +322,7 @@ fn every_option_is_refused_by_the_allocators_it_is_not_for() {
             ConfigField::AllocatorWeights => o.agent_weights = Some([1.0; 4]),
             ConfigField::ClarabelWeights => o.wrench_weights = Some([1.0; 6]),
             ConfigField::ClarabelLambda => o.regularization = Some(1e-6),
-            _ => o.max_rounds = Some(3),
+            _ => o.max_rounds = Some(tvmd_core::RoundCap::Rounds(3)),
         }
         o
     };

@@ -12,7 +12,7 @@ use tvmd_core::allocation::{
 };
 use tvmd_core::{
     AgentSpec, ConfigError, ControllerSettings, GainSchedule, Navigator, RateLimits, Relaxation,
-    TeamConfig,
+    RoundCap, TeamConfig,
 };
 
 use crate::status::*;
@@ -139,9 +139,12 @@ unsafe fn allocator(
         }
         options.agent_weights = Some(weights);
     }
-    if config.allocator_max_rounds != 0 {
-        options.max_rounds = Some(config.allocator_max_rounds);
-    }
+    options.max_rounds = match config.allocator_round_cap {
+        TVMD_ROUND_CAP_DEFAULT => None,
+        TVMD_ROUND_CAP_ROUNDS => Some(RoundCap::Rounds(config.allocator_max_rounds)),
+        TVMD_ROUND_CAP_UNCAPPED => Some(RoundCap::Uncapped),
+        _ => return Err(ConvertError::EnumValue),
+    };
     at.write(AllocatorChoice::new(name, &options)?);
     Ok(())
 }

@@ -62,6 +62,7 @@ unsafe fn fill(
         rate_limits: [0.0; 2],
         allocator: TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
         agent_weights: [1.0; TVMD_MAX_AGENTS],
+        allocator_round_cap: TVMD_ROUND_CAP_DEFAULT,
         allocator_max_rounds: 0,
         fault: TvmdFaultDetection::recommended_off(),
         law,
@@ -74,7 +75,8 @@ unsafe fn fill(
 /// `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
 /// damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
 /// (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
-/// (20 rad/s, 5 rad/s bound). This law holds its setpoint under model error and unmodelled
+/// (20 rad/s, 5 rad/s bound), with the exact-boundary redistribution's walk capped at
+/// `TVMD_DEFAULT_MAX_ROUNDS` rounds per period (`TVMD_ROUND_CAP_DEFAULT`). This law holds its setpoint under model error and unmodelled
 /// forces, where the paper's law leaves a steady error. The caller sets `config->size` first.
 ///
 /// # Safety
@@ -89,7 +91,8 @@ pub unsafe extern "C" fn tvmd_config_default(config: *mut TvmdConfig) -> TvmdSta
 /// square, `psi = [pi/2, pi/2, 0, 0]`), its limits (`sigma_x = pi/6`, `sigma_y = pi/4`,
 /// `sigma_Tf = 2 m_i g`, normalized rotor speed), gains, `s = 0.5`, `g = 9.81`, `dt = 0.01` s,
 /// no rate limits, the exact-boundary redistribution (the default allocator, as in the Rust
-/// and Python interfaces) and the paper's law: gains as given, no offset-free action, the
+/// and Python interfaces, its walk capped at `TVMD_DEFAULT_MAX_ROUNDS` rounds) and the paper's
+/// law: gains as given, no offset-free action, the
 /// reference's rates (every `law` mode off; its numbers are those of `tvmd_config_default`, so
 /// switching one mode on starts from the library's values). The caller sets `config->size`
 /// first.

@@ -86,6 +86,20 @@ pub const TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE: u32 = 2;
 /// `tvmd_set_failures` forget them).
 pub const TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION: u32 = 3;
 
+/// `allocator_round_cap`: the library's default cap of the exact-boundary redistribution's
+/// walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (another allocator has no walk to cap).
+pub const TVMD_ROUND_CAP_DEFAULT: u32 = 0;
+/// `allocator_round_cap`: exactly `allocator_max_rounds` walk rounds per period (`0`: the
+/// walk's start alone, the redistributed pseudo-inverse or the previous forces).
+pub const TVMD_ROUND_CAP_ROUNDS: u32 = 1;
+/// `allocator_round_cap`: no cap beyond the walk's own `2 n + 4` rounds (research: about
+/// 275,000 Cortex-M4F instructions for the worst n = 4 allocation).
+pub const TVMD_ROUND_CAP_UNCAPPED: u32 = 2;
+/// Walk rounds of `TVMD_ROUND_CAP_DEFAULT` (the core's `DEFAULT_MAX_ROUNDS`).
+pub const TVMD_DEFAULT_MAX_ROUNDS: u32 = 2;
+
+const _: () = assert!(TVMD_DEFAULT_MAX_ROUNDS == tvmd_core::allocation::DEFAULT_MAX_ROUNDS);
+
 /// Everything `tvmd_create` needs. `tvmd_config_default` fills the paper's team and settings
 /// with the offset-free law (the library's default); `tvmd_config_paper` the same team with the
 /// paper's law.
@@ -122,10 +136,14 @@ pub struct TvmdConfig {
     /// Per-agent weights `w_i > 0` of the weighted pseudo-inverse (the first `agent_count`
     /// are used; ignored by the other allocators).
     pub agent_weights: [f32; TVMD_MAX_AGENTS],
-    /// Non-zero: cap the exact-boundary redistribution's walk at this many rounds per period
-    /// (a bound on its work: the best admissible forces found so far, with their true `e_f`);
-    /// zero: no cap (the walk's own `2 n + 4`). With another allocator a non-zero value is
-    /// refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`).
+    /// One of `TVMD_ROUND_CAP_*`: how the exact-boundary redistribution's walk is capped per
+    /// period (a bound on its work: the best admissible forces found so far, with their true
+    /// `e_f`). Zero is the library's default cap; another allocator refuses
+    /// `TVMD_ROUND_CAP_ROUNDS` (`TVMD_ERR_CONFIG_UNUSED_OPTION`) and takes the other two; an
+    /// unknown value is `TVMD_ERR_ENUM_VALUE`.
+    pub allocator_round_cap: u32,
+    /// Walk rounds per period with `TVMD_ROUND_CAP_ROUNDS` (any number, `0` included);
+    /// ignored otherwise.
     pub allocator_max_rounds: u32,
     /// Agent fault detection (all zeros: off), see `TvmdFaultDetection`.
     pub fault: TvmdFaultDetection,

@@ -12,29 +12,28 @@ use tvmd_core::{AdmissibleSet, Allocation, AllocationRequest, Allocator, AnyAllo
 use tvmd_core::{ConfigError, ConfigField, GimbalCommand, RateLimits};
 
 use crate::convert::{arg, array, check_finite, class_arg, finite, finite_scalar, matrix};
-use crate::convert::{shape_error, shaped, Int, CAPACITY};
+use crate::convert::{round_cap_arg, shape_error, shaped, CAPACITY};
 use crate::errors::{config_error, ConfigError as PyConfigError, OrRaise};
 use crate::record::record;
 use crate::team::{failure_mask, PyTeam};
+use tvmd_core::RoundCap;
 
 /// Names of the allocators this build provides (the core's one table).
 pub(crate) const ALLOCATORS: &[&str] = AnyAllocator::<f64, CAPACITY>::NAMES;
 
 /// The allocator named `method` for a team of `n` agents ([`AnyAllocator::from_name`]).
 /// `weights` are per-agent weights (n,) or wrench weights (6,), depending on the allocator;
-/// `max_rounds` caps the exact-boundary redistribution's walk (an int >= 0).
+/// `max_rounds` caps the exact-boundary redistribution's walk (`None`: the default cap).
 pub(crate) fn make_allocator(
     method: &str,
     weights: Option<&Bound<'_, PyAny>>,
     regularization: Option<f64>,
-    max_rounds: Option<&Int>,
+    max_rounds: Option<RoundCap>,
     n: usize,
 ) -> PyResult<AnyAllocator<f64, CAPACITY>> {
     let mut options = AllocatorOptions::<f64, CAPACITY> {
         regularization,
-        max_rounds: max_rounds
-            .map(|k| k.to("max_rounds", 0, u32::MAX.into()))
-            .transpose()?,
+        max_rounds,
         ..Default::default()
     };
     match (method, weights.filter(|w| !w.is_none())) {
@@ -143,11 +142,17 @@ pub(crate) fn allocate(
     rate_limits: Option<&Bound<'_, PyAny>>,
     dt: Option<f64>,
     regularization: Option<f64>,
-    max_rounds: Option<Int>,
+    max_rounds: Option<Bound<'_, PyAny>>,
 ) -> PyResult<PyAllocation> {
     let team = &class_arg::<PyTeam>(team, "team")?.get().inner;
     let n = team.len();
-    let mut allocator = make_allocator(method, weights, regularization, max_rounds.as_ref(), n)?;
+    let mut allocator = make_allocator(
+        method,
+        weights,
+        regularization,
+        round_cap_arg(max_rounds.as_ref())?,
+        n,
+    )?;
     let wrench = finite::<6, 1>(wrench, "wrench")?;
     let mask = failure_mask(team, failed)?;
     team.validate_failures(&mask).or_raise()?;

@@ -11,7 +11,7 @@ use crate::afs::PyAfs;
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
 use crate::convert::null_space_arg;
 use crate::convert::{class_arg, commands_array, finite, iteration_cap, law_arg, matrix};
-use crate::convert::{fault_detection_arg, record_to_py};
+use crate::convert::{fault_detection_arg, record_to_py, round_cap_arg};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, value_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
@@ -74,7 +74,7 @@ impl PyController {
         null_space: Option<&str>,
         law: Option<&Bound<'_, PyAny>>,
         fault_detection: Option<&Bound<'_, PyAny>>,
-        max_rounds: Option<Int>,
+        max_rounds: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
@@ -112,7 +112,7 @@ impl PyController {
             allocator,
             weights,
             regularization,
-            max_rounds.as_ref(),
+            round_cap_arg(max_rounds.as_ref())?,
             team.len(),
         )?;
         let mask = failure_mask(&team, failed)?;

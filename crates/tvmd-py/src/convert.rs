@@ -23,10 +23,12 @@ use crate::errors::{sim_error, value_error, OrRaise, READ};
 
 mod commands;
 mod law;
+mod round_cap;
 
 pub(crate) use commands::{batch_commands_arg, batch_wrench_arg, commands_arg, wrench_arg};
 
 pub(crate) use law::{fault_detection_arg, law_arg};
+pub(crate) use round_cap::round_cap_arg;
 
 /// Agent capacity of the bindings: `TeamConfig<f64, 64>`.
 pub(crate) const CAPACITY: usize = 64;

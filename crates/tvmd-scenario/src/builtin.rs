@@ -4,6 +4,7 @@ use std::f64::consts::PI;
 
 use super::{Failure, Scenario};
 use crate::{LawConfig, ScenarioError, FAMILY_NAMES};
+use tvmd_core::RoundCap;
 use tvmd_plant::actuators::FailureKind;
 use tvmd_plant::physics::TeamBody;
 use tvmd_plant::reference::{PaperTilt, ReferenceConfig};
@@ -56,7 +57,8 @@ const ALL_NAMES: [&str; PAPER_NAMES.len() + FAMILY_NAMES.len()] =
 pub const RELAXATION_LANDING_SPOT: f64 = 0.06;
 
 /// Names of the built-in scenarios, for [`Scenario::builtin`]: the paper's, then the scenario
-/// families' ([`FAMILY_NAMES`]).
+/// families' ([`FAMILY_NAMES`]). The paper's fly the uncapped walk (their first flights' bits),
+/// the families the library's default round cap.
 pub const BUILTIN_NAMES: &[&str] = &ALL_NAMES;
 
 impl Scenario {
@@ -69,6 +71,9 @@ impl Scenario {
                           pi/3, descent; s = 0.5"
                 .into(),
             law: LawConfig::paper(),
+            // The walk these scenarios were first flown with, so they keep their bits (and
+            // the recordings made of them replay); the library's default caps it.
+            allocator_max_rounds: Some(RoundCap::Uncapped),
             ..Scenario::default()
         };
         let with = |mut s: Scenario, description: &str| {
@@ -157,7 +162,10 @@ impl Scenario {
                 )
             }
             "paper-experiment" => with(
-                crate::experiment::paper_experiment(LawConfig::paper()),
+                Scenario {
+                    allocator_max_rounds: Some(RoundCap::Uncapped),
+                    ..crate::experiment::paper_experiment(LawConfig::paper())
+                },
                 "The paper's experiment, modelled, with the paper's law: take-off, tilt and hover \
                  to 20 s on a tether pulling 0.3 N down, a 0.03 N m yaw torque, agents 0 and 2 \
                  at 98% thrust, gimbal offsets, servo and rotor dynamics, state noise and one \

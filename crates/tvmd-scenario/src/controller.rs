@@ -77,3 +77,40 @@ impl Default for GainsConfig {
         }
     }
 }
+
+/// `allocator_max_rounds` in a scenario file: a number of rounds (`0`: the walk's start alone)
+/// or `"uncapped"`; absent, the core's default cap
+/// ([`tvmd_core::allocation::DEFAULT_MAX_ROUNDS`]).
+pub(crate) mod round_cap {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use tvmd_core::RoundCap;
+
+    /// The word of [`RoundCap::Uncapped`].
+    pub const UNCAPPED: &str = "uncapped";
+
+    #[derive(Serialize, Deserialize)]
+    #[serde(untagged)]
+    enum Input {
+        Rounds(u32),
+        Word(String),
+    }
+
+    /// Writes `Some(cap)` as a number or `"uncapped"` (`None` is skipped by the field).
+    pub fn serialize<S: Serializer>(cap: &Option<RoundCap>, s: S) -> Result<S::Ok, S::Error> {
+        match cap {
+            Some(RoundCap::Rounds(k)) => Input::Rounds(*k).serialize(s),
+            Some(RoundCap::Uncapped) | None => Input::Word(UNCAPPED.into()).serialize(s),
+        }
+    }
+
+    /// Reads a number of rounds or `"uncapped"`.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<RoundCap>, D::Error> {
+        match Input::deserialize(d)? {
+            Input::Rounds(k) => Ok(Some(RoundCap::Rounds(k))),
+            Input::Word(w) if w == UNCAPPED => Ok(Some(RoundCap::Uncapped)),
+            Input::Word(w) => Err(serde::de::Error::custom(format!(
+                "expected a number of rounds (0 or more) or \"{UNCAPPED}\", got \"{w}\""
+            ))),
+        }
+    }
+}

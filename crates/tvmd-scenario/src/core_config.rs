@@ -7,7 +7,7 @@ use tvmd_core::error::{ConfigError, ConfigField};
 use tvmd_core::{
     AgentLimits, AgentSpec, AllocatorOptions, AnyAllocator, AttitudeRateFilter, ControllerSettings,
     DisturbanceObserver, FaultDetection, FaultResponse, GainSchedule, Gains, IntegralAction,
-    NaturalGains, Navigator, OffsetFree, RateLimits, Relaxation, TeamConfig,
+    NaturalGains, Navigator, OffsetFree, RateLimits, Relaxation, RoundCap, TeamConfig,
 };
 use tvmd_plant::math::from_rows;
 
@@ -237,7 +237,7 @@ pub fn law_settings<T: CoreFloat>(
 /// `scenario.allocator_max_rounds`.
 pub fn allocator<T: CoreFloat, const N: usize>(
     name: &str,
-    max_rounds: Option<u32>,
+    max_rounds: Option<RoundCap>,
 ) -> Result<AnyAllocator<T, N>, ScenarioError> {
     let options = AllocatorOptions {
         max_rounds,

@@ -13,7 +13,7 @@
 //! initial_position = [0.5, -0.5, 0.0]
 //! relaxation = 0.5
 //! allocator = "exact-boundary-redistribution" # "redistributed-pseudo-inverse", "clarabel", ...
-//! # allocator_max_rounds = 2                    # cap on its walk per period (bounds its cost)
+//! # allocator_max_rounds = 2                    # cap on its walk per period (default 2; "uncapped")
 //! controller_precision = "f64"               # or "f32": the flight configuration
 //! # controller_rate_limits = [6.0, 6.0]       # gimbal rates the controller respects (rad/s)
 //! # null_space = "margin"                     # null-space stage after the allocator

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use tvmd_core::RoundCap;
 use tvmd_plant::actuators::{ActuatorModel, SaturationLimits};
 use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
@@ -43,12 +44,18 @@ pub struct Scenario {
     /// `"clarabel-sequential"` with the `clarabel` feature).
     pub allocator: String,
     /// Round cap of the exact-boundary redistribution's walk per control period
-    /// (`ExactBoundaryRedistribution::with_max_rounds`: the best forces found so far, inside
+    /// (`ExactBoundaryRedistribution::with_round_cap`: the best forces found so far, inside
     /// `E_f`, with their true `e_f`), the flight option that bounds its worst case
-    /// (`docs/allocation-benchmark.md`); none by default, the walk's own `2 n + 4`. Refused
-    /// with any other allocator.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub allocator_max_rounds: Option<u32>,
+    /// (`docs/allocation-benchmark.md`): a number of rounds, or `"uncapped"` for the walk's own
+    /// `2 n + 4`; absent, the core's default of [`tvmd_core::allocation::DEFAULT_MAX_ROUNDS`]
+    /// rounds (the paper's scenarios name `"uncapped"`, the walk they were first flown with).
+    /// Refused with any other allocator.
+    #[serde(
+        default,
+        with = "crate::controller::round_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub allocator_max_rounds: Option<RoundCap>,
     /// Gimbal rate limits `[eta_x, eta_y]` (rad/s) the *controller* respects (rate-constrained
     /// allocation); none by default. Independent of `actuators.servo.rate_limit`, which is the
     /// plant's: give both to model a servo the controller knows about.

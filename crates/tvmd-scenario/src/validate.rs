@@ -370,7 +370,7 @@ mod tests {
     #[test]
     fn the_round_cap_is_for_the_exact_boundary_walk_only() {
         let s = Scenario::from_toml_str("allocator_max_rounds = 2\n").unwrap();
-        assert_eq!(s.allocator_max_rounds, Some(2));
+        assert_eq!(s.allocator_max_rounds, Some(tvmd_core::RoundCap::Rounds(2)));
         assert_eq!(Scenario::default().allocator_max_rounds, None);
         for other in ["redistributed-pseudo-inverse", "pseudo-inverse", "clarabel"] {
             let e = Scenario::from_toml_str(&format!(

@@ -1,6 +1,6 @@
 //! The f32 controller's configuration as words, and the controller built from it.
 
-use tvmd_core::allocation::AllocatorOptions;
+use tvmd_core::allocation::{AllocatorOptions, RoundCap};
 use tvmd_core::nalgebra::{Matrix3, Vector3};
 use tvmd_core::{
     AgentLimits, AgentSpec, AnyAllocator, ConfigError, Controller, ControllerSettings,
@@ -43,8 +43,10 @@ pub struct CoreConfig {
     /// The controller's fault detection, if any.
     pub fault_detection: Option<FaultDetection<f32>>,
     /// The exact-boundary redistribution's round cap, if any
-    /// (`AllocatorOptions::max_rounds`).
-    pub max_rounds: Option<u32>,
+    /// (`AllocatorOptions::max_rounds`), resolved: words `1, k` for `Rounds(k)`, `0, 0` for
+    /// `Uncapped` (so the recordings of format 3, flown uncapped when the walk had no default
+    /// cap, replay as they were flown).
+    pub max_rounds: RoundCap,
 }
 
 impl CoreConfig {
@@ -76,8 +78,8 @@ impl CoreConfig {
         self.law.put(w)?;
         put_fault_detection(w, self.fault_detection.as_ref())?;
         match self.max_rounds {
-            Some(k) => w.u32(1).and_then(|()| w.u32(k)),
-            None => w.f32s(&[0.0; 2]),
+            RoundCap::Rounds(k) => w.u32(1).and_then(|()| w.u32(k)),
+            RoundCap::Uncapped => w.f32s(&[0.0; 2]),
         }
     }
 
@@ -101,8 +103,8 @@ impl CoreConfig {
         let law = LawWords::get(r)?;
         let fault_detection = get_fault_detection(r)?;
         let max_rounds = match (r.u32()?, r.u32()?) {
-            (0, _) => None,
-            (1, k) => Some(k),
+            (0, _) => RoundCap::Uncapped,
+            (1, k) => RoundCap::Rounds(k),
             _ => return None,
         };
         Some(Self {
@@ -164,7 +166,7 @@ impl CoreConfig {
         };
         self.law.apply(&mut settings)?;
         let options = AllocatorOptions {
-            max_rounds: self.max_rounds,
+            max_rounds: Some(self.max_rounds),
             ..Default::default()
         };
         let alloc = AnyAllocator::from_name(self.allocator_name(), &options)?;

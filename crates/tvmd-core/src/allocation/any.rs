@@ -92,7 +92,7 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
             Choice::PseudoInverse => Self::PseudoInverse(PseudoInverse),
             Choice::Redistributed => Self::RedistributedPseudoInverse(RedistributedPseudoInverse),
             Choice::ExactBoundary { max_rounds } => Self::ExactBoundaryRedistribution(
-                ExactBoundaryRedistribution::new().with_max_rounds(max_rounds),
+                ExactBoundaryRedistribution::new().with_round_cap(max_rounds),
             ),
             Choice::Weighted(a) => Self::WeightedPseudoInverse(a),
             #[cfg(feature = "clarabel")]

@@ -7,7 +7,7 @@ use super::names::{
     CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
-use super::WeightedPseudoInverse;
+use super::{RoundCap, WeightedPseudoInverse};
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::real::Real;
 
@@ -22,10 +22,12 @@ pub struct AllocatorOptions<T: Real, const N: usize> {
     /// Regularisation `lambda` of `ClarabelAllocator` (default `1e-6`) and
     /// `SequentialConvexAllocator` (default `0`).
     pub regularization: Option<T>,
-    /// Round cap of [`super::ExactBoundaryRedistribution::with_max_rounds`] (default: none,
+    /// Round cap of [`super::ExactBoundaryRedistribution::with_round_cap`] (`None`: the
+    /// allocator's default, [`super::DEFAULT_MAX_ROUNDS`] rounds; [`RoundCap::Uncapped`] for
     /// the walk's own `2 n + 4`): bounds the allocator's work per period, see
-    /// `docs/allocation-benchmark.md`.
-    pub max_rounds: Option<u32>,
+    /// `docs/allocation-benchmark.md`. `Some(RoundCap::Rounds(_))` is refused by the other
+    /// allocators; `Uncapped` is accepted by all (none caps anything).
+    pub max_rounds: Option<RoundCap>,
 }
 
 impl<T: Real, const N: usize> Default for AllocatorOptions<T, N> {
@@ -71,7 +73,7 @@ pub(super) enum Choice<T: Real, const N: usize> {
     PseudoInverse,
     Redistributed,
     ExactBoundary {
-        max_rounds: Option<u32>,
+        max_rounds: RoundCap,
     },
     Weighted(WeightedPseudoInverse<T, N>),
     #[cfg(feature = "clarabel")]
@@ -120,15 +122,18 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
                 ConfigField::ClarabelLambda,
             )?;
         }
+        // A cap of some rounds is the walk's alone; "uncapped" promises no bound, which every
+        // allocator keeps (so a scenario naming it may switch allocators).
         refuse(
-            options.max_rounds.is_some() && name != EXACT_BOUNDARY_REDISTRIBUTION,
+            matches!(options.max_rounds, Some(RoundCap::Rounds(_)))
+                && name != EXACT_BOUNDARY_REDISTRIBUTION,
             ConfigField::AllocatorMaxRounds,
         )?;
         let choice = match name {
             PSEUDO_INVERSE => Choice::PseudoInverse,
             REDISTRIBUTED_PSEUDO_INVERSE => Choice::Redistributed,
             EXACT_BOUNDARY_REDISTRIBUTION => Choice::ExactBoundary {
-                max_rounds: options.max_rounds,
+                max_rounds: options.max_rounds.unwrap_or_default(),
             },
             WEIGHTED_PSEUDO_INVERSE => {
                 let weights = options.agent_weights.unwrap_or([T::one(); N]);

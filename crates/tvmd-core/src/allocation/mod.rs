@@ -22,7 +22,7 @@ pub use clarabel::{
     ClarabelAllocator, ClarabelStatus, FallbackReason, SequentialConvexAllocator, SequentialReport,
     SolveReport, StopReason,
 };
-pub use exact_boundary::{ExactBoundaryRedistribution, WalkCost};
+pub use exact_boundary::{ExactBoundaryRedistribution, RoundCap, WalkCost, DEFAULT_MAX_ROUNDS};
 pub use names::{
     CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
     REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,

@@ -220,13 +220,29 @@ static void test_create_errors(void) {
   /* The round cap is the exact-boundary redistribution's alone. Capped, a step is as good as
    * the cap allows: never a smaller e_f than the uncapped walk's. */
   bad = config; bad.allocator = TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE;
+  bad.allocator_round_cap = TVMD_ROUND_CAP_ROUNDS;
   bad.allocator_max_rounds = 2;
   CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_ERR_CONFIG_UNUSED_OPTION);
+  /* No cap promises no bound: every allocator takes it, and the default. */
+  bad.allocator_round_cap = TVMD_ROUND_CAP_UNCAPPED;
+  CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+  bad.allocator_round_cap = TVMD_ROUND_CAP_DEFAULT;
+  CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+  bad = config; bad.allocator_round_cap = 3;
+  CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_ERR_ENUM_VALUE);
   {
     TvmdController uncapped;
     TvmdOutput capped_out = o, uncapped_out = o;
     bad = config; bad.allocator = TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION;
+    bad.allocator_round_cap = TVMD_ROUND_CAP_UNCAPPED;
     CHECK_STATUS(tvmd_create(&uncapped, sizeof uncapped, &bad), TVMD_OK);
+    /* Every cap, the start alone (0 rounds) included, is a bound the walk respects. */
+    bad.allocator_round_cap = TVMD_ROUND_CAP_ROUNDS;
+    bad.allocator_max_rounds = 0;
+    CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&storage, &s, &r, &capped_out), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&uncapped, &s, &r, &uncapped_out), TVMD_OK);
+    CHECK(capped_out.e_f >= uncapped_out.e_f - 1e-5f);
     bad.allocator_max_rounds = 1;
     CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
     CHECK_STATUS(tvmd_step(&storage, &s, &r, &capped_out), TVMD_OK);

@@ -846,7 +846,7 @@ def allocate(
     rate_limits: Optional[ArrayLike] = None,
     dt: Optional[float] = None,
     regularization: Optional[float] = None,
-    max_rounds: Optional[int] = None,
+    max_rounds: Optional[Union[int, Literal["uncapped"]]] = None,
 ) -> Allocation:
     """Allocates a desired wrench ``u_d`` over the team's working agents: inverts ``u_d = M f``
     (eq. 4) into agent-frame forces inside each agent's admissible set ``E_f`` (eq. 6).
@@ -887,9 +887,10 @@ def allocate(
         dt: the control period (s), required with ``rate_limits``.
         regularization: ``lambda`` of "clarabel" and "clarabel-sequential".
         max_rounds: "exact-boundary-redistribution" only: caps its walk at this many rounds
-            (an int >= 0; 0 is its start, the redistributed pseudo-inverse's forces or better).
-            A capped call returns the best forces found so far, inside ``E_f``, with their true
-            ``e_f``. Default None: the walk's own cap, ``2 n + 4`` rounds.
+            (an int >= 0; 0 is its start, the redistributed pseudo-inverse's forces or better),
+            or "uncapped" for the walk's own ``2 n + 4`` rounds. A capped call returns the best
+            forces found so far, inside ``E_f``, with their true ``e_f``. Default None: the
+            library's default cap, 2 rounds (a bounded worst case).
 
     Returns:
         Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).
@@ -962,7 +963,8 @@ class Controller:
             offset-free law's observer. ``fault_report()`` gives each period's verdict.
         max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
             (keyword only; see ``tvmd.allocate``): bounds its worst-case cost, the flight option
-            of docs/allocation-benchmark.md. Default None: no cap.
+            of docs/allocation-benchmark.md; "uncapped" for the walk's own ``2 n + 4``. Default
+            None: the library's default cap, 2 rounds.
 
     Raises:
         ConfigError: invalid gains, ``s``, gravity, period, rates, or a degraded team that cannot
@@ -995,7 +997,7 @@ class Controller:
         null_space: Optional[str] = None,
         law: _LawArg = "offset-free",
         fault_detection: Union[str, Mapping[str, Any], None] = None,
-        max_rounds: Optional[int] = None,
+        max_rounds: Optional[Union[int, Literal["uncapped"]]] = None,
     ) -> "Controller": ...
     def fault_report(self) -> Optional[Dict[str, Any]]:
         """The fault detector's report of the last period, or None (detection off, or no period

@@ -81,6 +81,6 @@ pub fn wire_config(scenario: &Scenario) -> Result<tvmd_wire::CoreConfig, SimErro
         allocator,
         law: LawWords::of(&settings),
         fault_detection: settings.fault_detection,
-        max_rounds: scenario.allocator_max_rounds,
+        max_rounds: scenario.allocator_max_rounds.unwrap_or_default(),
     })
 }

@@ -155,24 +155,75 @@ fn the_wire_configuration_carries_the_law() {
 /// the recorder build the same capped allocator).
 #[test]
 fn the_allocators_round_cap_is_flown_in_process_and_carried_by_the_words() {
-    use tvmd_core::AnyAllocator;
+    use tvmd_core::{AnyAllocator, RoundCap};
     use tvmd_sim::control::{core_of_scenario, wire_config};
     let mut s = Scenario {
-        allocator_max_rounds: Some(2),
+        allocator_max_rounds: Some(RoundCap::Rounds(3)),
         ..Scenario::default()
     };
     let (controller, _) = core_of_scenario::<f32>(&s).unwrap();
     let AnyAllocator::ExactBoundaryRedistribution(a) = controller.allocator() else {
         panic!("the default allocator is the exact-boundary redistribution");
     };
-    assert_eq!(a.max_rounds(), Some(2));
+    assert_eq!(a.round_cap(), RoundCap::Rounds(3));
     let words = wire_config(&s).unwrap();
-    assert_eq!(words.max_rounds, Some(2));
+    assert_eq!(words.max_rounds, RoundCap::Rounds(3));
     let built = words.build().unwrap();
     let AnyAllocator::ExactBoundaryRedistribution(a) = built.allocator() else {
         panic!("the words build the exact-boundary redistribution");
     };
-    assert_eq!(a.max_rounds(), Some(2));
+    assert_eq!(a.round_cap(), RoundCap::Rounds(3));
+    // No cap named: the library's default, resolved in the words; "uncapped" as named.
     s.allocator_max_rounds = None;
-    assert_eq!(wire_config(&s).unwrap().max_rounds, None);
+    assert_eq!(wire_config(&s).unwrap().max_rounds, RoundCap::default());
+    assert_eq!(RoundCap::default(), RoundCap::Rounds(2));
+    s.allocator_max_rounds = Some(RoundCap::Uncapped);
+    let words = wire_config(&s).unwrap();
+    assert_eq!(words.max_rounds, RoundCap::Uncapped);
+    let built = words.build().unwrap();
+    let AnyAllocator::ExactBoundaryRedistribution(a) = built.allocator() else {
+        panic!("the words build the exact-boundary redistribution");
+    };
+    assert_eq!(a.round_cap(), RoundCap::Uncapped);
+}
+
+/// Issue 59: the library's default caps the walk, the paper's scenarios name the uncapped
+/// walk they were first flown with (so their bits and recordings stay), and a scenario file
+/// says either.
+#[test]
+fn the_default_is_capped_and_the_papers_scenarios_fly_uncapped() {
+    use tvmd_core::RoundCap;
+    for name in [
+        "paper-tilt",
+        "relaxation-1.0",
+        "agent-failure",
+        "paper-experiment",
+    ] {
+        let s = Scenario::builtin(name).unwrap();
+        assert_eq!(s.allocator_max_rounds, Some(RoundCap::Uncapped), "{name}");
+    }
+    for name in ["hover", "turbulence", "initial-attitude-1.5"] {
+        let s = Scenario::builtin(name).unwrap();
+        assert_eq!(s.allocator_max_rounds, None, "{name}");
+    }
+    let file = |text: &str| Scenario::from_toml_str(text).map(|s| s.allocator_max_rounds);
+    assert_eq!(
+        file("allocator_max_rounds = \"uncapped\"\n").unwrap(),
+        Some(RoundCap::Uncapped)
+    );
+    assert_eq!(
+        file("allocator_max_rounds = 0\n").unwrap(),
+        Some(RoundCap::Rounds(0))
+    );
+    let e = file("allocator_max_rounds = \"none\"\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("allocator_max_rounds") && e.contains("uncapped"),
+        "{e}"
+    );
+    // And it round-trips through the scenario's TOML (the log's metadata).
+    let s = Scenario::builtin("paper-tilt").unwrap();
+    let back = Scenario::from_toml_str(&s.to_toml_string().unwrap()).unwrap();
+    assert_eq!(back.allocator_max_rounds, Some(RoundCap::Uncapped));
 }

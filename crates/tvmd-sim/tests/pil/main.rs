@@ -221,7 +221,7 @@ fn fault_scenario() -> Scenario {
     );
     let mut s = Scenario {
         controller_precision: Precision::F32,
-        allocator_max_rounds: Some(3),
+        allocator_max_rounds: Some(tvmd_core::RoundCap::Rounds(3)),
         ..Scenario::from_file(path).unwrap()
     };
     s.team.preset = Some("a6-inc".into());
@@ -276,7 +276,7 @@ fn pil_flight_with_fault_detection_and_a_round_cap_matches_the_host() {
 fn the_words_carry_fault_detection_and_the_round_cap() {
     let s = fault_scenario();
     let config = tvmd_sim::control::wire_config(&s).unwrap();
-    assert_eq!(config.max_rounds, Some(3));
+    assert_eq!(config.max_rounds, tvmd_core::RoundCap::Rounds(3));
     let settings = tvmd_sim::control::controller_settings::<f32>(&s).unwrap();
     assert_eq!(config.fault_detection, settings.fault_detection);
     assert!(config.fault_detection.is_some());

@@ -108,7 +108,18 @@ inline TvmdStatus config_from(const Settings &settings, const AgentParamHandles 
 	config.relaxation = settings.relaxation;
 	config.period = settings.law_rate_hz > 0 ? 1.0f / static_cast<float>(settings.law_rate_hz) : 0.0f;
 	config.allocator = static_cast<uint32_t>(settings.allocator);
-	config.allocator_max_rounds = static_cast<uint32_t>(settings.allocator_max_rounds);
+	// TVMD_ALLOC_CAP: rounds per period, -1 uncapped; only the exact-boundary redistribution
+	// (TVMD_ALLOC 3) has a walk to cap, the others take the default.
+	if (settings.allocator != static_cast<int32_t>(TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION)) {
+		config.allocator_round_cap = TVMD_ROUND_CAP_DEFAULT;
+
+	} else if (settings.allocator_max_rounds < 0) {
+		config.allocator_round_cap = TVMD_ROUND_CAP_UNCAPPED;
+
+	} else {
+		config.allocator_round_cap = TVMD_ROUND_CAP_ROUNDS;
+		config.allocator_max_rounds = static_cast<uint32_t>(settings.allocator_max_rounds);
+	}
 	config.rate_limited = settings.rate_limit > 0.0f ? 1u : 0u;
 	config.rate_limits[0] = settings.rate_limit;
 	config.rate_limits[1] = settings.rate_limit;

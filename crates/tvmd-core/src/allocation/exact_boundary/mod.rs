@@ -5,6 +5,7 @@
 pub(super) mod active;
 pub(super) mod constraint;
 mod cost;
+mod round_cap;
 mod walk;
 mod workspace;
 
@@ -12,6 +13,7 @@ use nalgebra::{Vector3, Vector6};
 
 use self::constraint::regular;
 pub use self::cost::WalkCost;
+pub use self::round_cap::{RoundCap, DEFAULT_MAX_ROUNDS};
 use self::walk::{on_boundary, Walk};
 use self::workspace::Workspace;
 use super::{
@@ -42,8 +44,8 @@ use crate::foundation::real::{eps, fmax, lit, Real};
 /// 3. that agent is held on that boundary from now on (a cone or sphere is re-entered after a
 ///    tangent step); an agent held on three independent boundaries stops moving.
 ///
-/// It ends when `r` is spent, nothing can move, or after `2 n + 4` rounds (or the cap of
-/// [`Self::with_max_rounds`], for a flight controller's period). A start that
+/// It ends when `r` is spent, nothing can move, after its round cap ([`Self::with_round_cap`]:
+/// 2 rounds by default, for a flight controller's period) or at most `2 n + 4` rounds. A start that
 /// already meets the request is returned as it is. The result is the candidate (the
 /// redistributed pseudo-inverse's forces, the walk's start and each of its points) with the
 /// smallest torque-first error, so it is never worse than the redistributed pseudo-inverse by
@@ -60,7 +62,7 @@ use crate::foundation::real::{eps, fmax, lit, Real};
 ///
 /// ```
 /// use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
-/// use tvmd_core::{ExactBoundaryRedistribution, GimbalCommand, RedistributedPseudoInverse};
+/// use tvmd_core::{ExactBoundaryRedistribution, GimbalCommand, RedistributedPseudoInverse, RoundCap};
 /// let team = presets::a4_inc::<f64, 4>()?;
 /// let effectiveness = team.effectiveness(&FailureMask::none());
 /// let set = AdmissibleSet::from_limits(team.limits());
@@ -70,16 +72,16 @@ use crate::foundation::real::{eps, fmax, lit, Real};
 /// let corner = GimbalCommand { eta_x: set.eta_x().hi, eta_y: set.eta_y().hi, thrust: 4.0 };
 /// let wrench = effectiveness.wrench(&[corner.force(); 4]);
 /// let request = AllocationRequest { effectiveness: &effectiveness, sets: &sets, wrench };
-/// let walked = ExactBoundaryRedistribution::new().allocate(&request);
+/// let walked = ExactBoundaryRedistribution::new().with_round_cap(RoundCap::Uncapped).allocate(&request);
 /// let clamped = RedistributedPseudoInverse.allocate(&request);
-/// // Measured: 0.0185 against 0.936 (N and N m, the whole wrench).
+/// // Measured: 0.0185 against 0.936 (N and N m, the whole wrench), uncapped.
 /// assert!(walked.wrench_error < 0.05 * clamped.wrench_error);
 /// # Ok::<(), tvmd_core::ConfigError>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExactBoundaryRedistribution<T: Real, const N: usize> {
     previous: Option<[Vector3<T>; N]>,
-    max_rounds: Option<u32>,
+    round_cap: RoundCap,
     last: WalkCost,
     workspace: Workspace<T, N>,
 }
@@ -88,7 +90,7 @@ impl<T: Real, const N: usize> Default for ExactBoundaryRedistribution<T, N> {
     fn default() -> Self {
         Self {
             previous: None,
-            max_rounds: None,
+            round_cap: RoundCap::default(),
             last: WalkCost::default(),
             workspace: Workspace::default(),
         }
@@ -107,24 +109,21 @@ impl<T: Real, const N: usize> ExactBoundaryRedistribution<T, N> {
     /// request the walk meets exactly unchanged.
     pub const TORQUE_PRIORITY: f64 = 100.0;
 
-    /// A new allocator with no previous forces.
+    /// A new allocator with no previous forces, its walk capped at [`DEFAULT_MAX_ROUNDS`].
     pub fn new() -> Self {
         Self::default()
     }
 
-    /// The same allocator with its walk capped at `rounds` rounds per allocation (`None`: no cap
-    /// beyond the built-in `2 n + 4`, the default). A capped walk returns the best forces it
-    /// found so far (by the torque-first error, never worse than the redistributed
-    /// pseudo-inverse's), inside every agent's set, and their true wrench error; `Some(0)` is
-    /// the redistributed pseudo-inverse (or the previous forces, when they do better).
-    pub fn with_max_rounds(mut self, rounds: Option<u32>) -> Self {
-        self.max_rounds = rounds;
+    /// The same allocator with its walk capped at `cap` ([`RoundCap::default`]: 2 rounds;
+    /// [`RoundCap::Uncapped`]: the walk's own `2 n + 4`).
+    pub fn with_round_cap(mut self, cap: RoundCap) -> Self {
+        self.round_cap = cap;
         self
     }
 
-    /// The cap of [`Self::with_max_rounds`].
-    pub fn max_rounds(&self) -> Option<u32> {
-        self.max_rounds
+    /// The cap of [`Self::with_round_cap`].
+    pub fn round_cap(&self) -> RoundCap {
+        self.round_cap
     }
 
     /// The work of the last allocation (zero before the first), within
@@ -263,7 +262,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
         if forces != start.forces && max_abs(&walk.remaining(&request.wrench)) > tol {
             walk.shed_internal();
         }
-        let limit = WalkCost::bound(e.working_count(), self.max_rounds.unwrap_or(u32::MAX)).rounds;
+        let limit = WalkCost::bound(e.working_count(), self.round_cap.rounds()).rounds;
         let mut rounds: u32 = 0;
         // The walk's best forces: a retraction onto a curved boundary can cost more wrench
         // than its step gained, and the result is never worse than the start.

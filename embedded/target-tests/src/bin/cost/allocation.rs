@@ -13,6 +13,7 @@ use core::hint::black_box;
 use cortex_m_semihosting::hprintln;
 use tvmd_core::nalgebra::{Vector3, Vector6};
 use tvmd_core::team::presets;
+use tvmd_core::RoundCap;
 use tvmd_core::{
     AdmissibleSet, AllocationRequest, Allocator, ExactBoundaryRedistribution, FailureMask,
     RedistributedPseudoInverse, TeamConfig,
@@ -83,19 +84,20 @@ fn team<const N: usize>(name: &str) -> Option<TeamConfig<f32, N>> {
 }
 
 /// The worst and median instructions of one allocation over `set`'s requests (`None` if the
-/// team was refused), printed with the stack peak and the comparison with the host (uncapped
-/// only: the host's forces are the default's); `cap` is the walk's round cap
-/// (`ExactBoundaryRedistribution::with_max_rounds`).
+/// team was refused), printed with the stack peak and the comparison with the host (the default
+/// cap only: the host's forces are the default's); `cap` is the walk's round cap
+/// (`ExactBoundaryRedistribution::with_round_cap`), `None` the default.
 pub fn report<const N: usize>(
     set: &SetTeam<N>,
-    cap: Option<u32>,
+    cap: Option<RoundCap>,
     per_tick: u32,
 ) -> Option<(u32, u32)> {
     let config = team::<N>(set.name)?;
     let mask = FailureMask::with_failed(set.failed).ok()?;
     let e = config.effectiveness(&mask);
     let sets = [AdmissibleSet::from_limits(config.limits()); N];
-    let mut a = ExactBoundaryRedistribution::<f32, N>::new().with_max_rounds(cap);
+    let mut a =
+        ExactBoundaryRedistribution::<f32, N>::new().with_round_cap(cap.unwrap_or_default());
     let mut counts = [0u32; 128];
     let mut paper = [0u32; 128];
     let (mut stack_peak, mut identical, mut worst_diff, mut max_rounds) = (0, 0, 0.0f32, 0);
@@ -155,8 +157,8 @@ pub fn report<const N: usize>(
     let (paper_worst, paper_median) = (sorted.last().copied()?, *sorted.get(n / 2)?);
     if cap.is_some() {
         hprintln!(
-            "cost: allocation {:10} (n = {:2}, {} requests), walk capped at {:?} rounds: {:6} instructions worst (request {}), {:6} median, {:2} rounds at most",
-            set.name, N, n, cap, worst, worst_at, median, max_rounds
+            "cost: allocation {:10} (n = {:2}, {} requests), walk {:?}: {:6} instructions worst (request {}), {:6} median, {:2} rounds at most",
+            set.name, N, n, cap.unwrap_or_default(), worst, worst_at, median, max_rounds
         );
         return Some((worst, median));
     }

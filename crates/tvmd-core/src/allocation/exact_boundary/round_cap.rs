@@ -1,0 +1,55 @@
+//! The exact-boundary walk's round cap per allocation: capped by default, so that a flight
+//! controller's cycle has a bounded, stated worst case ([`super::WalkCost::bound`]).
+
+/// Walk rounds of the default cap ([`RoundCap::default`]). Two: the allocation set's worst
+/// requests take 12-15 rounds uncapped at 10,000-13,000 Cortex-M4F instructions each, while two
+/// rounds recover most of what the walk adds over its start (`docs/allocation-benchmark.md`,
+/// "Round cap").
+pub const DEFAULT_MAX_ROUNDS: u32 = 2;
+
+/// How many rounds the exact-boundary redistribution may walk per allocation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RoundCap {
+    /// At most this many rounds (`Rounds(0)`: the walk's start alone, the redistributed
+    /// pseudo-inverse or the previous forces, whichever does better). A capped walk returns the
+    /// best forces it found, inside every agent's set, with their true wrench error.
+    Rounds(u32),
+    /// No cap beyond the walk's own `2 n + 4` rounds: the exact boundary's last corners, at up
+    /// to about 275,000 Cortex-M4F instructions for one n = 4 allocation (research, not a
+    /// flight controller's period).
+    Uncapped,
+}
+
+impl Default for RoundCap {
+    /// [`DEFAULT_MAX_ROUNDS`] rounds.
+    fn default() -> Self {
+        Self::Rounds(DEFAULT_MAX_ROUNDS)
+    }
+}
+
+impl RoundCap {
+    /// The cap as a number of rounds (`u32::MAX` when uncapped: no walk reaches it), as
+    /// [`super::WalkCost::bound`] takes it.
+    pub const fn rounds(self) -> u32 {
+        match self {
+            Self::Rounds(k) => k,
+            Self::Uncapped => u32::MAX,
+        }
+    }
+
+    /// `Some(k)` for `Rounds(k)`, `None` when uncapped.
+    pub const fn limit(self) -> Option<u32> {
+        match self {
+            Self::Rounds(k) => Some(k),
+            Self::Uncapped => None,
+        }
+    }
+
+    /// The cap of `limit` ([`Self::limit`]'s inverse).
+    pub const fn from_limit(limit: Option<u32>) -> Self {
+        match limit {
+            Some(k) => Self::Rounds(k),
+            None => Self::Uncapped,
+        }
+    }
+}
