@@ -70,12 +70,14 @@ fn step_error(e: tvmd_sim::SimError) -> PyErr {
 /// The simulator stepped one controller period at a time with your own controller.
 ///
 /// `Simulation(scenario="hover", *, toml, team, relaxation, allocator, precision, null_space,
-/// law, max_samples)`: the plant of `run` (actuators, failures, disturbances, noise). `reset()`
+/// law, max_samples, fault_detection, max_rounds)`: the plant of `run` (actuators, failures,
+/// disturbances, noise). `reset()`
 /// returns the first `Observation`; `step(commands)` holds (n, 3) `eta_x, eta_y, thrust` (or
 /// (n, 4), or normalized rotor speeds with `rotor_speeds=True`, or a `ScenarioController`'s
 /// output) and `step_wrench(u)` the allocation of a (6,) body wrench `[u_tau; u_f]` for one
 /// controller period, each returning the next `Observation`; `result()` is the flight so far.
-/// Bad actions raise `ValueError` and change nothing.
+/// Bad actions raise `ValueError` and change nothing. `copy.deepcopy` and `pickle` replay the
+/// steps since the last reset: the copy goes on exactly as the original.
 #[pyclass(module = "tvmd.sim", name = "Simulation")]
 pub(crate) struct PySimulation {
     sim: Simulation,
