@@ -3,7 +3,7 @@
 //! [`ConfigError`] variant (a configuration or failure mask refused); `50..=59` actuator-map
 //! errors. The mapping is exhaustive, so a new core variant fails to compile until it has a code.
 
-use tvmd_core::{ConfigError, InputError};
+use tvmd_core::{ConfigError, ConfigField, InputError};
 
 /// A status code returned by every fallible entry point (`TVMD_OK` or one of `TVMD_ERR_*`).
 pub type TvmdStatus = i32;
@@ -124,6 +124,12 @@ pub fn config_status(error: &ConfigError) -> TvmdStatus {
         ConfigError::NavigatorInertia => TVMD_ERR_CONFIG_NAVIGATOR_INERTIA,
         ConfigError::AgentInertia { .. } => TVMD_ERR_CONFIG_AGENT_INERTIA,
         ConfigError::NotSymmetricPositiveDefinite { .. } => TVMD_ERR_CONFIG_NOT_SPD,
+        // A gain that natural frequencies make overflow keeps its documented code (the core
+        // names the frequencies since issue 57; the status C callers test is unchanged).
+        ConfigError::Overflow {
+            field: ConfigField::NaturalFrequency,
+            ..
+        } => TVMD_ERR_CONFIG_NON_FINITE,
         ConfigError::Overflow { .. } => TVMD_ERR_CONFIG_OVERFLOW,
         ConfigError::RankDeficient { .. } => TVMD_ERR_CONFIG_RANK_DEFICIENT,
         ConfigError::AgentCount { .. } => TVMD_ERR_CONFIG_AGENT_COUNT,

@@ -1,7 +1,9 @@
 //! `tvmd.Controller`: one `step` per control period (its output in [`crate::step_output`]),
 //! with the law the `law` argument names (default the offset-free law).
 
+use pyo3::intern;
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyType};
 
 use tvmd_core::{AnyAllocator, Controller, ControllerSettings};
 use tvmd_scenario::{LawConfig, NullSpaceConfig};
@@ -9,11 +11,11 @@ use tvmd_sim::control::law_settings;
 
 use crate::afs::PyAfs;
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
-use crate::convert::null_space_arg;
+use crate::controller_args::{argument_error, deep_copy, period_arg};
 use crate::convert::{class_arg, commands_array, finite, iteration_cap, law_arg, matrix};
 use crate::convert::{fault_detection_arg, record_to_py, round_cap_arg};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
-use crate::errors::{cycle_error, value_error, OrRaise};
+use crate::errors::{cycle_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
 use crate::planner::{planner, PyPlannerResult};
 use crate::step_output::{AllocationStageData, PyAllocationStage, PyLawStage};
@@ -45,6 +47,8 @@ pub struct PyController {
     null_space: Option<NullSpaceConfig>,
     /// The law as asked for (`law`), whose settings the core holds.
     law: LawConfig,
+    /// The constructor's arguments by name (deep-copied), which `pickle` rebuilds from.
+    arguments: Py<PyDict>,
 }
 
 #[pymethods]
@@ -58,6 +62,7 @@ impl PyController {
     )]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         team: &Bound<'_, PyAny>,
         gains: Option<&Bound<'_, PyAny>>,
         relaxation: Option<f64>,
@@ -76,23 +81,55 @@ impl PyController {
         fault_detection: Option<&Bound<'_, PyAny>>,
         max_rounds: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let arguments = PyDict::new(py);
+        arguments.set_item("team", team)?;
+        let named: [(&str, Option<&Bound<'_, PyAny>>); 6] = [
+            ("gains", gains),
+            ("rate_limits", rate_limits),
+            ("failed", failed),
+            ("weights", weights),
+            ("law", law),
+            ("fault_detection", fault_detection),
+        ];
+        for (name, value) in named {
+            arguments.set_item(name, value)?;
+        }
+        arguments.set_item("relaxation", relaxation)?;
+        arguments.set_item("gravity", gravity)?;
+        arguments.set_item("period", period)?;
+        arguments.set_item("allocator", allocator)?;
+        arguments.set_item("regularization", regularization)?;
+        arguments.set_item("planner_tolerance", planner_tolerance)?;
+        // Integers as Python ints (a constructed controller's fit i64).
+        let int = |i: &Option<Int>| i.as_ref().and_then(Int::get::<i64>);
+        arguments.set_item("planner_max_iterations", int(&planner_max_iterations))?;
+        arguments.set_item("s", s)?;
+        arguments.set_item("null_space", null_space)?;
+        arguments.set_item("max_rounds", int(&max_rounds))?;
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
+        period_arg(period)?;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
-        let null_space = null_space_arg(null_space)?;
+        let null_space = null_space
+            .map(tvmd_sim::RunRequest::parse_null_space)
+            .transpose()
+            .map_err(|e| argument_error("null_space", e))?;
         let stage = match &null_space {
-            Some(c) => Some(c.stage::<f64>().map_err(value_error)?),
+            Some(c) => Some(
+                c.stage::<f64>()
+                    .map_err(|e| argument_error("null_space", e.into()))?,
+            ),
             None => None,
         };
         let law = law.map_or(Ok(LawConfig::default()), |l| law_arg(l, "law"))?;
         let (gain_schedule, offset_free, attitude_rate) =
-            law_settings::<f64>(&law).map_err(value_error)?;
+            law_settings::<f64>(&law).map_err(|e| argument_error("law", e))?;
         let fault_detection = match fault_detection {
             Some(f) => Some(
                 tvmd_sim::control::fault_detection::<f64>(&fault_detection_arg(
                     f,
                     "fault_detection",
                 )?)
-                .map_err(value_error)?,
+                .map_err(|e| argument_error("fault_detection", e))?,
             ),
             None => None,
         };
@@ -123,12 +160,60 @@ impl PyController {
         if planner_tolerance.is_some() || planner_max_iterations.is_some() {
             inner.set_planner(planner(relaxation, planner_tolerance, max_iterations)?);
         }
+        let arguments = deep_copy(arguments)?;
         Ok(Self {
             inner,
             max_iterations,
             null_space,
             law,
+            arguments,
         })
+    }
+
+    /// `pickle` support: the controller as constructed (`Controller._restore` calls the
+    /// constructor with the same arguments), with its current failures and landed flag. The
+    /// flight state (previous commands, offset-free state, planned-rate filter, fault
+    /// detector) starts afresh, as after `reset()`; `copy.deepcopy` keeps it.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Py<PyDict>, Vec<usize>, bool))> {
+        let restore = slf.get_type().getattr(intern!(slf.py(), "_restore"))?;
+        let this = borrow(slf)?;
+        let arguments = this.arguments.clone_ref(slf.py());
+        Ok((restore, (arguments, this.failed(), this.inner.landed())))
+    }
+
+    /// The controller of `__reduce__`'s data.
+    #[classmethod]
+    fn _restore<'py>(
+        cls: &Bound<'py, PyType>,
+        arguments: &Bound<'py, PyDict>,
+        failed: Vec<usize>,
+        landed: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let controller = cls.call((), Some(arguments))?;
+        controller.call_method1(intern!(cls.py(), "set_failures"), (failed,))?;
+        controller.call_method1(intern!(cls.py(), "set_landed"), (landed,))?;
+        Ok(controller)
+    }
+
+    /// An independent controller in the same state (`copy.copy`): what follows, on either,
+    /// is what would have followed on the original.
+    fn __copy__(slf: &Bound<'_, Self>) -> PyResult<Self> {
+        let this = borrow(slf)?;
+        Ok(Self {
+            inner: this.inner.clone(),
+            max_iterations: this.max_iterations,
+            null_space: this.null_space,
+            law: this.law,
+            arguments: this.arguments.clone_ref(slf.py()),
+        })
+    }
+
+    /// As `__copy__` (`copy.deepcopy`): the controller owns no Python object.
+    fn __deepcopy__(slf: &Bound<'_, Self>, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Self::__copy__(slf)
     }
 
     #[doc = include_str!("../docstrings/tvmd.Controller.fault_report.txt")]

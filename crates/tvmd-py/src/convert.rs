@@ -15,11 +15,11 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 use pyo3::{intern, IntoPyObjectExt};
 
 use tvmd_core::{AgentCommand, Relaxation};
-use tvmd_scenario::{NullSpaceConfig, Scenario};
+use tvmd_scenario::Scenario;
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::ScenarioSource;
 
-use crate::errors::{sim_error, value_error, OrRaise, READ};
+use crate::errors::{sim_error, OrRaise, READ};
 
 mod commands;
 mod law;
@@ -424,14 +424,6 @@ pub(crate) fn relaxation_arg(
         }
     };
     Relaxation::new(value).or_raise()
-}
-
-/// A `null_space` argument ("margin", "inward-tilt=<rad>"), checked.
-pub(crate) fn null_space_arg(spec: Option<&str>) -> PyResult<Option<NullSpaceConfig>> {
-    // The one parser of the option, shared with the command line and `tvmd.sim.run`.
-    spec.map(tvmd_sim::RunRequest::parse_null_space)
-        .transpose()
-        .map_err(value_error)
 }
 
 /// A `max_samples` argument (named `name`): `None` keeps every tick, `n >= 0` at most `n`

@@ -51,6 +51,15 @@ pub(crate) fn config_error(e: tvmd_core::ConfigError) -> PyErr {
     err
 }
 
+/// A `tvmd.ConfigError` of the binding's own with `message` and `field`.
+pub(crate) fn config_error_of(message: String, field: &str) -> PyErr {
+    let err = ConfigError::new_err(message);
+    Python::attach(|py| {
+        let _ = err.value(py).setattr("field", field);
+    });
+    err
+}
+
 impl<T> OrRaise<T> for Result<T, tvmd_core::ConfigError> {
     fn or_raise(self) -> PyResult<T> {
         self.map_err(config_error)

@@ -91,6 +91,16 @@ record! {
             Ok(Self { inner })
         }
 
+        /// `pickle` support: `Gains(k_x, k_r, k_xi)` of the same matrices.
+        #[allow(clippy::type_complexity)]
+        fn __reduce__<'py>(
+            slf: &Bound<'py, Self>,
+        ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>))> {
+            let (py, g) = (slf.py(), &slf.get().inner);
+            let args = (matrix(py, &g.k_x())?, matrix(py, &g.k_r())?, matrix(py, &k_xi(g))?);
+            Ok((slf.get_type().into_any(), args))
+        }
+
         /// The paper's gains.
         #[staticmethod]
         fn paper() -> Self {

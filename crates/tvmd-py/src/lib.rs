@@ -7,10 +7,11 @@
 //!
 //! Modules import one way (no circle; `a <- b` reads "b imports a"): `errors` and `record`
 //! import no module of the crate, nor does `interrupt` (Ctrl-C for long calls), `convert` only `errors`, and every other module imports
-//! those three as it needs; above them, `afs <- planner`, `afs, law <- team <- allocation`,
+//! those three as it needs; above them, `afs <- planner`, `afs, law, team_data <- team <- allocation`,
 //! `afs, allocation, law, planner <- step_output`,
-//! `afs, allocation, law, planner, step_output, team <- controller`, and for the simulator
-//! `sim_result <- runs <- sim, executor, stepping <- sim_batch` (`stepping` also imports `law`); `atlas` and `montecarlo` import only `convert`, `errors` and
+//! `afs, allocation, controller_args, law, planner, step_output, team <- controller`, and for the simulator
+//! `sim_result <- runs <- sim, executor, stepping <- sim_batch` (`stepping` also imports `law`
+//! and `replay`, which imports no module of the crate); `atlas` and `montecarlo` import only `convert`, `errors` and
 //! `interrupt`. This file imports every module and no module imports it.
 #![deny(
     clippy::unwrap_used,
@@ -29,6 +30,7 @@ mod afs;
 mod allocation;
 mod atlas;
 mod controller;
+mod controller_args;
 mod convert;
 mod errors;
 mod executor;
@@ -37,6 +39,7 @@ mod law;
 mod montecarlo;
 mod planner;
 mod record;
+mod replay;
 mod runs;
 mod sim;
 mod sim_batch;
@@ -44,6 +47,7 @@ mod sim_result;
 mod step_output;
 mod stepping;
 mod team;
+mod team_data;
 
 use convert::CAPACITY;
 

@@ -2,7 +2,8 @@
 //!
 //! One list of fields gives the frozen `#[pyclass]` (holding the Rust value), one getter per
 //! field (converted on access, so every array is a fresh copy), the `FIELDS` tuple, `to_dict()`
-//! (nested records become nested dicts) and a dataclass-like `__repr__`.
+//! (nested records become nested dicts), a dataclass-like `__repr__`, and `copy.copy` /
+//! `copy.deepcopy` (the record itself: records are frozen).
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -75,6 +76,20 @@ macro_rules! record {
                 py: pyo3::Python<'py>,
             ) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyDict>> {
                 $crate::record::to_dict(py, self.record_fields(py)?)
+            }
+
+            /// The record itself: it is immutable (`copy.copy`).
+            fn __copy__<'py>(slf: &pyo3::Bound<'py, Self>) -> pyo3::Bound<'py, Self> {
+                slf.clone()
+            }
+
+            /// The record itself: it is immutable, so a deep copy may share it
+            /// (`copy.deepcopy`, as for a tuple of numbers).
+            fn __deepcopy__<'py>(
+                slf: &pyo3::Bound<'py, Self>,
+                _memo: &pyo3::Bound<'py, pyo3::PyAny>,
+            ) -> pyo3::Bound<'py, Self> {
+                slf.clone()
             }
 
             fn __repr__(&self, py: pyo3::Python<'_>) -> pyo3::PyResult<String> {

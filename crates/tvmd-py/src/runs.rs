@@ -9,12 +9,13 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use tvmd_scenario::{LawConfig, LimitsConfig, TeamSpec};
+use tvmd_scenario::{FaultDetectionConfig, LawConfig, LimitsConfig, TeamSpec};
 use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{RunRequest, ScenarioSource};
 
-use crate::convert::{law_arg, retention_arg, scalars, scenario_source, shape_error, Int};
+use crate::convert::{fault_detection_arg, law_arg, retention_arg, scalars};
+use crate::convert::{scenario_source, shape_error, Int};
 use crate::errors::{sim_error, value_error, WRITE};
 use crate::interrupt::{interruptible, Ended};
 use crate::sim_result::{PySimResult, SimData};
@@ -56,6 +57,10 @@ pub(crate) struct RunArgs<'a, 'py> {
     pub(crate) team_config: Option<TeamConfigArg>,
     /// The converted `law` ([`law_arg`]), or None for the scenario's.
     pub(crate) law: Option<LawConfig>,
+    /// The converted `fault_detection`, or None for the scenario's `[fault_detection]`.
+    pub(crate) fault_detection: Option<FaultDetectionConfig>,
+    /// `max_rounds`: the scenario's `allocator_max_rounds` replaced, or None for its own.
+    pub(crate) max_rounds: Option<u32>,
 }
 
 impl RunArgs<'_, '_> {
@@ -78,6 +83,7 @@ impl RunArgs<'_, '_> {
             allocator: self.allocator,
             team: self.team,
             law: self.law,
+            fault_detection: self.fault_detection,
             log: self.mcap,
             samples: self.samples,
             ..RunRequest::default()
@@ -94,10 +100,71 @@ impl RunArgs<'_, '_> {
     /// ([`RunRequest::spec`]: the log is checked too, and never the scenario file).
     pub(crate) fn spec(mut self, scenario_name: &str) -> PyResult<RunSpec> {
         let team = self.team_config.take();
+        let max_rounds = self.max_rounds;
         let mut spec = self.request(scenario_name)?.spec().map_err(value_error)?;
         fly_team(&mut spec, team)?;
+        if max_rounds.is_some() {
+            spec.scenario.allocator_max_rounds = max_rounds;
+            spec.scenario.validate().map_err(value_error)?;
+        }
         Ok(spec)
     }
+}
+
+/// The scenario of a `Simulation`, `ScenarioController` or `SimulationBatch`: `run`'s
+/// arguments, the built-in `"hover"` when neither `scenario` nor `toml` is given; `control`
+/// the converted `fault_detection` and `max_rounds` ([`control_args`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn spec(
+    py: Python<'_>,
+    scenario: Option<&Bound<'_, PyAny>>,
+    toml: Option<String>,
+    team: Option<&Bound<'_, PyAny>>,
+    relaxation: Option<f64>,
+    allocator: Option<String>,
+    precision: Option<String>,
+    null_space: Option<String>,
+    law: Option<&Bound<'_, PyAny>>,
+    max_samples: Option<&Int>,
+    control: (Option<FaultDetectionConfig>, Option<u32>),
+) -> PyResult<RunSpec> {
+    let (team, team_config) = team_arg(team)?;
+    let hover = PyString::new(py, "hover").into_any();
+    let scenario = scenario
+        .filter(|s| !s.is_none())
+        .or(toml.is_none().then_some(&hover));
+    RunArgs {
+        scenario,
+        toml,
+        team,
+        team_config,
+        relaxation,
+        allocator,
+        precision,
+        null_space,
+        law: law.map(|l| law_arg(l, "law")).transpose()?,
+        samples: retention_arg(max_samples, "max_samples")?,
+        fault_detection: control.0,
+        max_rounds: control.1,
+        ..RunArgs::default()
+    }
+    .spec("scenario")
+}
+
+/// The `fault_detection` (as `tvmd.Controller`'s) and `max_rounds` (the scenario's
+/// `allocator_max_rounds`) arguments of `run` and `Simulation`.
+pub(crate) fn control_args(
+    fault_detection: Option<&Bound<'_, PyAny>>,
+    max_rounds: Option<&Int>,
+) -> PyResult<(Option<FaultDetectionConfig>, Option<u32>)> {
+    let detection = fault_detection
+        .filter(|f| !f.is_none())
+        .map(|f| fault_detection_arg(f, "fault_detection"))
+        .transpose()?;
+    let rounds = max_rounds
+        .map(|r| r.to("max_rounds", 0, i128::from(u32::MAX)))
+        .transpose()?;
+    Ok((detection, rounds))
 }
 
 /// Flies `team` (a `tvmd.Team`'s team and limits, [`team_arg`]) in `spec` instead of its
@@ -221,6 +288,7 @@ pub(crate) fn run_request(
         team,
         team_config: None,
         law,
+        ..RunArgs::default()
     }
     .request(&format!("{name}['scenario']"))?;
     let (mut spec, input) = checked(request)?;

@@ -14,8 +14,8 @@ use tvmd_scenario::{Scenario, BUILTIN_NAMES};
 use crate::convert::{jobs_arg, law_arg, retention_arg, Int};
 use crate::errors::value_error;
 use crate::runs::{batch_label, run_items, run_items_keeping, run_specs};
+use crate::runs::{control_args, team_arg, RunArgs};
 use crate::runs::{sweep_label, sweep_run_specs};
-use crate::runs::{team_arg, RunArgs};
 use crate::sim_result::{PySimResult, SimData};
 use tvmd_sim::runner::RunSpec;
 use tvmd_sim::SampleRetention;
@@ -37,7 +37,7 @@ fn scenario_toml(name: &str) -> PyResult<String> {
 
 #[doc = include_str!("../docstrings/tvmd.sim.run.txt")]
 #[pyfunction]
-#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None, law = None))]
+#[pyo3(signature = (scenario = None, *, toml = None, mcap = None, relaxation = None, allocator = None, precision = None, pil = None, null_space = None, max_samples = None, team = None, law = None, fault_detection = None, max_rounds = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -52,8 +52,11 @@ fn run(
     max_samples: Option<Int>,
     team: Option<&Bound<'_, PyAny>>,
     law: Option<&Bound<'_, PyAny>>,
+    fault_detection: Option<&Bound<'_, PyAny>>,
+    max_rounds: Option<Int>,
 ) -> PyResult<PySimResult> {
     let (team, team_config) = team_arg(team)?;
+    let (fault_detection, max_rounds) = control_args(fault_detection, max_rounds.as_ref())?;
     let samples = retention_arg(max_samples.as_ref(), "max_samples")?;
     let law = law.map(|l| law_arg(l, "law")).transpose()?;
     let spec = RunArgs {
@@ -69,6 +72,8 @@ fn run(
         team,
         team_config,
         law,
+        fault_detection,
+        max_rounds,
     }
     .spec("scenario")?;
     run_specs(py, vec![spec], Some(1), |_, _| String::new())?

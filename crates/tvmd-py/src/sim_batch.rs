@@ -10,14 +10,15 @@ use tvmd_sim::SimError;
 
 use crate::convert::{batch_commands_arg, batch_wrench_arg, shaped, table, Int};
 use crate::errors::value_error;
-use crate::stepping::spec;
+use crate::runs::spec;
 
 /// Many teams of one scenario stepped together inside Rust, one call per batch step.
 ///
 /// `SimulationBatch(scenario="hover", *, count, jobs, ...)` (`Simulation`'s scenario
 /// arguments). `reset`, `step_wrench((B, 6))` and `step((B, n, 3))` return a dict of `(B, ...)`
 /// arrays (`t`, `position`, `velocity_world`, `angular_velocity`, `rotation`, `true_position`,
-/// `reference_position`, `reference_velocity`, `reference_rotation`, `done`, `saturation`
+/// `reference_position`, `reference_velocity`, `reference_rotation`,
+/// `reference_angular_velocity`, `done`, `saturation`
 /// (B, n, 3): what the plant clamped off each team's last commands) and `errors` (one message
 /// or None per team: a failed team does not stop the others).
 #[pyclass(module = "tvmd.sim", name = "SimulationBatch")]
@@ -48,7 +49,7 @@ fn arrays<'py>(
         .map(|k| ok(k).map_or(f64::NAN, |s| s.observation.t))
         .collect();
     out.set_item("t", shaped(py, t, &[b])?)?;
-    let fields: [(&str, &Field); 6] = [
+    let fields: [(&str, &Field); 7] = [
         ("position", &|s| s.observation.state.position.into()),
         ("velocity_world", &|s| s.observation.state.velocity.into()),
         ("angular_velocity", &|s| s.observation.state.omega.into()),
@@ -58,6 +59,9 @@ fn arrays<'py>(
         }),
         ("reference_velocity", &|s| {
             s.observation.reference.velocity.into()
+        }),
+        ("reference_angular_velocity", &|s| {
+            s.observation.reference.omega.into()
         }),
     ];
     for (name, f) in fields {
@@ -146,7 +150,17 @@ impl PySimulationBatch {
         let teams = count.to("count", 1, 1 << 20)?;
         let jobs = jobs.map(|j| j.to("jobs", 1, 1024)).transpose()?;
         let spec = spec(
-            py, scenario, toml, team, relaxation, allocator, precision, null_space, law, None,
+            py,
+            scenario,
+            toml,
+            team,
+            relaxation,
+            allocator,
+            precision,
+            null_space,
+            law,
+            None,
+            (None, None),
         )?;
         // The batch keeps no samples: it is for many short steps, not for results.
         let options = SimOptions {

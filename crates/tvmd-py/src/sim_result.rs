@@ -45,6 +45,10 @@ pub(crate) struct SimData {
     hover_roll_limit: Option<f64>,
     mass: Option<f64>,
     n: usize,
+    /// Your own controller flew (`Simulation.step` with commands or `step_wrench`): the
+    /// scenario's law and relaxation did not.
+    #[serde(default)]
+    own_controller: bool,
 }
 
 impl SimData {
@@ -62,7 +66,24 @@ impl SimData {
             sample_stride: result.sample_stride,
             summary: result.summary,
             scenario,
+            own_controller: false,
         }
+    }
+
+    /// The run of your own controller (`Simulation`): `law` and `relaxation` are None.
+    pub(crate) fn own_controller(mut self, own: bool) -> Self {
+        self.own_controller = own;
+        self
+    }
+
+    /// The law that flew, or None for your own controller.
+    fn law(&self) -> Option<&'static str> {
+        (!self.own_controller).then(|| self.scenario.law.name())
+    }
+
+    /// The relaxation `s` that flew, or None for your own controller.
+    fn relaxation(&self) -> Option<f64> {
+        (!self.own_controller).then_some(self.scenario.relaxation)
     }
 
     fn mcap_string(&self) -> Option<String> {
@@ -146,11 +167,13 @@ impl SimData {
     fn repr(&self) -> String {
         let mcap = self.mcap_string();
         format!(
-            "SimResult(scenario_name='{}', law='{}', relaxation={}, allocator='{}', \
+            "SimResult(scenario_name='{}', law={}, relaxation={}, allocator='{}', \
              precision='{}', samples={}, n_agents={}, mcap_path={})",
             self.scenario.name,
-            self.scenario.law.name(),
-            self.scenario.relaxation,
+            self.law()
+                .map_or_else(|| "None".to_string(), |l| format!("'{l}'")),
+            self.relaxation()
+                .map_or_else(|| "None".to_string(), |s| s.to_string()),
             self.scenario.allocator,
             self.scenario.controller_precision,
             self.samples.len(),
@@ -165,14 +188,15 @@ record! {
     "SimResult" in "tvmd.sim" => PySimResult(SimData) repr SimData::repr |py, o| {
         /// Name of the scenario that ran.
         scenario_name => o.scenario.name.as_str(),
-        /// Planner relaxation `s` of the run.
-        relaxation => o.scenario.relaxation,
+        /// Planner relaxation `s` of the run; None for your own controller's (`Simulation`).
+        relaxation => o.relaxation(),
         /// Allocator of the run.
         allocator => o.scenario.allocator.as_str(),
         /// The null-space stage of the run ("margin", "inward-tilt=<rad>"), or None.
         null_space => o.scenario.null_space.map(|n| n.to_string()),
-        /// The control law that flew: "paper", "offset-free" or "custom".
-        law => o.scenario.law.name(),
+        /// The control law that flew: "paper", "offset-free" or "custom"; None for your own
+        /// controller's flight (`Simulation.step` with commands, `step_wrench`).
+        law => o.law(),
         /// The float type the controller flew in, "f64" or "f32".
         precision => o.scenario.controller_precision.as_str(),
         /// Where the controller ran: "host", or the emulated target of a processor-in-the-loop

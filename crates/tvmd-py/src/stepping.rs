@@ -6,9 +6,9 @@
 
 use std::sync::Mutex;
 
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyString;
+use pyo3::types::{PyBytes, PyDict, PyType};
 
 use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_sim::control::{core_reference, core_state};
@@ -16,49 +16,14 @@ use tvmd_sim::runner::RunSpec;
 use tvmd_sim::sim::{Observation, SimOptions, Simulation, Verdict};
 use tvmd_sim::{AnyTvmdController, FlightController, FlightOutput};
 
-use crate::convert::{commands_arg, law_arg, matrix, record_to_py, retention_arg, shaped};
+use crate::convert::{commands_arg, matrix, record_to_py, shaped};
 use crate::convert::{finite, wrench_arg, Int};
 use crate::errors::value_error;
 use crate::law::{PyReference, PyState};
 use crate::record::record;
-use crate::runs::{team_arg, RunArgs};
+use crate::replay::{Action, ReplayLog};
+use crate::runs::{control_args, spec};
 use crate::sim_result::{PySimResult, SimData};
-
-/// The scenario of a `Simulation` or `ScenarioController`: `run`'s arguments, the built-in
-/// `"hover"` when neither `scenario` nor `toml` is given.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn spec(
-    py: Python<'_>,
-    scenario: Option<&Bound<'_, PyAny>>,
-    toml: Option<String>,
-    team: Option<&Bound<'_, PyAny>>,
-    relaxation: Option<f64>,
-    allocator: Option<String>,
-    precision: Option<String>,
-    null_space: Option<String>,
-    law: Option<&Bound<'_, PyAny>>,
-    max_samples: Option<&Int>,
-) -> PyResult<RunSpec> {
-    let (team, team_config) = team_arg(team)?;
-    let hover = PyString::new(py, "hover").into_any();
-    let scenario = scenario
-        .filter(|s| !s.is_none())
-        .or(toml.is_none().then_some(&hover));
-    RunArgs {
-        scenario,
-        toml,
-        team,
-        team_config,
-        relaxation,
-        allocator,
-        precision,
-        null_space,
-        law: law.map(|l| law_arg(l, "law")).transpose()?,
-        samples: retention_arg(max_samples, "max_samples")?,
-        ..RunArgs::default()
-    }
-    .spec("scenario")
-}
 
 /// An observation and whether the run is over.
 pub(crate) struct ObservationData {
@@ -105,16 +70,22 @@ fn step_error(e: tvmd_sim::SimError) -> PyErr {
 /// The simulator stepped one controller period at a time with your own controller.
 ///
 /// `Simulation(scenario="hover", *, toml, team, relaxation, allocator, precision, null_space,
-/// law, max_samples)`: the plant of `run` (actuators, failures, disturbances, noise). `reset()`
+/// law, max_samples, fault_detection, max_rounds)`: the plant of `run` (actuators, failures,
+/// disturbances, noise). `reset()`
 /// returns the first `Observation`; `step(commands)` holds (n, 3) `eta_x, eta_y, thrust` (or
 /// (n, 4), or normalized rotor speeds with `rotor_speeds=True`, or a `ScenarioController`'s
 /// output) and `step_wrench(u)` the allocation of a (6,) body wrench `[u_tau; u_f]` for one
 /// controller period, each returning the next `Observation`; `result()` is the flight so far.
-/// Bad actions raise `ValueError` and change nothing.
+/// Bad actions raise `ValueError` and change nothing. `copy.deepcopy` and `pickle` replay the
+/// steps since the last reset: the copy goes on exactly as the original.
 #[pyclass(module = "tvmd.sim", name = "Simulation")]
 pub(crate) struct PySimulation {
     sim: Simulation,
     spec: RunSpec,
+    /// `max_samples` as given (`pickle` builds the copy with it).
+    max_samples: Option<u64>,
+    /// What the simulation did since its last reset (copies replay it).
+    log: ReplayLog,
 }
 
 impl PySimulation {
@@ -135,7 +106,7 @@ impl PySimulation {
 #[pymethods]
 impl PySimulation {
     #[new]
-    #[pyo3(signature = (scenario = None, *, toml = None, team = None, relaxation = None, allocator = None, precision = None, null_space = None, law = None, max_samples = None))]
+    #[pyo3(signature = (scenario = None, *, toml = None, team = None, relaxation = None, allocator = None, precision = None, null_space = None, law = None, max_samples = None, fault_detection = None, max_rounds = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -148,7 +119,10 @@ impl PySimulation {
         null_space: Option<String>,
         law: Option<&Bound<'_, PyAny>>,
         max_samples: Option<Int>,
+        fault_detection: Option<&Bound<'_, PyAny>>,
+        max_rounds: Option<Int>,
     ) -> PyResult<Self> {
+        let control = control_args(fault_detection, max_rounds.as_ref())?;
         let spec = spec(
             py,
             scenario,
@@ -160,12 +134,90 @@ impl PySimulation {
             null_space,
             law,
             max_samples.as_ref(),
+            control,
         )?;
         let options = SimOptions {
             samples: spec.samples,
         };
         let sim = Simulation::with_options(&spec.scenario, options).map_err(value_error)?;
-        Ok(Self { sim, spec })
+        Ok(Self {
+            sim,
+            spec,
+            max_samples: max_samples.as_ref().and_then(Int::get::<u64>),
+            log: ReplayLog::default(),
+        })
+    }
+
+    /// An independent simulation in the same state (`copy.copy`, `copy.deepcopy`): the
+    /// same scenario with every reset and step since the last reset replayed, so what follows
+    /// is what would have followed on the original (only `result().summary`'s wall time
+    /// differs).
+    fn __copy__(&self) -> PyResult<Self> {
+        let options = SimOptions {
+            samples: self.spec.samples,
+        };
+        let mut sim =
+            Simulation::with_options(&self.spec.scenario, options).map_err(value_error)?;
+        self.log.replay(&mut sim).map_err(PyRuntimeError::new_err)?;
+        Ok(Self {
+            sim,
+            spec: self.spec.clone(),
+            max_samples: self.max_samples,
+            log: self.log.clone(),
+        })
+    }
+
+    /// As `__copy__`.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
+        self.__copy__()
+    }
+
+    /// `pickle` support: the scenario as TOML, `max_samples` and the replay log; unpickling
+    /// (`Simulation._restore`) builds the simulation and replays the log, as `__copy__`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (String, Option<u64>, Bound<'py, PyBytes>),
+    )> {
+        let this = slf.borrow();
+        let toml = this.scenario_toml()?;
+        let log = this
+            .log
+            .to_bytes()
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot pickle a Simulation: {e}")))?;
+        let restore = slf.get_type().getattr("_restore")?;
+        Ok((
+            restore,
+            (toml, this.max_samples, PyBytes::new(slf.py(), &log)),
+        ))
+    }
+
+    /// The simulation of `__reduce__`'s data.
+    #[classmethod]
+    fn _restore<'py>(
+        cls: &Bound<'py, PyType>,
+        toml: String,
+        max_samples: Option<u64>,
+        log: &[u8],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let kwargs = PyDict::new(cls.py());
+        kwargs.set_item("toml", toml)?;
+        kwargs.set_item("max_samples", max_samples)?;
+        let restored = cls.call((), Some(&kwargs))?;
+        {
+            let sim = restored.cast::<Self>()?;
+            let mut this = sim.borrow_mut();
+            let this = &mut *this;
+            this.log = ReplayLog::from_bytes(log).map_err(|e| {
+                PyValueError::new_err(format!("not a pickled Simulation's log: {e}"))
+            })?;
+            this.log
+                .replay(&mut this.sim)
+                .map_err(PyRuntimeError::new_err)?;
+        }
+        Ok(restored)
     }
 
     /// Starts over (optionally reseeding the state noise, from another initial pose); the
@@ -187,9 +239,12 @@ impl PySimulation {
         let attitude = attitude_rpy
             .map(|a| finite::<3, 1>(a, "attitude_rpy"))
             .transpose()?;
-        self.sim
-            .reset_at(seed, position.map(Into::into), attitude.map(Into::into))
-            .map_err(step_error)?;
+        let action = Action::Reset {
+            seed,
+            position: position.map(Into::into),
+            attitude: attitude.map(Into::into),
+        };
+        self.log.apply(&mut self.sim, action).map_err(step_error)?;
         self.observation()
     }
 
@@ -205,12 +260,16 @@ impl PySimulation {
     #[pyo3(signature = (commands, *, rotor_speeds = false))]
     fn step(&mut self, commands: &Bound<'_, PyAny>, rotor_speeds: bool) -> PyResult<PyObservation> {
         if let Ok(out) = commands.cast::<PyControllerOutput>() {
-            let out = out.get().inner.clone();
-            self.sim.step_output(out).map_err(step_error)?;
+            let action = Action::output(&out.get().inner);
+            self.log.apply(&mut self.sim, action).map_err(step_error)?;
         } else {
             let n = self.sim.agents();
             let commands = commands_arg(commands, n, rotor_speeds, self.sim.max_thrust())?;
-            self.sim.step(&commands).map_err(step_error)?;
+            let action = Action::Output {
+                commands,
+                diagnostics: None,
+            };
+            self.log.apply(&mut self.sim, action).map_err(step_error)?;
         }
         self.observation()
     }
@@ -220,7 +279,8 @@ impl PySimulation {
     /// mass; the scenario controller's allocation stage makes it admissible commands.
     fn step_wrench(&mut self, wrench: &Bound<'_, PyAny>) -> PyResult<PyObservation> {
         let wrench = wrench_arg(wrench)?;
-        self.sim.step_wrench(&wrench).map_err(step_error)?;
+        let action = Action::Wrench(wrench);
+        self.log.apply(&mut self.sim, action).map_err(step_error)?;
         self.observation()
     }
 
@@ -229,7 +289,8 @@ impl PySimulation {
         let mut result = self.sim.result();
         result.summary.verdict = Verdict::judge(&result.summary, &self.spec.scenario.success);
         PySimResult {
-            inner: SimData::new(self.spec.clone(), result),
+            inner: SimData::new(self.spec.clone(), result)
+                .own_controller(self.log.own_controller()),
         }
     }
 
@@ -368,7 +429,17 @@ impl PyScenarioController {
         law: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let spec = spec(
-            py, scenario, toml, team, relaxation, allocator, precision, null_space, law, None,
+            py,
+            scenario,
+            toml,
+            team,
+            relaxation,
+            allocator,
+            precision,
+            null_space,
+            law,
+            None,
+            (None, None),
         )?;
         let inner = AnyTvmdController::from_scenario(&spec.scenario).map_err(value_error)?;
         let n = spec.scenario.team_body().map_err(value_error)?.len();

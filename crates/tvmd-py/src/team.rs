@@ -17,6 +17,7 @@ use crate::convert::{shape_error, shape_str, shaped, table, Int, CAPACITY};
 use crate::errors::{ConfigError, OrRaise};
 use crate::law::PyPlant;
 use crate::record::record;
+use crate::team_data::TeamData;
 
 /// A `tvmd.Team` as the simulator's team and limits (`[team]` with explicit agents and
 /// `[limits]` of a scenario): the same positions, quarter turns, masses, navigator, gimbal limits
@@ -315,6 +316,40 @@ record! {
     ) -> PyResult<Self> {
         let limits = AgentLimits::new(sigma_x, sigma_y, max_thrust).or_raise()?;
         Self::wrap(presets::ring(count(&n, "n")?, radius, inconsistent, limits))
+    }
+
+    /// `pickle` support: the team's data, rebuilt by `Team._restore`.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
+        let restore = slf.get_type().getattr("_restore")?;
+        let args = TeamData::of(&slf.get().inner).args();
+        Ok((restore, args.into_pyobject(slf.py())?))
+    }
+
+    /// The team of `__reduce__`'s data (the same team, bit for bit).
+    #[classmethod]
+    #[allow(clippy::too_many_arguments)]
+    fn _restore(
+        _cls: &Bound<'_, pyo3::types::PyType>,
+        positions: Vec<[f64; 3]>,
+        quarter_turns: Vec<i32>,
+        masses: Vec<f64>,
+        agent_inertias: Vec<[f64; 9]>,
+        limits: (f64, f64, f64, f64, f64),
+        navigator_mass: f64,
+        navigator_inertia: [f64; 9],
+    ) -> PyResult<Self> {
+        let data = TeamData {
+            positions,
+            quarter_turns,
+            masses,
+            agent_inertias,
+            limits,
+            navigator_mass,
+            navigator_inertia,
+        };
+        Self::wrap(data.team())
     }
 
     /// `M(Xi)` (6, 3n) of eq. (4); columns of failed agents are zero.

@@ -5,10 +5,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use tvmd_log::paths::{check_output_dir, check_outputs, file_stem, write_file};
 use tvmd_log::LiveOptions;
+use tvmd_scenario::ScenarioError;
 use tvmd_sim::control::hover_roll_limit;
 use tvmd_sim::runner::*;
 use tvmd_sim::sim::SampleRetention;
-use tvmd_sim::{RunRequest, ScenarioSource};
+use tvmd_sim::{RunRequest, ScenarioSource, SimError};
 use tvmd_studies::plot::{self, PlotSeries};
 
 use crate::error::CliError;
@@ -35,6 +36,24 @@ pub struct RunArgs {
     pub(crate) live: Option<LiveOptions>,
 }
 
+/// `--detect` refused for a law without the disturbance observer (a paper-law scenario, or
+/// `--law paper`): the message says which law to fly.
+fn detect_hint(e: SimError, law_given: bool) -> SimError {
+    match e {
+        SimError::Scenario(ScenarioError::InvalidScenario { field, reason })
+            if field == "fault_detection" =>
+        {
+            let hint = if law_given {
+                "--detect flies with `--law offset-free` only"
+            } else {
+                "this scenario flies a law without it: add `--law offset-free` to --detect"
+            };
+            SimError::invalid_field(field, format!("{reason}; {hint}"))
+        }
+        other => other,
+    }
+}
+
 pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
     // The one run request of the command line and Python: parses the options (errors name
     // them), loads the scenario, applies the overrides and validates.
@@ -54,7 +73,10 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
         ..RunRequest::default()
     }
     .with_strings(a.precision.as_deref(), a.pil.as_deref(), None)?;
-    let mut spec = request.spec()?;
+    let mut spec = request.spec().map_err(|e| match &a.detect {
+        Some(_) => detect_hint(e, a.law.is_some()),
+        None => e,
+    })?;
     let stem = file_stem(&spec.scenario.name);
     let log = if a.no_log {
         None

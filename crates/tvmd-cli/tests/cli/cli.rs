@@ -342,8 +342,25 @@ fn detect_option_reports_the_fault_and_needs_the_observer() {
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("fault_detection"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("fault_detection"), "{stderr}");
+    assert!(stderr.contains("--law offset-free"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 57: `--detect` on a scenario that flies the paper's law says which law it needs.
+#[test]
+fn detect_on_a_paper_law_scenario_names_the_law_it_needs() {
+    let out = bin()
+        .args(["run", "paper-tilt", "--no-log", "--detect", "mask"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("fault_detection") && stderr.contains("add `--law offset-free`"),
+        "{stderr}"
+    );
 }
 
 /// Issue 57: `catalogue --help` says what a row of `catalogue.csv` is (a team and an

@@ -98,8 +98,10 @@ impl<T: Real> NaturalGains<T> {
     /// poles; for a `J_C` with products of inertia the congruence keeps them symmetric positive
     /// definite (the poles then hold only approximately).
     ///
-    /// Errors: as [`Gains::new`] (a non-finite product, e.g. an overflow, is
-    /// [`ConfigError::NonFinite`] naming the gain).
+    /// Errors: as [`Gains::new`], except that a non-finite product (an overflow: frequencies
+    /// or damping ratios too large for the team in this float type) is
+    /// [`ConfigError::Overflow`] naming [`ConfigField::NaturalFrequency`], the input, and the
+    /// gain in its quantity.
     pub fn gains(&self, mass: T, inertia: &Matrix3<T>) -> Result<Gains<T>, ConfigError> {
         let two = T::one() + T::one();
         let w = &self.position_frequency;
@@ -112,7 +114,18 @@ impl<T: Real> NaturalGains<T> {
             * two)
             .map(T::sqrt);
         let k_omega = congruence(inertia, &s);
-        Gains::new(k_x, k_r, k_omega, k_v)
+        Gains::new(k_x, k_r, k_omega, k_v).map_err(|e| match e {
+            ConfigError::NonFinite { field } => ConfigError::Overflow {
+                quantity: match field {
+                    ConfigField::GainKx => "gain K_x = m_C w^2",
+                    ConfigField::GainKv => "gain K_v = 2 m_C zeta w",
+                    ConfigField::GainKr => "gain K_R (J_C and w^2)",
+                    _ => "gain K_Omega (J_C, zeta and w)",
+                },
+                field: ConfigField::NaturalFrequency,
+            },
+            other => other,
+        })
     }
 }
 
@@ -149,13 +162,20 @@ mod tests {
                 field: ConfigField::DampingRatio
             })
         );
-        // Finite settings whose gain overflows are refused by the gain check.
+        // Finite settings whose gain overflows are refused naming the input (issue 57).
         let huge = NaturalGains::<f32>::uniform((1e20, 1.0), (1.0, 1.0)).unwrap();
-        assert_eq!(
-            huge.gains(1.0, &Matrix3::identity()),
-            Err(ConfigError::NonFinite {
-                field: ConfigField::GainKx
-            })
+        let err = huge.gains(1.0, &Matrix3::identity()).unwrap_err();
+        assert_eq!(err.field(), Some(ConfigField::NaturalFrequency));
+        assert!(
+            matches!(err, ConfigError::Overflow { quantity, .. } if quantity.contains("K_x")),
+            "{err:?}"
+        );
+        let huge = NaturalGains::<f64>::uniform((1.0, 1.0), (1e160, 1.0)).unwrap();
+        let err = huge.gains(1.0, &Matrix3::identity()).unwrap_err();
+        assert_eq!(err.field(), Some(ConfigField::NaturalFrequency));
+        assert!(
+            matches!(err, ConfigError::Overflow { quantity, .. } if quantity.contains("K_R")),
+            "{err:?}"
         );
     }
 

@@ -79,7 +79,8 @@ class CycleError(InputError):
 @final
 class Team:
     """The team configuration ``Xi = {(p_i, psi_i)}`` with agent limits, masses and navigator
-    (paper, "Modeling"; eqs. 3-6), validated. Up to 64 agents.
+    (paper, "Modeling"; eqs. 3-6), validated. Up to 64 agents. Immutable: ``copy.deepcopy``
+    returns it, ``pickle`` rebuilds the same team bit for bit (as ``Gains`` and the records).
 
     Args:
         positions: (n, 3) agent positions ``p_i`` in the team CoM frame {C} (m).
@@ -920,6 +921,12 @@ class Controller:
     arguments are converted before the controller is borrowed, so a conversion that runs
     Python code (an ``__array__`` method) never finds it busy. The order of two threads' steps is
     theirs to arrange: each ``step`` advances the one controller state.
+
+    Copies: ``copy.copy`` and ``copy.deepcopy`` give an independent controller in the same state
+    (previous commands, offset-free state, planned-rate filter, fault detector): both go on
+    exactly as the original would. ``pickle`` rebuilds the controller from its constructor's
+    arguments with its current failures (``set_failures``) and landed flag; its flight state
+    starts afresh, as after ``reset()``.
 
     Args:
         team: the ``Team``.

@@ -19,7 +19,10 @@ z up.
 
 Observation (``Box`` of 18 float32): the position error ``x - x_r`` (3, m, world frame), the
 velocity error ``x_dot - x_dot_r`` (3, m/s, world frame), the attitude ``R`` (9, body to world,
-row-major) and the body rates ``Omega`` (3, rad/s), of the fed-back (noisy, delayed) state.
+row-major) and the body rates ``Omega`` (3, rad/s), of the fed-back (noisy, delayed) state. With
+``observe_reference=True`` (a setting; default off, the 18 values above) 12 more follow, what the
+reward's attitude term compares against: the reference attitude ``R_r`` (9, row-major) and the
+reference body rates ``Omega_r`` (3, rad/s) of the same tick (30 float32 in all).
 
 Actions, two modes (``action=``):
 
@@ -87,7 +90,13 @@ ENVIRONMENTS = {
     "tvmd/AgentFailure-v0": {"toml": AGENT_FAILURE_TOML},
 }
 
-_OBSERVATION = spaces.Box(-np.inf, np.inf, shape=(18,), dtype=np.float32)
+
+
+def _observation_space(observe_reference: Any) -> spaces.Box:
+    # The observation box: 18 values, 30 with the reference attitude and rates.
+    if not isinstance(observe_reference, (bool, np.bool_)):
+        raise ValueError(f"`observe_reference` must be a bool, got {observe_reference!r}")
+    return spaces.Box(-np.inf, np.inf, shape=(30 if observe_reference else 18,), dtype=np.float32)
 
 
 def _action_bounds(simulation: Any, action: str) -> tuple[np.ndarray, np.ndarray]:
@@ -173,6 +182,8 @@ class TeamEnv(gym.Env):
         initial_tilt: largest initial roll and pitch (rad, in [0, pi]).
         max_position_error: the episode terminates beyond it (m, finite, positive).
         max_tilt: the episode terminates beyond it (rad, in (0, pi]).
+        observe_reference: append the reference attitude ``R_r`` (9) and rates ``Omega_r`` (3)
+            to the observation (30 values; default False: the 18 of before).
 
     A bad argument raises ``ValueError`` naming it, here rather than at a later reset; so do an
     ``initial_offset`` and ``initial_tilt`` whose farthest pose the scenario refuses (an agent
@@ -193,10 +204,13 @@ class TeamEnv(gym.Env):
         initial_tilt: float = 0.1,
         max_position_error: float = 2.0,
         max_tilt: float = 1.2,
+        observe_reference: bool = False,
         render_mode: Optional[str] = None,
         **simulation: Any,
     ) -> None:
         self.weights = _check(action, weights)
+        self.observation_space = _observation_space(observe_reference)
+        self.observe_reference = bool(observe_reference)
         if render_mode is not None:
             raise ValueError("TeamEnv does not render")
         self.render_mode = render_mode
@@ -209,15 +223,14 @@ class TeamEnv(gym.Env):
         self._low, self._high = _action_bounds(self.sim, action)
         self._scale = np.maximum(np.abs(self._low), np.abs(self._high))
         self.action_space = spaces.Box(self._low.astype(np.float32), self._high.astype(np.float32), dtype=np.float32)
-        self.observation_space = _OBSERVATION
         self._last = self._vector(first)
 
-    @staticmethod
-    def _vector(obs: Any) -> np.ndarray:
+    def _vector(self, obs: Any) -> np.ndarray:
         s, r = obs.state, obs.reference
-        return np.concatenate(
-            [s.position - r.position, obs.velocity_world - r.velocity, s.attitude.reshape(9), s.angular_velocity]
-        ).astype(np.float32)
+        parts = [s.position - r.position, obs.velocity_world - r.velocity, s.attitude.reshape(9), s.angular_velocity]
+        if self.observe_reference:
+            parts += [r.attitude.reshape(9), r.angular_velocity]
+        return np.concatenate(parts).astype(np.float32)
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
         """Starts an episode from a perturbed pose (drawn with the environment's generator)."""
@@ -286,10 +299,13 @@ class TeamVectorEnv(gym.vector.VectorEnv):
         initial_tilt: float = 0.1,
         max_position_error: float = 2.0,
         max_tilt: float = 1.2,
+        observe_reference: bool = False,
         jobs: Optional[int] = None,
         **simulation: Any,
     ) -> None:
         self.weights = _check(action, weights)
+        self.single_observation_space = _observation_space(observe_reference)
+        self.observe_reference = bool(observe_reference)
         self.num_envs = int(num_envs)
         self.batch = _sim.SimulationBatch(scenario, count=self.num_envs, jobs=jobs, **simulation)
         one = _sim.Simulation(scenario, **simulation)
@@ -298,13 +314,12 @@ class TeamVectorEnv(gym.vector.VectorEnv):
         self._low, self._high = _action_bounds(one, action)
         self._scale = np.maximum(np.abs(self._low), np.abs(self._high))
         self.single_action_space = spaces.Box(self._low.astype(np.float32), self._high.astype(np.float32), dtype=np.float32)
-        self.single_observation_space = _OBSERVATION
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
         checked = _check_task(one, self._home, initial_offset, initial_tilt, max_position_error, max_tilt)
         self.initial_offset, self.initial_tilt, self.max_position_error, self.max_tilt = checked
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
-        self._last = np.zeros((self.num_envs, 18), dtype=np.float32)
+        self._last = np.zeros((self.num_envs, self.single_observation_space.shape[0]), dtype=np.float32)
 
     def _reset_teams(self, indices: np.ndarray) -> dict[str, Any]:
         m = len(indices)
@@ -315,18 +330,17 @@ class TeamVectorEnv(gym.vector.VectorEnv):
         attitudes = np.column_stack([tilts, np.zeros(m)])
         return self.batch.reset([int(k) for k in indices], seeds=seeds, positions=self._home + offsets, attitudes_rpy=attitudes)
 
-    @staticmethod
-    def _vectors(d: dict[str, Any]) -> np.ndarray:
+    def _vectors(self, d: dict[str, Any]) -> np.ndarray:
         b = len(d["t"])
-        return np.concatenate(
-            [
-                d["position"] - d["reference_position"],
-                d["velocity_world"] - d["reference_velocity"],
-                d["rotation"].reshape(b, 9),
-                d["angular_velocity"],
-            ],
-            axis=1,
-        ).astype(np.float32)
+        parts = [
+            d["position"] - d["reference_position"],
+            d["velocity_world"] - d["reference_velocity"],
+            d["rotation"].reshape(b, 9),
+            d["angular_velocity"],
+        ]
+        if self.observe_reference:
+            parts += [d["reference_rotation"].reshape(b, 9), d["reference_angular_velocity"]]
+        return np.concatenate(parts, axis=1).astype(np.float32)
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
         """Resets every team (initial poses drawn with the environment's generator)."""

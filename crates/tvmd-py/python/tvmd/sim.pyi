@@ -53,7 +53,9 @@ class SimResult:
 
     Attributes:
         scenario_name, law (the control law that flew: ``"paper"``, ``"offset-free"`` or
-        ``"custom"``), relaxation (``s``), allocator, null_space (the null-space stage or None),
+        ``"custom"``; None when your own controller flew, a ``Simulation`` stepped with commands
+        or wrenches), relaxation (``s``; None likewise), allocator, null_space (the null-space
+        stage or None),
         precision (``"f64"`` or ``"f32"``, the
         controller's float type), controller_target (``"host"`` or the PIL target), mcap_path
         (str or None), n_agents,
@@ -95,12 +97,15 @@ class SimResult:
     def scenario_name(self) -> str:
         """Name of the scenario that ran."""
     @property
-    def law(self) -> Literal["paper", "offset-free", "custom"]:
+    def law(self) -> Optional[Literal["paper", "offset-free", "custom"]]:
         """The control law that flew (the scenario's ``law``, or ``run``'s override):
-        ``"paper"``, ``"offset-free"`` or ``"custom"`` (any other ``[law]`` table)."""
+        ``"paper"``, ``"offset-free"`` or ``"custom"`` (any other ``[law]`` table); None for the
+        flight of a ``Simulation`` that your own controller stepped (commands not from a
+        ``ScenarioController``, or ``step_wrench``)."""
     @property
-    def relaxation(self) -> float:
-        """Planner relaxation ``s`` of the run."""
+    def relaxation(self) -> Optional[float]:
+        """Planner relaxation ``s`` of the run; None when your own controller flew (as
+        ``law``)."""
     @property
     def allocator(self) -> AllocatorName:
         """Allocator of the run."""
@@ -336,6 +341,12 @@ class Simulation:
     ``SimulationBatch``; ``Observation.saturation`` says by how much it clamped each agent's
     command. tvmd's own commands are inside that range. Non-finite commands are refused.
 
+    Copies: ``copy.copy``, ``copy.deepcopy`` and ``pickle`` replay the simulation's reset and
+    steps since its last reset on a simulation of the same scenario (``scenario_toml``), so the
+    copy is in the same state, noise generator included, and every later step gives exactly the
+    original's observation (only ``result().summary``'s wall time differs). A copy costs the
+    replay of those steps.
+
     Example::
 
         sim = tvmd.sim.Simulation("hover")
@@ -355,6 +366,9 @@ class Simulation:
             the null-space stage are ``step_wrench``'s; ``precision`` and ``law`` concern
             ``ScenarioController`` built with the same arguments).
         max_samples: the samples ``result()`` keeps, as ``run``'s.
+        fault_detection, max_rounds: as ``run``'s (the round cap is ``step_wrench``'s
+            allocator's; fault detection concerns ``ScenarioController`` built from
+            ``scenario_toml``).
 
     Raises:
         ValueError: a scenario or override that cannot be used; a step with commands of the
@@ -375,6 +389,8 @@ class Simulation:
         null_space: Optional[str] = None,
         law: Optional[_LawArg] = None,
         max_samples: Optional[int] = None,
+        fault_detection: Optional[Union[Literal["report", "mask"], Mapping[str, Any]]] = None,
+        max_rounds: Optional[int] = None,
     ) -> "Simulation": ...
     def reset(
         self,
@@ -504,7 +520,8 @@ class SimulationBatch:
     Every call returns a dict of the teams' observations (the fed-back state):
     ``t`` (B,), ``position``, ``velocity_world``, ``angular_velocity`` (B, 3), ``rotation``
     (B, 3, 3), ``true_position`` (B, 3), ``reference_position``, ``reference_velocity`` (B, 3),
-    ``reference_rotation`` (B, 3, 3),
+    ``reference_rotation`` (B, 3, 3), ``reference_angular_velocity`` (B, 3) (the reference's
+    body rates ``Omega_r``),
     ``done`` (B,) bool (the duration is reached: reset that team), ``saturation`` (B, n, 3): by how
     much the plant clamped each team's last commands to the hardware's range, as
     ``Observation.saturation`` (NaN for a failed team), and ``errors`` (a list of B messages or
@@ -601,6 +618,8 @@ def run(
     max_samples: Optional[int] = None,
     team: Optional[Union[str, Team]] = None,
     law: Optional[_LawArg] = None,
+    fault_detection: Optional[Union[Literal["report", "mask"], Mapping[str, Any]]] = None,
+    max_rounds: Optional[int] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -659,6 +678,13 @@ def run(
             paper scenarios fly ``"paper"``; the families and any TOML that names no ``law``,
             ``toml=`` text included, ``"offset-free"``).
             ``SimResult.law`` says which flew. Not with ``pil`` unless ``"paper"``.
+        fault_detection: turn on agent fault detection in the controller (scenario table
+            ``[fault_detection]``), as ``tvmd.Controller``'s ``fault_detection``: ``"report"``,
+            ``"mask"`` or a dict of the table's keys; it needs the offset-free law's observer.
+            ``summary["fault"]`` reports what it found. Default None: the scenario's own.
+        max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
+            (scenario field ``allocator_max_rounds``; bounds its worst-case cost). Default None:
+            the scenario's own.
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
