@@ -105,7 +105,7 @@ impl PyController {
         arguments.set_item("planner_max_iterations", int(&planner_max_iterations))?;
         arguments.set_item("s", s)?;
         arguments.set_item("null_space", null_space)?;
-        arguments.set_item("max_rounds", int(&max_rounds))?;
+        arguments.set_item("max_rounds", &max_rounds)?;
         let team = class_arg::<PyTeam>(team, "team")?.get().inner;
         period_arg(period)?;
         let relaxation = relaxation_arg(relaxation, s, Some(0.5))?;
@@ -116,7 +116,7 @@ impl PyController {
         let stage = match &null_space {
             Some(c) => Some(
                 c.stage::<f64>()
-                    .map_err(|e| argument_error("null_space", e.into()))?,
+                    .map_err(|e| argument_error("null_space", e))?,
             ),
             None => None,
         };

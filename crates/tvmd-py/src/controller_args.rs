@@ -14,8 +14,8 @@ use crate::errors::{config_error_of, value_error};
 
 /// A tvmd-sim error about the controller's argument `argument` (`law`, `fault_detection`,
 /// `null_space`): the argument and its key, not a scenario field.
-pub(crate) fn argument_error(argument: &str, e: SimError) -> PyErr {
-    match e {
+pub(crate) fn argument_error(argument: &str, e: impl Into<SimError>) -> PyErr {
+    match e.into() {
         SimError::Scenario(ScenarioError::InvalidScenario { field, reason }) => {
             // The scenario's path of the key, without the argument's own table.
             let key = field

@@ -14,12 +14,14 @@ use tvmd_sim::runner::{self, sweep_specs, RunOutcome, RunSpec};
 use tvmd_sim::sim::SampleRetention;
 use tvmd_sim::{RunRequest, ScenarioSource};
 
+use crate::convert::round_cap_arg;
 use crate::convert::{fault_detection_arg, law_arg, retention_arg, scalars};
 use crate::convert::{scenario_source, shape_error, Int};
 use crate::errors::{sim_error, value_error, WRITE};
 use crate::interrupt::{interruptible, Ended};
 use crate::sim_result::{PySimResult, SimData};
 use crate::team::{team_spec, PyTeam};
+use tvmd_core::RoundCap;
 
 /// A `tvmd.Team` as a scenario's team and limits.
 pub(crate) type TeamConfigArg = (TeamSpec, LimitsConfig);
@@ -60,7 +62,7 @@ pub(crate) struct RunArgs<'a, 'py> {
     /// The converted `fault_detection`, or None for the scenario's `[fault_detection]`.
     pub(crate) fault_detection: Option<FaultDetectionConfig>,
     /// `max_rounds`: the scenario's `allocator_max_rounds` replaced, or None for its own.
-    pub(crate) max_rounds: Option<u32>,
+    pub(crate) max_rounds: Option<RoundCap>,
 }
 
 impl RunArgs<'_, '_> {
@@ -126,7 +128,7 @@ pub(crate) fn spec(
     null_space: Option<String>,
     law: Option<&Bound<'_, PyAny>>,
     max_samples: Option<&Int>,
-    control: (Option<FaultDetectionConfig>, Option<u32>),
+    control: (Option<FaultDetectionConfig>, Option<RoundCap>),
 ) -> PyResult<RunSpec> {
     let (team, team_config) = team_arg(team)?;
     let hover = PyString::new(py, "hover").into_any();
@@ -155,16 +157,13 @@ pub(crate) fn spec(
 /// `allocator_max_rounds`) arguments of `run` and `Simulation`.
 pub(crate) fn control_args(
     fault_detection: Option<&Bound<'_, PyAny>>,
-    max_rounds: Option<&Int>,
-) -> PyResult<(Option<FaultDetectionConfig>, Option<u32>)> {
+    max_rounds: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Option<FaultDetectionConfig>, Option<RoundCap>)> {
     let detection = fault_detection
         .filter(|f| !f.is_none())
         .map(|f| fault_detection_arg(f, "fault_detection"))
         .transpose()?;
-    let rounds = max_rounds
-        .map(|r| r.to("max_rounds", 0, i128::from(u32::MAX)))
-        .transpose()?;
-    Ok((detection, rounds))
+    Ok((detection, round_cap_arg(max_rounds)?))
 }
 
 /// Flies `team` (a `tvmd.Team`'s team and limits, [`team_arg`]) in `spec` instead of its

@@ -53,7 +53,7 @@ fn run(
     team: Option<&Bound<'_, PyAny>>,
     law: Option<&Bound<'_, PyAny>>,
     fault_detection: Option<&Bound<'_, PyAny>>,
-    max_rounds: Option<Int>,
+    max_rounds: Option<Bound<'_, PyAny>>,
 ) -> PyResult<PySimResult> {
     let (team, team_config) = team_arg(team)?;
     let (fault_detection, max_rounds) = control_args(fault_detection, max_rounds.as_ref())?;

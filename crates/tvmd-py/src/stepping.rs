@@ -120,7 +120,7 @@ impl PySimulation {
         law: Option<&Bound<'_, PyAny>>,
         max_samples: Option<Int>,
         fault_detection: Option<&Bound<'_, PyAny>>,
-        max_rounds: Option<Int>,
+        max_rounds: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let control = control_args(fault_detection, max_rounds.as_ref())?;
         let spec = spec(

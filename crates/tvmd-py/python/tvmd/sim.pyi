@@ -390,7 +390,7 @@ class Simulation:
         law: Optional[_LawArg] = None,
         max_samples: Optional[int] = None,
         fault_detection: Optional[Union[Literal["report", "mask"], Mapping[str, Any]]] = None,
-        max_rounds: Optional[int] = None,
+        max_rounds: Optional[Union[int, Literal["uncapped"]]] = None,
     ) -> "Simulation": ...
     def reset(
         self,
@@ -619,7 +619,7 @@ def run(
     team: Optional[Union[str, Team]] = None,
     law: Optional[_LawArg] = None,
     fault_detection: Optional[Union[Literal["report", "mask"], Mapping[str, Any]]] = None,
-    max_rounds: Optional[int] = None,
+    max_rounds: Optional[Union[int, Literal["uncapped"]]] = None,
 ) -> SimResult:
     """Runs one scenario with the tvmd controller in the loop (tvmd-sim: rapier3d rigid body at
     ``physics.dt``, controller every ``controller_period`` with zero-order hold) and returns its
@@ -683,8 +683,9 @@ def run(
             ``"mask"`` or a dict of the table's keys; it needs the offset-free law's observer.
             ``summary["fault"]`` reports what it found. Default None: the scenario's own.
         max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
-            (scenario field ``allocator_max_rounds``; bounds its worst-case cost). Default None:
-            the scenario's own.
+            (scenario field ``allocator_max_rounds``; bounds its worst-case cost): an int >= 0
+            or "uncapped". Default None: the scenario's own (a scenario that names none flies
+            the library's default, 2 rounds).
 
     Raises:
         ValueError: unknown scenario, TOML that does not parse or a field that is not valid (the
