@@ -3,7 +3,8 @@
 # warnings as errors; the C test program, linked against the staticlib, runs the paper team
 # (hover, the saturating tilt, failure masks, every error path, the actuator channel map) and
 # the default offset-free law (law_test.c: convergence under an unmodelled force, the landed
-# hold, bad law values), and its record is replayed on the Rust API bit for bit; the thumbv7em staticlib builds and every
+# hold, bad law values), and its record is replayed on the Rust API bit for bit; a fuzz of the
+# handle's storage (every word, several patterns) runs under a watchdog; the thumbv7em staticlib builds and every
 # entry point links there without a panic path (embedded/ffi-check). The header's staleness is
 # checked by `cargo test -p tvmd-ffi --test header` (part of `cargo test --workspace`).
 # Installs a C/C++ compiler with apt-get where one is missing.
@@ -36,6 +37,15 @@ cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tv
   "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl -o "$out/tvmd_test"
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
+
+step "storage corruption: every word of a created handle overwritten, each case forked under a watchdog"
+# crates/tvmd-ffi/tests/c/storage_fuzz.c: no entry point hangs (alarm) or crashes; every call
+# returns TVMD_OK with finite outputs inside the created configuration's admissible set, or an
+# error status (TVMD_ERR_CORRUPTED where a count, flag or enum tag is refused).
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/storage_fuzz"
+"$out/storage_fuzz"
 
 step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"
 c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \

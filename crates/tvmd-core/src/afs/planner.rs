@@ -90,6 +90,11 @@ pub struct AttitudePlanner<T: Real> {
     max_iterations: u32,
 }
 
+/// The most iterations any planner runs, whatever its cap ([`AttitudePlanner::with_tolerance`]):
+/// more than a bisection of `[0, pi]` down to the smallest positive `f64` takes (about 1,080),
+/// so a larger cap changes no plan, only how long a bracket that stopped shrinking is held.
+pub const PLANNER_ITERATION_LIMIT: u32 = 2048;
+
 impl<T: Real> AttitudePlanner<T> {
     /// A planner with relaxation `s`, tolerance `max(1e-10, 8 eps)` rad and at most 64 iterations.
     pub fn new(relaxation: Relaxation<T>) -> Self {
@@ -100,7 +105,8 @@ impl<T: Real> AttitudePlanner<T> {
         }
     }
 
-    /// Sets the search tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
+    /// Sets the search tolerance on `theta` (rad, positive) and the iteration cap (>= 1; the
+    /// search stops at [`PLANNER_ITERATION_LIMIT`] whatever the cap).
     pub fn with_tolerance(
         mut self,
         tolerance: T,
@@ -240,7 +246,9 @@ impl<T: Real> AttitudePlanner<T> {
             }
         };
         let mut iterations = 0;
-        while hi - lo > self.tolerance && iterations < self.max_iterations {
+        // Bounded by the constant too: a cap a stray write changed cannot spin the loop.
+        let cap = self.max_iterations.min(PLANNER_ITERATION_LIMIT);
+        while hi - lo > self.tolerance && iterations < cap {
             iterations += 1;
             let width = hi - lo;
             let guard = self.tolerance * half;
@@ -429,5 +437,28 @@ mod tests {
             );
         }
         assert!(!guide(&cone, &Vector3::new(0.0, 0.0, f64::NAN)).1);
+    }
+
+    /// A cap above [`PLANNER_ITERATION_LIMIT`] (a stored cap a stray write changed, or a
+    /// caller's) stops the search at the limit with the limit's plan: the smallest tolerance
+    /// never closes the bracket, which stops shrinking long before.
+    #[test]
+    fn the_search_stops_at_the_constant_limit_whatever_the_cap() {
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let afs = team.afs(&FailureMask::none()).unwrap();
+        let relaxation = Relaxation::new(0.5).unwrap();
+        let force = Vector3::new(0.0, 0.0, 2.8 * 9.81);
+        let r_r = crate::foundation::rotation::roll(1.2);
+        let planner = |cap| {
+            AttitudePlanner::new(relaxation)
+                .with_tolerance(f64::from_bits(1), cap)
+                .unwrap()
+                .plan(&afs, &r_r, &force)
+                .unwrap()
+        };
+        let unbounded = planner(u32::MAX);
+        assert_eq!(unbounded.status, PlannerStatus::Planned);
+        assert_eq!(unbounded.iterations, PLANNER_ITERATION_LIMIT);
+        assert_eq!(unbounded, planner(PLANNER_ITERATION_LIMIT));
     }
 }
