@@ -59,6 +59,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use core::mem::ManuallyDrop;
     use core::ptr::addr_of_mut;
 
