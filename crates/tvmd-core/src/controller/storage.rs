@@ -37,17 +37,24 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let plant = addr_of!((*this).plant).read();
         let limits = addr_of!((*this).team.limits).read();
         let admissible = addr_of!((*this).admissible).read();
-        // Flags 0 or 1, none past the team; the working count (a second copy of the team's
-        // size) is the team's less its failed agents.
-        let mut flags = true;
-        let mut failed_in_team = 0_usize;
-        for (i, b) in failed.iter().enumerate() {
-            flags &= *b == 0 || (*b == 1 && i < len);
-            failed_in_team += usize::from(*b == 1);
+        // Flags 0 or 1 (their OR has no other bit), and the working count (a second copy of the
+        // team's size) the team's less the failed agents: a flag set past the team, or a
+        // changed size, makes the two disagree. Four flags a word, branch-free: a word's flags
+        // sum to its top byte times 0x01010101 (exact while each is 0 or 1, else refused).
+        let (mut bits, mut failed_agents) = (0_u32, 0_usize);
+        let mut words = failed.chunks_exact(4);
+        for word in &mut words {
+            let w = u32::from_le_bytes(<[u8; 4]>::try_from(word).unwrap_or([0xff; 4]));
+            bits |= w;
+            failed_agents += (w.wrapping_mul(0x0101_0101) >> 24) as usize;
+        }
+        for b in words.remainder() {
+            bits |= u32::from(*b);
+            failed_agents += usize::from(*b);
         }
         (1..=N).contains(&len)
-            && flags
-            && len.checked_sub(failed_in_team) == Some(working)
+            && bits & 0xfefe_fefe == 0
+            && len.checked_sub(failed_agents) == Some(working)
             && capable <= 1
             && limit < HOVER_LIMITS
             && margin.is_finite()
