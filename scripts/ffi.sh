@@ -45,6 +45,14 @@ step "storage corruption: every word of a created handle overwritten, each case 
 cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
   crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
   -o "$out/storage_fuzz"
+# Again against an optimized build (the ci profile: release without fat LTO), which may exploit
+# what a stray write leaves (a tag assumed in range) where debug code does not: a hang in
+# tvmd_step from the effectiveness blocks' tags showed only here (issue 57, item 7).
+cargo build --locked -p tvmd-ffi --profile ci
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/ci/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/storage_fuzz_optimized"
+"$out/storage_fuzz_optimized"
 "$out/storage_fuzz"
 
 step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"

@@ -15,7 +15,7 @@ const HOVER_LIMITS: u8 = 4;
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Whether the controller at `this` holds, where the cycle reads them, an agent count in
-    /// `1..=N` that agrees with the working count, valid flags and tags (the failure mask, the
+    /// `1..=N` that agrees with the working count and the effectiveness's count of blocks, valid flags and tags (the failure mask, the
     /// hover classification, the allocator's variant), a finite hover margin at the plant's
     /// weight and an admissible set equal to the team's limits. A controller
     /// some write changed there is refused before it is used (the C interface answers
@@ -28,6 +28,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     pub unsafe fn storage_intact(this: *const Self) -> bool {
         let len = addr_of!((*this).team.len).read();
         let working = addr_of!((*this).afs.n).read();
+        let blocks = addr_of!((*this).effectiveness.working).read();
         let failed = addr_of!((*this).failures.failed).cast::<[u8; N]>().read();
         let capable = addr_of!((*this).hover.capable).cast::<u8>().read();
         let limit = addr_of!((*this).hover.limit).cast::<u8>().read();
@@ -55,6 +56,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         (1..=N).contains(&len)
             && bits & 0xfefe_fefe == 0
             && len.checked_sub(failed_agents) == Some(working)
+            && blocks == working
             && capable <= 1
             && limit < HOVER_LIMITS
             && margin.is_finite()
@@ -111,6 +113,10 @@ mod tests {
             let mut c = controller();
             let p: *mut Checked = &mut *c;
             assert!(!intact_after(p, addr_of_mut!((*p).afs.n), 3), "working 3");
+            let mut c = controller();
+            let p: *mut Checked = &mut *c;
+            let blocks = addr_of_mut!((*p).effectiveness.working);
+            assert!(!intact_after(p, blocks, 0x41), "blocks 0x41");
             let mut c = controller();
             let p: *mut Checked = &mut *c;
             let flag = addr_of_mut!((*p).failures.failed).cast::<u8>();
