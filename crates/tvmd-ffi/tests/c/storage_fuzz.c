@@ -91,6 +91,9 @@ static int judge(const char *call, TvmdStatus status, int outputs_ok) {
   return 0;
 }
 
+/* Zeroes a struct and sets its `size`. */
+#define SIZED(x) (memset(&(x), 0, sizeof(x)), (x).size = sizeof(x))
+
 /* Two control periods' entry points on `c`: the number of ill-formed answers. */
 static int periods(TvmdController *c) {
   TvmdState s = state();
@@ -106,22 +109,14 @@ static int periods(TvmdController *c) {
   TvmdStatus st;
   int bad = 0, period;
   for (period = 0; period < 2; ++period) {
-    memset(&out, 0, sizeof out);
-    out.size = sizeof out;
-    memset(&law, 0, sizeof law);
-    law.size = sizeof law;
-    memset(&wrench, 0, sizeof wrench);
-    wrench.size = sizeof wrench;
-    memset(&alloc, 0, sizeof alloc);
-    alloc.size = sizeof alloc;
-    memset(&plan, 0, sizeof plan);
-    plan.size = sizeof plan;
-    memset(&map, 0, sizeof map);
-    map.size = sizeof map;
-    memset(&act, 0, sizeof act);
-    act.size = sizeof act;
-    memset(&hover, 0, sizeof hover);
-    hover.size = sizeof hover;
+    SIZED(out);
+    SIZED(law);
+    SIZED(wrench);
+    SIZED(alloc);
+    SIZED(plan);
+    SIZED(map);
+    SIZED(act);
+    SIZED(hover);
     bad += judge("tvmd_check", tvmd_check(c), 1);
     bad += judge("tvmd_set_landed", tvmd_set_landed(c, 0), 1);
     st = tvmd_step(c, &s, &r, &out);
