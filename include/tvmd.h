@@ -1384,8 +1384,9 @@ TvmdStatus tvmd_reset(struct TvmdController *handle);
 /*
  The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
  the storage are intact and the controller's counts and enum tags hold valid values (the
- agent count, the failure mask, the hover classification, the allocator's variant, the
- admissible set against the team's limits), `TVMD_ERR_NOT_INITIALIZED` or
+ agent count against the working count and the effectiveness's count of blocks, the
+ failure mask, the hover classification, the allocator's variant, the admissible set
+ against the team's limits), `TVMD_ERR_NOT_INITIALIZED` or
  `TVMD_ERR_CORRUPTED` otherwise. Every other entry point makes the same check first;
  whatever else a stray write leaves in the storage, every loop stays bounded by the
  capacity and constant caps, and no entry point hangs or crashes.
