@@ -61,13 +61,18 @@ c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \
   -o "$out/px4_test"
 "$out/px4_test"
 
-step "the 4-agent capacity (feature capacity-4, TVMD_CAPACITY_4): the PX4 adapter's test again"
+step "the 4-agent capacity (feature capacity-4, TVMD_CAPACITY_4): the PX4 adapter's test and the storage fuzz again"
 # Its own target directory: the feature changes the library's layout.
 cargo build --locked -p tvmd-ffi --features capacity-4 --target-dir "$target_dir/capacity-4"
 c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -DTVMD_CAPACITY_4 -Iinclude \
   crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/capacity-4/debug/libtvmd_ffi.a" -lm \
   -lpthread -ldl -o "$out/px4_test_capacity_4"
 "$out/px4_test_capacity_4"
+# The storage fuzz at this capacity (its own layout; about 30 s).
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -DTVMD_CAPACITY_4 -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/capacity-4/debug/libtvmd_ffi.a" -lm \
+  -lpthread -ldl -o "$out/storage_fuzz_capacity_4"
+"$out/storage_fuzz_capacity_4"
 
 step "staticlib for thumbv7em-none-eabihf (no_std) and its size"
 cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release
