@@ -1063,7 +1063,9 @@ typedef struct TvmdPlanOutput {
 
 /*
  The handle's storage was overwritten: its start says created, but the guard at its end
- does not hold (a neighbouring buffer overran it). Create the controller again.
+ does not hold (a neighbouring buffer overran it), or a count, flag or enum tag the
+ controller keeps holds a value no controller has (a stray write inside it; see
+ `tvmd_check`). Create the controller again.
  */
 #define TVMD_ERR_CORRUPTED 6
 
@@ -1411,9 +1413,14 @@ TvmdStatus tvmd_hover_capability(const struct TvmdController *handle, struct Tvm
 TvmdStatus tvmd_reset(struct TvmdController *handle);
 
 /*
- The preflight integrity check: `TVMD_OK` when the handle was created and both guards
- around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
- otherwise (every other entry point makes the same check first).
+ The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
+ the storage are intact and the controller's counts and enum tags hold valid values (the
+ agent count against the working count and the effectiveness's count of blocks, the
+ failure mask, the hover classification, the allocator's variant, the admissible set
+ against the team's limits), `TVMD_ERR_NOT_INITIALIZED` or
+ `TVMD_ERR_CORRUPTED` otherwise. Every other entry point makes the same check first;
+ whatever else a stray write leaves in the storage, every loop stays bounded by the
+ capacity and constant caps, and no entry point hangs or crashes.
 
  # Safety
  `handle` as for [`tvmd_step`].

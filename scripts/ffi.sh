@@ -3,7 +3,8 @@
 # warnings as errors; the C test program, linked against the staticlib, runs the paper team
 # (hover, the saturating tilt, failure masks, every error path, the actuator channel map) and
 # the default offset-free law (law_test.c: convergence under an unmodelled force, the landed
-# hold, bad law values), and its record is replayed on the Rust API bit for bit; the thumbv7em staticlib builds and every
+# hold, bad law values), and its record is replayed on the Rust API bit for bit; a fuzz of the
+# handle's storage (every word, several patterns) runs under a watchdog; the thumbv7em staticlib builds and every
 # entry point links there without a panic path (embedded/ffi-check). The header's staleness is
 # checked by `cargo test -p tvmd-ffi --test header` (part of `cargo test --workspace`).
 # Installs a C/C++ compiler with apt-get where one is missing.
@@ -37,19 +38,41 @@ cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude crates/tvmd-ffi/tests/c/tv
 "$out/tvmd_test" "$out/record.txt"
 TVMD_FFI_C_RECORD="$out/record.txt" cargo test --locked -p tvmd-ffi --test c_record -- --ignored --nocapture
 
+step "storage corruption: every word of a created handle overwritten, each case forked under a watchdog"
+# crates/tvmd-ffi/tests/c/storage_fuzz.c: no entry point hangs (alarm) or crashes; every call
+# returns TVMD_OK with finite outputs inside the created configuration's admissible set, or an
+# error status (TVMD_ERR_CORRUPTED where a count, flag or enum tag is refused).
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/storage_fuzz"
+# Again against an optimized build (the ci profile: release without fat LTO), which may exploit
+# what a stray write leaves (a tag assumed in range) where debug code does not: a hang in
+# tvmd_step from the effectiveness blocks' tags showed only here (issue 57, item 7).
+cargo build --locked -p tvmd-ffi --profile ci
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/ci/libtvmd_ffi.a" -lm -lpthread -ldl \
+  -o "$out/storage_fuzz_optimized"
+"$out/storage_fuzz_optimized"
+"$out/storage_fuzz"
+
 step "the PX4 adapter include/tvmd_px4.hpp: C++17 test (-Wall -Wextra -Werror -Wpedantic -Wold-style-cast)"
 c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -Iinclude \
   crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/debug/libtvmd_ffi.a" -lm -lpthread -ldl \
   -o "$out/px4_test"
 "$out/px4_test"
 
-step "the 4-agent capacity (feature capacity-4, TVMD_CAPACITY_4): the PX4 adapter's test again"
+step "the 4-agent capacity (feature capacity-4, TVMD_CAPACITY_4): the PX4 adapter's test and the storage fuzz again"
 # Its own target directory: the feature changes the library's layout.
 cargo build --locked -p tvmd-ffi --features capacity-4 --target-dir "$target_dir/capacity-4"
 c++ -std=c++17 -Wall -Wextra -Werror -Wpedantic -Wold-style-cast -DTVMD_CAPACITY_4 -Iinclude \
   crates/tvmd-ffi/tests/cpp/px4_test.cpp "$target_dir/capacity-4/debug/libtvmd_ffi.a" -lm \
   -lpthread -ldl -o "$out/px4_test_capacity_4"
 "$out/px4_test_capacity_4"
+# The storage fuzz at this capacity (its own layout; about 30 s).
+cc -std=c99 -D_POSIX_C_SOURCE=200809L -DTVMD_CAPACITY_4 -Wall -Wextra -Werror -pedantic -Iinclude \
+  crates/tvmd-ffi/tests/c/storage_fuzz.c "$target_dir/capacity-4/debug/libtvmd_ffi.a" -lm \
+  -lpthread -ldl -o "$out/storage_fuzz_capacity_4"
+"$out/storage_fuzz_capacity_4"
 
 step "staticlib for thumbv7em-none-eabihf (no_std) and its size"
 cargo build --locked -p tvmd-ffi --no-default-features --target thumbv7em-none-eabihf --release

@@ -103,7 +103,9 @@ cargo build --release --locked --manifest-path embedded/cycle-check/Cargo.toml -
 
 step "the C interface: header as C99/C++11, the C test program and its bit-exact replay, thumbv7em staticlib and panic-free link check"
 # See scripts/ffi.sh. Measured on the 2-core development machine: 6 s warm; the link check's
-# own thumbv7em build from scratch about 55 s (plus apt-get of g++ where c++ is missing).
+# own thumbv7em build from scratch about 55 s (plus apt-get of g++ where c++ is missing); the
+# storage fuzz about 2 min more (debug 95 s, the 4-agent capacity 30 s, optimized 3 s, plus
+# the ci-profile build of tvmd-ffi).
 bash scripts/ffi.sh
 
 step "target tests: the f32 core on emulated Cortex-M4F and Cortex-M7 (QEMU)"

@@ -80,7 +80,7 @@ pub struct SemiAxes<T: Real> {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttainableForceSpace<T: Real> {
-    n: usize,
+    pub(crate) n: usize,
     n_x: usize,
     sigma_x: T,
     sigma_y: T,

@@ -12,6 +12,7 @@ mod detection;
 mod guard;
 mod reconfigure;
 mod settings;
+mod storage;
 
 pub use crate::fault::detection::{
     FaultDetection, FaultResponse, FAULT_BASELINE_BANDWIDTH, FAULT_MODEL_ERROR, FAULT_PERSISTENCE,

@@ -102,8 +102,8 @@ pub enum Arrangement {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TeamConfig<T: Real, const N: usize> {
     agents: [AgentSpec<T>; N],
-    len: usize,
-    limits: AgentLimits<T>,
+    pub(crate) len: usize,
+    pub(crate) limits: AgentLimits<T>,
     navigator: Navigator<T>,
     mass: T,
     inertia: Matrix3<T>,

@@ -98,16 +98,18 @@ pub(crate) unsafe fn inner<'a>(handle: *const TvmdController) -> Result<&'a Inne
     if handle as usize % align_of::<Inner>() != 0 {
         return Err(TVMD_ERR_ALIGNMENT);
     }
-    let inner = &*handle.cast::<Inner>();
-    if inner.magic != MAGIC {
+    // Raw reads until the storage is known to hold valid counts and tags: a reference to a
+    // controller with an invalid enum tag would already be undefined behaviour.
+    let storage = handle.cast::<Inner>();
+    if core::ptr::addr_of!((*storage).magic).read() != MAGIC {
         return Err(TVMD_ERR_NOT_INITIALIZED);
     }
     // In bounds: the storage is TVMD_CONTROLLER_SIZE bytes and 8-byte aligned.
     let tail = handle.cast::<u8>().add(TAIL_OFFSET).cast::<u64>().read();
-    if tail != TAIL {
+    if tail != TAIL || !FfiController::storage_intact(core::ptr::addr_of!((*storage).controller)) {
         return Err(TVMD_ERR_CORRUPTED);
     }
-    Ok(inner)
+    Ok(&*storage)
 }
 
 /// As [`inner`], mutable.
@@ -343,9 +345,14 @@ pub unsafe extern "C" fn tvmd_reset(handle: *mut TvmdController) -> TvmdStatus {
     }
 }
 
-/// The preflight integrity check: `TVMD_OK` when the handle was created and both guards
-/// around the storage are intact, `TVMD_ERR_NOT_INITIALIZED` or `TVMD_ERR_CORRUPTED`
-/// otherwise (every other entry point makes the same check first).
+/// The preflight integrity check: `TVMD_OK` when the handle was created, both guards around
+/// the storage are intact and the controller's counts and enum tags hold valid values (the
+/// agent count against the working count and the effectiveness's count of blocks, the
+/// failure mask, the hover classification, the allocator's variant, the admissible set
+/// against the team's limits), `TVMD_ERR_NOT_INITIALIZED` or
+/// `TVMD_ERR_CORRUPTED` otherwise. Every other entry point makes the same check first;
+/// whatever else a stray write leaves in the storage, every loop stays bounded by the
+/// capacity and constant caps, and no entry point hangs or crashes.
 ///
 /// # Safety
 /// `handle` as for [`tvmd_step`].

@@ -23,7 +23,9 @@ pub const TVMD_ERR_NOT_INITIALIZED: TvmdStatus = 4;
 /// `map.motor_curve`) has a value this library does not know.
 pub const TVMD_ERR_ENUM_VALUE: TvmdStatus = 5;
 /// The handle's storage was overwritten: its start says created, but the guard at its end
-/// does not hold (a neighbouring buffer overran it). Create the controller again.
+/// does not hold (a neighbouring buffer overran it), or a count, flag or enum tag the
+/// controller keeps holds a value no controller has (a stray write inside it; see
+/// `tvmd_check`). Create the controller again.
 pub const TVMD_ERR_CORRUPTED: TvmdStatus = 6;
 
 /// [`InputError::NonFinite`]: a NaN or infinite number in the state or reference.

@@ -36,8 +36,10 @@ pub fn hover_margin_tolerance<T: Real>() -> T {
     sqrt(eps::<T>())
 }
 
-/// Which bound of an agent's admissible set limits the margin.
+/// Which bound of an agent's admissible set limits the margin (`repr(u8)`: its tag checked raw
+/// by [`crate::Controller::storage_intact`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
 pub enum HoverLimit {
     /// The maximum thrust `sigma_Tf`.
     MaxThrust,

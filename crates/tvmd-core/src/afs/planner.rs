@@ -90,6 +90,12 @@ pub struct AttitudePlanner<T: Real> {
     max_iterations: u32,
 }
 
+/// The most iterations any planner runs, whatever its stored cap
+/// ([`AttitudePlanner::with_tolerance`]): more than a valid search can take (halving `[0, pi]`
+/// to the smallest positive `f64` takes about 1,080 steps, the secant adds at most 4), so no
+/// valid plan changes; a cap or tolerance a stray write changed cannot spin the loop.
+pub const PLANNER_ITERATION_LIMIT: u32 = 2048;
+
 impl<T: Real> AttitudePlanner<T> {
     /// A planner with relaxation `s`, tolerance `max(1e-10, 8 eps)` rad and at most 64 iterations.
     pub fn new(relaxation: Relaxation<T>) -> Self {
@@ -100,7 +106,8 @@ impl<T: Real> AttitudePlanner<T> {
         }
     }
 
-    /// Sets the search tolerance on `theta` (rad, positive) and the iteration cap (>= 1).
+    /// Sets the search tolerance on `theta` (rad, positive) and the iteration cap (>= 1; the
+    /// search stops at [`PLANNER_ITERATION_LIMIT`] whatever the cap).
     pub fn with_tolerance(
         mut self,
         tolerance: T,
@@ -240,7 +247,9 @@ impl<T: Real> AttitudePlanner<T> {
             }
         };
         let mut iterations = 0;
-        while hi - lo > self.tolerance && iterations < self.max_iterations {
+        // Bounded by the constant too: a cap a stray write changed cannot spin the loop.
+        let cap = self.max_iterations.min(PLANNER_ITERATION_LIMIT);
+        while hi - lo > self.tolerance && iterations < cap {
             iterations += 1;
             let width = hi - lo;
             let guard = self.tolerance * half;
@@ -429,5 +438,27 @@ mod tests {
             );
         }
         assert!(!guide(&cone, &Vector3::new(0.0, 0.0, f64::NAN)).1);
+    }
+
+    /// A stored cap and tolerance a stray write changed (a negative tolerance never stops the
+    /// search, a cap of `u32::MAX` would run it for minutes) stop at
+    /// [`PLANNER_ITERATION_LIMIT`]; a valid planner's plan is unchanged by the limit.
+    #[test]
+    fn the_search_stops_at_the_constant_limit_whatever_the_stored_cap() {
+        let team = presets::a4_inc::<f64, 4>().unwrap();
+        let afs = team.afs(&FailureMask::none()).unwrap();
+        let relaxation = Relaxation::new(0.5).unwrap();
+        let force = Vector3::new(0.0, 0.0, 2.8 * 9.81);
+        let r_r = crate::foundation::rotation::roll(1.2);
+        let valid = AttitudePlanner::new(relaxation).with_tolerance(f64::from_bits(1), u32::MAX);
+        let valid = valid.unwrap().plan(&afs, &r_r, &force).unwrap();
+        assert_eq!(valid.status, PlannerStatus::Planned);
+        assert!(valid.iterations < PLANNER_ITERATION_LIMIT);
+        let mut changed = AttitudePlanner::new(relaxation);
+        changed.tolerance = -1.0;
+        changed.max_iterations = u32::MAX;
+        let out = changed.plan(&afs, &r_r, &force).unwrap();
+        assert_eq!(out.iterations, PLANNER_ITERATION_LIMIT);
+        assert!(out.theta.is_finite() && out.r_d.iter().all(|x| x.is_finite()));
     }
 }

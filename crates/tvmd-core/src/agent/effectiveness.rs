@@ -27,6 +27,10 @@ pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Effectiveness<T: Real, const N: usize> {
     blocks: [Option<Matrix6x3<T>>; N],
+    /// How many blocks there are, counted when they were assigned: a plain count, so that the
+    /// allocators' round bounds never derive from the blocks' tags (a stray write in a C
+    /// caller's handle can make a tag anything, and an optimizer may count by adding tags).
+    pub(crate) working: usize,
     /// The factor of `M M^T`, computed once here and reused by the pseudo-inverses.
     gram: GramSolver<T>,
 }
@@ -46,6 +50,7 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
     pub fn new<'a>(agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>) -> Self {
         let mut m = Self {
             blocks: [None; N],
+            working: 0,
             gram: GramSolver::Zero,
         };
         m.assign(agents);
@@ -65,6 +70,7 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
         for i in 0..N {
             blocks.add(i).write(None);
         }
+        core::ptr::addr_of_mut!((*this).working).write(0);
         core::ptr::addr_of_mut!((*this).gram).write(GramSolver::Zero);
         (*this).assign(agents);
     }
@@ -81,6 +87,7 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
                 *slot = Some(agent_block(position, quarter_turns));
             }
         }
+        self.working = self.blocks.iter().flatten().count();
         self.gram = GramSolver::new(&self.gram());
     }
 
@@ -99,9 +106,11 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
         &self.blocks
     }
 
-    /// Number of working agents.
+    /// Number of working agents (at most `N`).
     pub fn working_count(&self) -> usize {
-        self.blocks.iter().flatten().count()
+        // The stored count (checked by `Controller::storage_intact`), at most the capacity
+        // whatever it holds: it bounds the allocators' rounds.
+        self.working.min(N)
     }
 
     /// `u = M f` (eq. 4) for agent-frame forces; failed agents' forces are ignored.

@@ -5,8 +5,9 @@ use crate::foundation::error::ConfigError;
 /// Which agents have failed. A failed agent leaves `n`, `n_x` / `n_y` and `M` (paper's degraded
 /// team); it is commanded to zero thrust.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(transparent)]
 pub struct FailureMask<const N: usize> {
-    failed: [bool; N],
+    pub(crate) failed: [bool; N],
 }
 
 impl<const N: usize> Default for FailureMask<N> {

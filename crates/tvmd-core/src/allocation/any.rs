@@ -49,7 +49,11 @@ const NAMES: &[&str] = &[
 /// assert!(AnyAllocator::<f64, 4>::from_name("magic", &AllocatorOptions::default()).is_err());
 /// # Ok::<(), tvmd_core::ConfigError>(())
 /// ```
+///
+/// `repr(u8)`: the variant's tag is the first byte, in declaration order, so that
+/// [`Allocator::storage_intact`] can check it raw.
 #[derive(Clone, Debug)]
+#[repr(u8)]
 pub enum AnyAllocator<T: Real, const N: usize> {
     /// [`PseudoInverse`].
     PseudoInverse(PseudoInverse),
@@ -116,6 +120,12 @@ impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
 }
 
 impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
+    unsafe fn storage_intact(this: *const Self) -> bool {
+        // The variants in declaration order (repr(u8)): 4, or 6 with `clarabel`.
+        const VARIANTS: u8 = if cfg!(feature = "clarabel") { 6 } else { 4 };
+        this.cast::<u8>().read() < VARIANTS
+    }
+
     fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
         match self {
             Self::PseudoInverse(a) => a.configure(effectiveness),

@@ -122,6 +122,21 @@ pub trait Allocator<T: Real, const N: usize> {
 
     /// A short name for logs ("pseudo-inverse", ...).
     fn name(&self) -> &'static str;
+
+    /// Whether the bytes at `this` hold valid enum tags where the allocator keeps any, read raw
+    /// (no reference made), for [`crate::Controller::storage_intact`]: a controller in memory a
+    /// stray write may have changed (a C caller's handle). The default, for an allocator
+    /// without tags, is `true`.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    unsafe fn storage_intact(this: *const Self) -> bool
+    where
+        Self: Sized,
+    {
+        let _ = this;
+        true
+    }
 }
 
 /// The weighted pseudo-inverse over the agents selected by `free`:

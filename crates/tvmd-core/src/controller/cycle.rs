@@ -7,7 +7,9 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use super::guard::{check_range, first_non_finite, first_non_finite_allocation};
+use super::guard::{
+    check_range, first_non_finite, first_non_finite_allocation, first_non_finite_law,
+};
 use super::{ControlOutput, Controller, CycleError};
 use crate::afs::planner::{PlannerOutput, PlannerStatus};
 use crate::afs::projection::{project_force_in, ForceProjection};
@@ -95,6 +97,12 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         reference: &Reference<T>,
     ) -> Result<LawStage<T>, CycleError<T, N>> {
         let (stage, _, pending) = self.law_stage(state, reference)?;
+        // The safety net `step` has: a non-finite law is never handed on as a wrench.
+        if let Some(field) =
+            first_non_finite_law(&stage.planner, &stage.projection, &stage.f_r, &stage.law)
+        {
+            return Err(self.reject(InputError::Overflow { field }));
+        }
         // Kept for the allocation that delivers this wrench (`allocate`).
         self.pending = pending.map(|p| (*state, p));
         Ok(stage)

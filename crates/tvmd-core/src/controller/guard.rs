@@ -4,11 +4,13 @@
 use nalgebra::Vector3;
 
 use super::ControlOutput;
+use crate::afs::planner::PlannerOutput;
+use crate::afs::projection::ForceProjection;
 use crate::agent::command::AgentCommand;
 use crate::allocation::Allocation;
 use crate::foundation::error::InputError;
 use crate::foundation::real::{count, lit, sqrt, to_f64, Real};
-use crate::law::{Gains, Reference, RigidState};
+use crate::law::{Gains, LawOutput, Reference, RigidState};
 use crate::team::TeamConfig;
 
 /// [`InputError::OutOfRange`] for the first vector input with a component beyond `limit`
@@ -79,11 +81,20 @@ pub(super) fn first_non_finite<T: Real, const N: usize>(
     if let Some(field) = first_non_finite_allocation(&out.commands, &out.allocation) {
         return Some(field);
     }
-    let law = &out.law;
-    if !probe(out.planner.r_d.as_slice()) || !probe(&[out.planner.theta]) {
+    first_non_finite_law(&out.planner, &out.projection, &out.f_r, &out.law)
+}
+
+/// As [`first_non_finite`] for the law stage's part: the planner, the projection, the law.
+pub(super) fn first_non_finite_law<T: Real>(
+    planner: &PlannerOutput<T>,
+    projection: &ForceProjection<T>,
+    f_r: &Vector3<T>,
+    law: &LawOutput<T>,
+) -> Option<&'static str> {
+    if !probe(planner.r_d.as_slice()) || !probe(&[planner.theta]) {
         return Some("output.planner");
     }
-    if !probe(out.projection.force.as_slice()) || !probe(out.f_r.as_slice()) {
+    if !probe(projection.force.as_slice()) || !probe(f_r.as_slice()) {
         return Some("output.projection");
     }
     if !probe(law.u_r.as_slice())

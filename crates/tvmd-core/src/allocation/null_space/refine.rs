@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 
 use super::prepared::Prepared;
 use super::projection::{self, project_null};
-use super::{NullSpaceObjective, NullSpaceReport, NullSpaceStage};
+use super::{NullSpaceObjective, NullSpaceReport, NullSpaceStage, MAX_NULL_SPACE_ITERATIONS};
 use crate::allocation::exact_boundary::active::ActiveSet;
 use crate::allocation::exact_boundary::constraint::{
     constraints, regular, Constraint, CONSTRAINTS,
@@ -82,7 +82,10 @@ impl<T: Real> NullSpaceStage<T> {
         );
         let mut iterations = 0;
         let margin_objective = matches!(self.objective, NullSpaceObjective::Margin);
-        while iterations < self.iterations {
+        // The constant bounds it too: `new` allows no more, and a stored count a stray write
+        // changed cannot spin the loop.
+        let cap = self.iterations.min(MAX_NULL_SPACE_ITERATIONS);
+        while iterations < cap {
             let active = hold_boundaries(&objective, &bounds, sets, &working, &forces);
             let Some(d) = project_null(e, &active, &frozen, &objective.gradient(&forces)) else {
                 break;

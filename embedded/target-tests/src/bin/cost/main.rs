@@ -15,6 +15,7 @@
 //! 30,000 / 12,000 instructions (reported, not a failure: not met, see
 //! docs/allocation-benchmark.md), with a tighter estimate: the searching cycle around an
 //! allocation that hands back given forces, plus each allocation.
+//! Then the C handle's per-call storage check at n = 4 and 16 (`storage.rs`).
 //! Prints one line per case over semihosting; exits with failure if the clock cannot be
 //! calibrated or a cycle does not run as intended. Run by `scripts/target.sh`.
 #![no_std]
@@ -38,6 +39,7 @@ use tvmd_core::{
 mod allocation;
 mod clock;
 mod stack;
+mod storage;
 
 /// Cycles per measurement: the tick quantization (one tick, 40 instructions, at each end of the
 /// cycles' timing and of the overhead's) is spread over them: each count is within
@@ -314,7 +316,8 @@ fn run() -> bool {
     }
     let a = report::<4>(per_tick);
     let b = report::<16>(per_tick);
-    a && b && report_set(per_tick)
+    let checks = storage::report::<4>(per_tick) & storage::report::<16>(per_tick);
+    a && b && checks && report_set(per_tick)
 }
 
 /// Issue 59's bounds on the whole n = 4 cycle with the default allocator, its walk capped at
