@@ -231,8 +231,7 @@
 
 /*
  `allocator_round_cap`: the library's default cap of the exact-boundary redistribution's
- walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (and, with any other allocator, no cap
- to give: the only value they take).
+ walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (another allocator has no walk to cap).
  */
 #define TVMD_ROUND_CAP_DEFAULT 0
 
@@ -651,8 +650,9 @@ typedef struct TvmdConfig {
   /*
    One of `TVMD_ROUND_CAP_*`: how the exact-boundary redistribution's walk is capped per
    period (a bound on its work: the best admissible forces found so far, with their true
-   `e_f`). Zero is the library's default cap; with another allocator anything else is
-   refused (`TVMD_ERR_CONFIG_UNUSED_OPTION`); an unknown value is `TVMD_ERR_ENUM_VALUE`.
+   `e_f`). Zero is the library's default cap; another allocator refuses
+   `TVMD_ROUND_CAP_ROUNDS` (`TVMD_ERR_CONFIG_UNUSED_OPTION`) and takes the other two; an
+   unknown value is `TVMD_ERR_ENUM_VALUE`.
    */
   uint32_t allocator_round_cap;
   /*
