@@ -93,7 +93,7 @@ pub const TVMD_ROUND_CAP_DEFAULT: u32 = 0;
 /// walk's start alone, the redistributed pseudo-inverse or the previous forces).
 pub const TVMD_ROUND_CAP_ROUNDS: u32 = 1;
 /// `allocator_round_cap`: no cap beyond the walk's own `2 n + 4` rounds (research: about
-/// 275,000 Cortex-M4F instructions for the worst n = 4 allocation).
+/// 166,000 Cortex-M4F instructions for the worst n = 4 allocation of the allocation set).
 pub const TVMD_ROUND_CAP_UNCAPPED: u32 = 2;
 /// Walk rounds of `TVMD_ROUND_CAP_DEFAULT` (the core's `DEFAULT_MAX_ROUNDS`).
 pub const TVMD_DEFAULT_MAX_ROUNDS: u32 = 2;

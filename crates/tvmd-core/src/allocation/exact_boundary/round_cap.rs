@@ -3,8 +3,9 @@
 
 /// Walk rounds of the default cap ([`RoundCap::default`]). Two: the allocation set's worst
 /// requests take 12-15 rounds uncapped at 10,000-13,000 Cortex-M4F instructions each, while two
-/// rounds recover most of what the walk adds over its start (`docs/allocation-benchmark.md`,
-/// "Round cap").
+/// rounds keep 57 of its 64 attainable n = 4 requests exact (63 uncapped) and bound the whole
+/// n = 4 cycle at about 48,000 instructions (`docs/allocation-benchmark.md`, "Worst case, cost
+/// cap and target").
 pub const DEFAULT_MAX_ROUNDS: u32 = 2;
 
 /// How many rounds the exact-boundary redistribution may walk per allocation.
@@ -15,8 +16,8 @@ pub enum RoundCap {
     /// best forces it found, inside every agent's set, with their true wrench error.
     Rounds(u32),
     /// No cap beyond the walk's own `2 n + 4` rounds: the exact boundary's last corners, at up
-    /// to about 275,000 Cortex-M4F instructions for one n = 4 allocation (research, not a
-    /// flight controller's period).
+    /// to about 166,000 Cortex-M4F instructions for one n = 4 allocation of the allocation set
+    /// (research, not a flight controller's period).
     Uncapped,
 }
 
