@@ -38,15 +38,7 @@ impl RoundCap {
         }
     }
 
-    /// `Some(k)` for `Rounds(k)`, `None` when uncapped.
-    pub const fn limit(self) -> Option<u32> {
-        match self {
-            Self::Rounds(k) => Some(k),
-            Self::Uncapped => None,
-        }
-    }
-
-    /// The cap of `limit` ([`Self::limit`]'s inverse).
+    /// `Rounds(k)` for `Some(k)`, `Uncapped` for `None` (a cap given as an optional limit).
     pub const fn from_limit(limit: Option<u32>) -> Self {
         match limit {
             Some(k) => Self::Rounds(k),
