@@ -78,15 +78,18 @@ impl Default for GainsConfig {
     }
 }
 
+/// The word of `tvmd_core::RoundCap::Uncapped` in a scenario file's `allocator_max_rounds` and
+/// in Python's `max_rounds=`.
+pub const ROUND_CAP_UNCAPPED: &str = "uncapped";
+
 /// `allocator_max_rounds` in a scenario file: a number of rounds (`0`: the walk's start alone)
-/// or `"uncapped"`; absent, the core's default cap
+/// or [`ROUND_CAP_UNCAPPED`]; absent, the core's default cap
 /// ([`tvmd_core::allocation::DEFAULT_MAX_ROUNDS`]).
 pub(crate) mod round_cap {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
     use tvmd_core::RoundCap;
 
-    /// The word of [`RoundCap::Uncapped`].
-    pub const UNCAPPED: &str = "uncapped";
+    use super::ROUND_CAP_UNCAPPED as UNCAPPED;
 
     #[derive(Serialize, Deserialize)]
     #[serde(untagged)]
@@ -95,11 +98,13 @@ pub(crate) mod round_cap {
         Word(String),
     }
 
-    /// Writes `Some(cap)` as a number or `"uncapped"` (`None` is skipped by the field).
+    /// Writes `Some(cap)` as a number or `"uncapped"` (`None`, the default, is skipped by the
+    /// field).
     pub fn serialize<S: Serializer>(cap: &Option<RoundCap>, s: S) -> Result<S::Ok, S::Error> {
         match cap {
             Some(RoundCap::Rounds(k)) => Input::Rounds(*k).serialize(s),
-            Some(RoundCap::Uncapped) | None => Input::Word(UNCAPPED.into()).serialize(s),
+            Some(RoundCap::Uncapped) => Input::Word(UNCAPPED.into()).serialize(s),
+            None => s.serialize_none(),
         }
     }
 

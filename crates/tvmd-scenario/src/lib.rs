@@ -102,7 +102,7 @@ mod validate;
 
 pub use air::{Air, Gust, DRAG_AREA_PER_AGENT};
 pub use builtin::{BUILTIN_NAMES, RELAXATION_LANDING_SPOT};
-pub use controller::{GainsConfig, Precision, ALLOCATOR_NAMES};
+pub use controller::{GainsConfig, Precision, ALLOCATOR_NAMES, ROUND_CAP_UNCAPPED};
 pub use disturbances::{Disturbances, ExternalWrenchSpec, StateNoise, MAX_FEEDBACK_LATENCY};
 pub use error::ScenarioError;
 pub use failures::{Failure, FailureResponse, OnHoverLoss};

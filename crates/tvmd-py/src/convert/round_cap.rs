@@ -6,11 +6,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyString;
 
 use tvmd_core::RoundCap;
+use tvmd_scenario::ROUND_CAP_UNCAPPED as UNCAPPED;
 
 use super::Int;
-
-/// The word of [`RoundCap::Uncapped`].
-const UNCAPPED: &str = "uncapped";
 
 /// The cap of a `max_rounds` argument (`None`: the allocator's default): `ValueError` for a
 /// negative int or another word, `TypeError` for any other type.
