@@ -51,7 +51,7 @@
 //! [[failures]]
 //! agent = 0
 //! time = 5.0
-//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal", "half-thrust"
+//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal", "half-thrust", "link-loss"
 //! controller_informed = true
 //! informed_after = 0.0        # s; told this long after the failure (telemetry or detector latency)
 //!
@@ -64,6 +64,15 @@
 //! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
 //! state_noise = { position = 0.01, velocity = 0.02, attitude = 0.005, angular_velocity = 0.01, seed = 7 }
 //! feedback_latency = 1       # the controller sees the state of one period before (default 0)
+//!
+//! [links]                    # each agent's command link (none by default: commands applied as sent)
+//! latency = 0.02             # s
+//! jitter = 0.005             # s, uniform extra delay
+//! loss = 0.05                # independent losses
+//! burst_start = 0.01         # bursts of losses (mean burst_length commands)
+//! burst_length = 5.0
+//! hold = 0.1                 # s an agent holds its last command without one, then:
+//! failsafe = "idle"          # rotor stopped, gimbal level; or "hold"
 //!
 //! [success]                  # the verdict's bounds (see `SuccessBounds`)
 //! max_steady_state_position_error = 0.05
@@ -90,6 +99,7 @@ mod failures;
 mod families;
 mod fault_detection;
 mod law;
+mod links;
 mod log_settings;
 mod name_or;
 mod null_space;
@@ -115,6 +125,7 @@ pub use law::{
     AttitudeRateConfig, GainScheduleConfig, LawConfig, NaturalGainsConfig, OffsetFreeConfig,
     LAW_NAMES,
 };
+pub use links::{CommandLinks, LinkFailsafe, MAX_LINK_DELAY};
 pub use log_settings::LogSettings;
 pub use null_space::{
     NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,

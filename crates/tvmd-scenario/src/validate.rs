@@ -322,6 +322,9 @@ impl Scenario {
                 ),
             ));
         }
+        if let Some(links) = &self.links {
+            links.validate()?;
+        }
         self.law.validate()?;
         if let Some(detection) = &self.fault_detection {
             detection.validate(&self.law.offset_free)?;

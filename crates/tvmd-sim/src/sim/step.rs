@@ -114,6 +114,12 @@ impl Simulation {
         self.world.state()
     }
 
+    /// Per agent, what its command link did so far: commands sent, lost, overtaken, and
+    /// failsafes (`None`: the scenario has no links).
+    pub fn link_stats(&self) -> Option<Vec<super::links::LinkStats>> {
+        self.commands.link_stats()
+    }
+
     /// The number of agents (the length of every step's commands).
     pub fn agents(&self) -> usize {
         self.team.len()
@@ -123,7 +129,7 @@ impl Simulation {
     /// range (the command minus what it held: `eta_x`, `eta_y` in rad, thrust in N; zero
     /// inside the range and before the first step). See the module `saturation`.
     pub fn saturation(&self) -> &[ActuatorCommand] {
-        self.saturation.clamped()
+        self.commands.clamped()
     }
 
     /// The largest thrust of one agent, `sigma_Tf` (N): the thrust at the normalized rotor
@@ -278,7 +284,9 @@ impl Simulation {
                 }
                 self.attach_payloads(t)?;
             }
-            self.actuators.step(&self.held, dt);
+            let (applied, changed) = self.commands.applied(t);
+            self.forces_stale |= changed;
+            self.actuators.step(applied, dt);
             if self.forces_stale || !memoryless {
                 body_forces(
                     self.actuators.outputs(),

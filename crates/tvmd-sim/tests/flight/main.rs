@@ -9,6 +9,7 @@ mod coarse_step;
 mod fault_detection;
 mod flight_metrics;
 mod hover_failure;
+mod links;
 mod null_space;
 mod offset_free;
 mod precision;
