@@ -74,6 +74,15 @@
 //! hold = 0.1                 # s an agent holds its last command without one, then:
 //! failsafe = "idle"          # rotor stopped, gimbal level; or "hold"
 //!
+//! [reports]                  # the agents' own reports (rotor speed as thrust, gimbal angles)
+//! rate = 100.0               # Hz
+//! latency = 0.02             # s
+//! thrust_noise = 0.05        # N
+//! angle_noise = 0.005        # rad
+//! loss = 0.0
+//! dead_esc = "silent"        # or "zero"
+//! # lying = [2]              # agents that report their command whatever they do
+//!
 //! [success]                  # the verdict's bounds (see `SuccessBounds`)
 //! max_steady_state_position_error = 0.05
 //! # max_settling_time = 6.0
@@ -105,6 +114,7 @@ mod name_or;
 mod null_space;
 mod overrides;
 mod plant;
+mod reports;
 mod scenario;
 mod success;
 mod team;
@@ -132,6 +142,7 @@ pub use null_space::{
 };
 pub use overrides::Overrides;
 pub use plant::{Payload, PlantError};
+pub use reports::{AgentReports, DeadEsc};
 pub use scenario::{Scenario, MAX_SCENARIO_BYTES};
 pub use success::SuccessBounds;
 pub use team::{LimitsConfig, TeamSpec};

@@ -9,9 +9,9 @@ use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
 use crate::error::invalid;
 use crate::{
-    CommandLinks, Disturbances, Failure, FailureResponse, FaultDetectionConfig, GainsConfig,
-    LawConfig, LimitsConfig, LogSettings, NullSpaceConfig, Payload, PlantError, Precision,
-    ScenarioError, SuccessBounds, TeamSpec,
+    AgentReports, CommandLinks, Disturbances, Failure, FailureResponse, FaultDetectionConfig,
+    GainsConfig, LawConfig, LimitsConfig, LogSettings, NullSpaceConfig, Payload, PlantError,
+    Precision, ScenarioError, SuccessBounds, TeamSpec,
 };
 
 /// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
@@ -99,6 +99,9 @@ pub struct Scenario {
     /// applied as they are sent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub links: Option<CommandLinks>,
+    /// The agents' own reports (`[reports]`, [`AgentReports`]); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reports: Option<AgentReports>,
     /// Model error: how the flown team differs from the controller's model of it.
     #[serde(skip_serializing_if = "PlantError::is_nominal")]
     pub plant: PlantError,
@@ -140,6 +143,7 @@ impl Default for Scenario {
             fault_detection: None,
             disturbances: Disturbances::default(),
             links: None,
+            reports: None,
             plant: PlantError::nominal(),
             payloads: Vec::new(),
             log: LogSettings::default(),

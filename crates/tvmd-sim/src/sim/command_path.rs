@@ -1,10 +1,12 @@
 //! The way of a command from the controller to the actuators: the plant's saturation, then
-//! each agent's command link when the scenario has links (`[links]`, or a `link-loss` failure).
+//! each agent's command link when the scenario has links (`[links]`, or a `link-loss` failure);
+//! and of the agents' reports back (`[reports]`), over the same links.
 
-use tvmd_plant::actuators::{ActuatorCommand, FailureKind};
+use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand, FailureKind};
 use tvmd_scenario::{CommandLinks, Scenario};
 
 use super::links::{LinkStats, Links};
+use super::reports::{AgentReport, Reports};
 use super::saturation::PlantSaturation;
 use crate::SimError;
 
@@ -15,6 +17,7 @@ pub(super) struct CommandPath {
     held: Vec<ActuatorCommand>,
     saturation: PlantSaturation,
     links: Option<Links>,
+    reports: Option<Reports>,
 }
 
 impl CommandPath {
@@ -29,6 +32,7 @@ impl CommandPath {
             held: vec![ActuatorCommand::default(); agents],
             saturation: PlantSaturation::new(scenario, agents)?,
             links: spec.map(|s| Links::new(s, agents)),
+            reports: scenario.reports.as_ref().map(|r| Reports::new(r, agents)),
         })
     }
 
@@ -55,6 +59,23 @@ impl CommandPath {
         if let (true, Some(l)) = (kind.silences_link(), self.links.as_mut()) {
             l.silence(i, t);
         }
+    }
+
+    /// Samples the agents' reports at physics time `t` when one is due (`bank`: what the
+    /// actuators do).
+    pub(super) fn sample_reports(&mut self, t: f64, bank: &ActuatorBank) {
+        let Some(r) = self.reports.as_mut() else {
+            return;
+        };
+        match self.links.as_ref() {
+            Some(l) => r.sample(t, bank, l.applied(), |i| l.is_silent(i, t)),
+            None => r.sample(t, bank, &self.held, |_| false),
+        }
+    }
+
+    /// Per agent, the newest report arrived by `t` (empty: the scenario has no reports).
+    pub(super) fn reports_at(&mut self, t: f64) -> Vec<Option<AgentReport>> {
+        self.reports.as_mut().map_or_else(Vec::new, |r| r.at(t))
     }
 
     /// Per agent, the last held command minus its saturated value.

@@ -157,6 +157,19 @@ impl Links {
         (&self.applied, changed)
     }
 
+    /// The commands the agents apply now (as the last [`Self::deliver`] left them).
+    pub fn applied(&self) -> &[ActuatorCommand] {
+        &self.applied
+    }
+
+    /// Whether agent `i`'s link is silent at `t` (a `link-loss` failure).
+    pub fn is_silent(&self, i: usize, t: f64) -> bool {
+        self.agents
+            .get(i)
+            .and_then(|a| a.silent_from)
+            .is_some_and(|s| t >= s - SAME_TIME)
+    }
+
     /// Per agent, what its link did so far.
     pub fn stats(&self) -> Vec<LinkStats> {
         self.agents.iter().map(|a| a.stats).collect()

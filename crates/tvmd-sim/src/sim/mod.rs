@@ -31,6 +31,7 @@ pub mod difference;
 mod forces;
 pub mod latency;
 pub mod links;
+pub mod reports;
 pub mod retention;
 pub mod sample;
 mod saturation;

@@ -19,6 +19,7 @@ use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
+use super::reports::AgentReport;
 use super::{check_divergence, forces::body_forces, Simulation};
 use crate::control::WrenchAllocation;
 use crate::flight::{FlightInput, FlightOutput};
@@ -44,6 +45,9 @@ pub struct Observation {
     pub reference: ReferenceSample,
     /// `failed[i]`: agent `i` failed and the controller is told so.
     pub failed: Vec<bool>,
+    /// Per agent, its newest report arrived by `t_k` (`None`: none yet); empty when the
+    /// scenario has no `[reports]`.
+    pub reports: Vec<Option<AgentReport>>,
 }
 
 impl Observation {
@@ -242,6 +246,7 @@ impl Simulation {
             truth,
             reference: self.scenario.reference.at(t),
             failed: self.failed_told.clone(),
+            reports: self.commands.reports_at(t),
         })
     }
 
@@ -284,6 +289,7 @@ impl Simulation {
                 }
                 self.attach_payloads(t)?;
             }
+            self.commands.sample_reports(t, &self.actuators);
             let (applied, changed) = self.commands.applied(t);
             self.forces_stale |= changed;
             self.actuators.step(applied, dt);

@@ -14,6 +14,7 @@ mod null_space;
 mod offset_free;
 mod precision;
 mod recording;
+mod reports;
 mod sample_retention;
 mod scenario_families;
 mod sim_loop;
