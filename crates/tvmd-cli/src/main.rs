@@ -27,6 +27,10 @@
 //! Every output path follows one rule (`tvmd_log::paths`): checked before any work, written
 //! to a temporary file and renamed into place, every I/O error naming its path.
 
+// The argument docs are clap's help texts (`tvmd-sim --help`), where `<scenario name>` is
+// meant literally, not HTML.
+#![allow(rustdoc::invalid_html_tags)]
+
 mod args;
 mod commands;
 mod error;

@@ -55,7 +55,7 @@ pub trait LogMessage: Encode + Send + Sized + 'static {
     fn log(&self, channels: &LogChannels, nanos: u64);
 }
 
-/// The channels of a [`RunLog`], owned by its writer thread: a [`LogJob`] writes through them.
+/// The channels of a [`crate::RunLog`], owned by its writer thread: a [`crate::writer::LogJob`] writes through them.
 pub struct LogChannels {
     pub(crate) channels: Channels,
     pub(crate) written: Written,

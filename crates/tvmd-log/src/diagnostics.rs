@@ -110,7 +110,7 @@ pub struct LyapunovDiagnostics {
 }
 
 /// The hover classification of the working agents (logged on `/hover`), reported at the tick
-/// the controller accepted a new failure mask ([`tvmd_core::Controller::set_failures`]).
+/// the controller accepted a new failure mask (`tvmd_core::Controller::set_failures`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct HoverDiagnostics {
     /// The hover wrench is strictly inside the working agents' attainable wrench set.

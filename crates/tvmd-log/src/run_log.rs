@@ -125,7 +125,7 @@ impl RunLog {
     }
 
     /// Writes an MCAP metadata record `name` with string key/value pairs (for example the
-    /// scenario, see [`METADATA_SCENARIO`]); a no-op without an MCAP file.
+    /// scenario, see [`crate::METADATA_SCENARIO`]); a no-op without an MCAP file.
     pub fn write_metadata(
         &mut self,
         name: &str,
@@ -147,7 +147,7 @@ impl RunLog {
     }
 
     /// Queues `job` for the log's writer thread, which builds and writes its messages there
-    /// ([`writer`]); waits while [`QUEUE_JOBS`] jobs are queued.
+    /// ([`crate::writer`]); waits while [`crate::writer::QUEUE_JOBS`] jobs are queued.
     pub fn submit(
         &mut self,
         job: impl FnOnce(&mut LogChannels) + Send + 'static,

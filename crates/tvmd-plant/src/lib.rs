@@ -8,7 +8,7 @@
 //! Modules, in import order: [`math`] (rotations, planned roll, row-major conversions),
 //! [`actuators`] (commands, thrust direction (eq. 1), servo and rotor-lag models, failures),
 //! [`physics`] (team body, rapier world, [`PlantState`]), [`rk4`] (an independent RK4 of the
-//! paper's dynamics, eqs. 2-3, a check on rapier), [`reference`] (the paper's reference
+//! paper's dynamics, eqs. 2-3, a check on rapier), [`reference`](mod@reference) (the paper's reference
 //! trajectory and the other references) and [`turbulence`] (the Dryden field of the air).
 //!
 //! Conventions: SI units, z up, gravity `g = 9.81 m/s^2` along `-z`; body-frame twist

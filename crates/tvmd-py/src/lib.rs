@@ -1,7 +1,7 @@
 //! Python bindings of [`tvmd_core`] and `tvmd-sim` (PyO3 + rust-numpy): the extension module
 //! `tvmd._tvmd`, one Rust module per core area, each with a `register` function called from
 //! here, the one registration point; the simulator is the submodule `_tvmd.sim`. The bindings
-//! only convert types at the boundary ([`convert`], the one conversion layer; [`errors`], the
+//! only convert types at the boundary (`convert`, the one conversion layer; `errors`, the
 //! one error mapping) and call the core. The Python API is documented in the stubs
 //! `python/tvmd/_tvmd.pyi` and `sim.pyi`.
 //!

@@ -50,7 +50,7 @@ pub struct CoreConfig {
 }
 
 impl CoreConfig {
-    /// Appends the configuration's [`config_words`]`(n)` words.
+    /// Appends the configuration's [`crate::config_words`]`(n)` words.
     pub fn put(&self, w: &mut Writer<'_>) -> Option<()> {
         w.u32(u32::try_from(self.n).ok()?)?;
         for (p, turns, mass) in self.agents.get(..self.n)? {

@@ -13,15 +13,15 @@ pub const FRAME_HEADER_BYTES: usize = 12;
 pub const MAX_PAYLOAD_BYTES: usize = 2048;
 /// Protocol version, the payload of `KIND_READY` (2: the configuration carries the law and
 /// `KIND_SET_LANDED` exists; 3: the configuration carries the fault detection and the round
-/// cap, and a cycle's answer ends with its [`FaultAnswer`]).
+/// cap, and a cycle's answer ends with its [`crate::FaultAnswer`]).
 pub const PROTOCOL_VERSION: u32 = 3;
-/// Host: configure the controller ([`CoreConfig`] words). Reply `KIND_CONFIGURED` or
+/// Host: configure the controller ([`crate::CoreConfig`] words). Reply `KIND_CONFIGURED` or
 /// `KIND_REFUSED`.
 pub const KIND_CONFIGURE: u16 = 1;
-/// Host: set the failure mask (one word of [`mask_bits`]). Reply `KIND_HOVER` or
+/// Host: set the failure mask (one word of [`crate::mask_bits`]). Reply `KIND_HOVER` or
 /// `KIND_REFUSED`.
 pub const KIND_SET_FAILURES: u16 = 2;
-/// Host: one cycle ([`INPUT_WORDS`] words). Reply `KIND_OUTPUT` or `KIND_SKIPPED`.
+/// Host: one cycle ([`crate::INPUT_WORDS`] words). Reply `KIND_OUTPUT` or `KIND_SKIPPED`.
 pub const KIND_STEP: u16 = 3;
 /// Host: the landed hold (one word, 0 or 1: `Controller::set_landed`). Reply `KIND_LANDED`.
 pub const KIND_SET_LANDED: u16 = 4;
@@ -29,12 +29,12 @@ pub const KIND_SET_LANDED: u16 = 4;
 pub const KIND_READY: u16 = 0x80;
 /// Target: controller built (the agent count).
 pub const KIND_CONFIGURED: u16 = 0x81;
-/// Target: mask accepted ([`put_hover`] words).
+/// Target: mask accepted ([`crate::put_hover`] words).
 pub const KIND_HOVER: u16 = 0x82;
-/// Target: the cycle's output ([`put_output`] words, then the [`put_fault_answer`] words).
+/// Target: the cycle's output ([`crate::put_output`] words, then the [`crate::put_fault_answer`] words).
 pub const KIND_OUTPUT: u16 = 0x83;
-/// Target: the cycle was skipped (held commands, [`put_commands`] words, the
-/// [`put_fault_answer`] words, then the message).
+/// Target: the cycle was skipped (held commands, [`crate::put_commands`] words, the
+/// [`crate::put_fault_answer`] words, then the message).
 pub const KIND_SKIPPED: u16 = 0x84;
 /// Target: configuration or mask refused (the message).
 pub const KIND_REFUSED: u16 = 0x85;

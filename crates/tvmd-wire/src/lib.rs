@@ -8,11 +8,11 @@
 //! both sides encode, decode and build the controller with the same code: only `core` and
 //! `tvmd_core`, no allocation.
 //!
-//! Modules: [`words`] (the word cursors), [`config`] (the controller's configuration, with
-//! [`law`], the law beyond the paper),
-//! [`cycle`] (a cycle's inputs and outputs, the recording's events, failure masks), [`fault`]
+//! Modules: `words` (the word cursors), `config` (the controller's configuration, with
+//! `law`, the law beyond the paper),
+//! `cycle` (a cycle's inputs and outputs, the recording's events, failure masks), `fault`
 //! (the fault detection's settings and a cycle's fault answer) and
-//! [`frame`] (processor-in-the-loop frames and their CRC-32).
+//! `frame` (processor-in-the-loop frames and their CRC-32).
 
 #![no_std]
 #![warn(missing_docs)]

@@ -13,8 +13,8 @@
 //! and ends at `z = 0`. (The contact model is soft: at rest the colliders sink by well under a
 //! millimetre; see the landing test.)
 //!
-//! Files: [`team_body`] (the agents and the team's mass properties), [`state`] (the plant's
-//! state and the physics settings) and [`world`] (the rapier world and its step).
+//! Files: `team_body` (the agents and the team's mass properties), `state` (the plant's
+//! state and the physics settings) and `world` (the rapier world and its step).
 
 mod state;
 mod team_body;
