@@ -22,7 +22,10 @@
 # gimbal offsets): takeoff, hover with a bad parameter refused in flight, the paper's tilt through
 # the sticks, landing; scripts/px4/tvmd_control.py checks each (hover rms error at most 2 cm, the
 # tilt held within 0.1 m, the largest planned roll within 0.02 rad of tvmd-sim's own flight of the
-# reference, the parameter refused, no refused period, no non-finite output, landed). It needs
+# reference, the parameter refused, no refused period, no non-finite output, landed). Then an
+# agent failure, told (scenario-agent-failure.toml): the hover certificate lost, tvmd_control
+# asks PX4 to land (land mode within 1 s), the team lands on three agents (tilt at most 0.8 rad,
+# standing within 0.15 m of the target, disarmed). It needs
 # pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
 # PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs.
 set -euo pipefail
@@ -35,7 +38,7 @@ for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
     --fly) fly=1 ;;
-    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -135,7 +138,15 @@ if [ "$fly" -eq 1 ]; then
       --own "$out/own-tilt.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
       --json "$out/$flight.measures.json"
   done
-  echo "tvmd_control flew hover and the tilt in PX4 SITL (ulogs in $out)"
+  step "tvmd_control in PX4 on tvmd-sim: an agent failure, told (the certificate lost: PX4 lands it)"
+  start=$(date +%s)
+  "$sim" px4 "$flights/scenario-agent-failure.toml" --flight "$flights/flight-agent-failure.toml" \
+    --px4-dir "$px4_dir" --autostart 4090 --params "$flights/params" --instance "$instance" \
+    --out "$out/agent-failure.mcap"
+  echo "flown in $(($(date +%s) - start)) s wall"
+  python3 "$repo/scripts/px4/tvmd_control.py" "$out/agent-failure.ulg" "$out/agent-failure.px4.json" \
+    --failed-tilt 0.8 --failed-landing 0.15 --json "$out/agent-failure.measures.json"
+  echo "tvmd_control flew hover, the tilt and the agent failure in PX4 SITL (ulogs in $out)"
 fi
 
 [ "$smoke" -eq 1 ] || exit 0

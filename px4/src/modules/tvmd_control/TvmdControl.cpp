@@ -384,10 +384,14 @@ void TvmdControl::request_land(const char *reason)
 	cmd.param5 = static_cast<double>(NAN);
 	cmd.param6 = static_cast<double>(NAN);
 	cmd.param7 = NAN;
-	cmd.target_system = 1;
-	cmd.target_component = 1;
-	cmd.source_system = 1;
-	cmd.source_component = 1;
+	/* Addressed to this vehicle (MAV_SYS_ID, which SITL sets per instance), as PX4's own
+	 * modules do: commander ignores a command for another system. */
+	vehicle_status_s status{};
+	_vehicle_status_sub.copy(&status);
+	cmd.target_system = status.system_id;
+	cmd.target_component = status.component_id;
+	cmd.source_system = status.system_id;
+	cmd.source_component = status.component_id;
 	cmd.from_external = false;
 	cmd.timestamp = hrt_absolute_time();
 	_command_pub.publish(cmd);
@@ -539,11 +543,21 @@ void TvmdControl::publish_status(const TvmdAllocationOutput &alloc, hrt_abstime 
 
 	s.saturated_periods = _saturated_periods;
 
-	/* The stage interface does not give the offset-free state: see docs/px4-module.md. */
-	for (int i = 0; i < 3; ++i) {
-		s.compensation_force[i] = NAN;
-		s.compensation_torque[i] = NAN;
+	/* The offset-free state after the latest allocation (tvmd_compensation; NaN before the
+	 * first one); on the ground, where nothing is allocated, read from the handle (zero while
+	 * landed). */
+	TvmdCompensation compensation = _cascade.compensation();
+
+	if (_ground_idle) {
+		compensation.size = sizeof(compensation);
+		_log.record(tvmd_control::ALLOCATE, tvmd_compensation(&_controller, &compensation));
+
+	} else if (_cascade.report().compensation.last != TVMD_OK) {
+		_log.record(tvmd_control::ALLOCATE, _cascade.report().compensation.last);
 	}
+
+	flipped(compensation.force, s.compensation_force);
+	flipped(compensation.torque, s.compensation_torque);
 
 	s.hover_capable = _hover.capable != 0;
 	s.hover_margin = _hover.margin;

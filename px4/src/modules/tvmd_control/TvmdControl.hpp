@@ -33,6 +33,7 @@
 #include <uORB/topics/vehicle_control_mode.h>
 #include <uORB/topics/vehicle_land_detected.h>
 #include <uORB/topics/vehicle_local_position.h>
+#include <uORB/topics/vehicle_status.h>
 #include <uORB/topics/vehicle_thrust_setpoint.h>
 
 #include <Takeoff.hpp>
@@ -109,6 +110,7 @@ private:
 	uORB::Subscription _land_detected_sub{ORB_ID(vehicle_land_detected)};
 	uORB::Subscription _failure_detector_sub{ORB_ID(failure_detector_status)};
 	uORB::Subscription _vehicle_constraints_sub{ORB_ID(vehicle_constraints)};
+	uORB::Subscription _vehicle_status_sub{ORB_ID(vehicle_status)};
 
 	uORB::Publication<actuator_motors_s> _motors_pub{ORB_ID(actuator_motors)};
 	uORB::Publication<actuator_servos_s> _servos_pub{ORB_ID(actuator_servos)};
