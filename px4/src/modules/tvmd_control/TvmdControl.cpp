@@ -62,8 +62,18 @@ bool TvmdControl::init()
 		return false;
 	}
 
-	if (!apply_parameters()) {
+	/* The creation (tvmd_create, 3,596 B of stack on a Cortex-M4F) in the configuration
+	 * task, as every later parameter change: start() returns when it is done. */
+	if (!_config_task.start(&TvmdControl::config_task_main)) {
+		PX4_ERR("configuration task not started");
+		return false;
+	}
+
+	_config_task.take_back();
+
+	if (!_created) {
 		PX4_ERR("no valid configuration: not started");
+		_config_task.stop();
 		return false;
 	}
 
@@ -89,6 +99,27 @@ bool TvmdControl::init()
 	}
 
 	return true;
+}
+
+int TvmdControl::config_task_main(int argc, char *argv[])
+{
+	TvmdControl *instance = get_instance();  // stored by task_spawn before init()
+
+	if (instance != nullptr) {
+		instance->run_configuration();
+	}
+
+	return 0;
+}
+
+void TvmdControl::run_configuration()
+{
+	while (_config_task.wait_for_request()) {
+		apply_parameters();
+		_config_task.done();
+	}
+
+	_config_task.exited();
 }
 
 bool TvmdControl::apply_parameters()
@@ -324,8 +355,8 @@ void TvmdControl::run_law()
 {
 	vehicle_local_position_s lp;
 
-	if (!_law_position_sub.update(&lp)) {
-		return;
+	if (!_law_position_sub.update(&lp) || _config_task.state() != tvmd_control::ConfigTask::IDLE) {
+		return;  // no sample, or the configuration task holds the handle
 	}
 
 	if (!_have_attitude || !_have_angular_velocity || !lp.xy_valid || !lp.z_valid || !lp.v_xy_valid || !lp.v_z_valid) {
@@ -338,7 +369,6 @@ void TvmdControl::run_law()
 
 	perf_begin(_law_perf);
 	_law_timer.begin();
-	update_failures();
 	const TvmdState state = tvmd::px4::state_from(lp, _attitude, _angular_velocity);
 	const TvmdReference reference = reference_for(lp, _attitude);
 	const TvmdStatus status = _cascade.position(state, reference);
@@ -403,6 +433,7 @@ void TvmdControl::Run()
 	if (should_exit()) {
 		_angular_velocity_sub.unregisterCallback();
 		_law_position_sub.unregisterCallback();
+		_config_task.stop();
 		exit_and_cleanup();
 		return;
 	}
@@ -410,14 +441,32 @@ void TvmdControl::Run()
 	perf_begin(_rate_perf);
 	perf_count(_rate_interval_perf);
 
-	if (_parameter_update_sub.updated()) {
-		parameter_update_s update;
-		_parameter_update_sub.copy(&update);
-		apply_parameters();
-	}
-
 	if (_angular_velocity_sub.update(&_angular_velocity)) {
 		_have_angular_velocity = true;
+	}
+
+	/* A parameter change: the handle goes to the configuration task (ConfigTask.hpp), and
+	 * until it is back the held outputs are sent again. */
+	const tvmd_control::ConfigTask::State config = _config_task.state();
+
+	if (config == tvmd_control::ConfigTask::DONE) {
+		_config_task.take_back();
+
+	} else if (config == tvmd_control::ConfigTask::REQUESTED) {
+		++_held_periods;
+		publish_held(_angular_velocity.timestamp_sample);
+		perf_end(_rate_perf);
+		return;
+
+	} else if (_parameter_update_sub.updated()) {
+		parameter_update_s update;
+		_parameter_update_sub.copy(&update);
+		_config_task.request();
+		++_config_requests;
+		++_held_periods;
+		publish_held(_angular_velocity.timestamp_sample);
+		perf_end(_rate_perf);
+		return;
 	}
 
 	_have_attitude |= _attitude_sub.update(&_attitude);
@@ -429,6 +478,11 @@ void TvmdControl::Run()
 		perf_end(_rate_perf);
 		return;
 	}
+
+	/* The failure mask at the rate loop's rate: a told failure reaches the allocation within
+	 * one period, and tvmd_set_failures (2,572 B on a Cortex-M4F) runs under Run()'s frame,
+	 * not under the law's larger one (docs/px4-module.md, On a flight controller). */
+	update_failures();
 
 	_rate_timer.begin();
 	const TvmdState state = tvmd::px4::state_from(_local_position, _attitude, _angular_velocity);
@@ -474,19 +528,9 @@ void TvmdControl::publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime
 	if (status == TVMD_OK) {
 		_outputs = outputs;
 		_have_outputs = true;
-
-	} else if (!_have_outputs) {
-		return;  // nothing good was ever mapped: publish nothing rather than a guess
 	}
 
-	actuator_motors_s motors{};
-	actuator_servos_s servos{};
-	tvmd::px4::actuators_from(_outputs, motors, servos);
-	motors.timestamp_sample = timestamp_sample;
-	servos.timestamp_sample = timestamp_sample;
-	motors.timestamp = servos.timestamp = hrt_absolute_time();
-	_motors_pub.publish(motors);
-	_servos_pub.publish(servos);
+	publish_held(timestamp_sample);
 
 	/* The collective thrust for PX4's land detector and hover thrust estimator, normalized by
 	 * the team's largest thrust n sigma_Tf (FRD). */
@@ -506,6 +550,22 @@ void TvmdControl::publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime
 		thrust.timestamp = hrt_absolute_time();
 		_thrust_pub.publish(thrust);
 	}
+}
+
+void TvmdControl::publish_held(hrt_abstime timestamp_sample)
+{
+	if (!_have_outputs) {
+		return;  // nothing good was ever mapped: publish nothing rather than a guess
+	}
+
+	actuator_motors_s motors{};
+	actuator_servos_s servos{};
+	tvmd::px4::actuators_from(_outputs, motors, servos);
+	motors.timestamp_sample = timestamp_sample;
+	servos.timestamp_sample = timestamp_sample;
+	motors.timestamp = servos.timestamp = hrt_absolute_time();
+	_motors_pub.publish(motors);
+	_servos_pub.publish(servos);
 }
 
 void TvmdControl::publish_status(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample)
@@ -596,6 +656,10 @@ int TvmdControl::print_status()
 		 static_cast<unsigned>(_rate_timer.count()), static_cast<double>(_rate_timer.mean_us()),
 		 static_cast<double>(_rate_timer.max_us()), static_cast<unsigned>(_law_timer.count()),
 		 static_cast<double>(_law_timer.mean_us()), static_cast<double>(_law_timer.max_us()));
+
+	PX4_INFO("configuration task (its own stack, %d B): %u parameter changes, %u rate periods held meanwhile",
+		 tvmd_control::ConfigTask::STACK_SIZE, static_cast<unsigned>(_config_requests),
+		 static_cast<unsigned>(_held_periods));
 
 	for (int i = 0; i < tvmd_control::STAGE_COUNT; ++i) {
 		const auto stage = static_cast<tvmd_control::Stage>(i);
