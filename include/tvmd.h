@@ -1328,7 +1328,8 @@ TvmdStatus tvmd_actuator_commands(const struct TvmdController *handle,
  records the delivered wrench for the observer): read after that allocation, it is
  `tvmd_step`'s `compensation_*` of the same period, bit for bit. Reads the controller,
  changes nothing. On an error after `out` was found usable (a handle not created or
- corrupted) the numbers are NaN.
+ corrupted, `TVMD_ERR_CORRUPTED` also for a non-finite offset-free state, which only a stray
+ write leaves) the numbers are NaN.
 
  # Safety
  `handle` is null or points to a `TvmdController`; `out` is null or points to a

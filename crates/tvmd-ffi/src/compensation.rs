@@ -3,7 +3,7 @@
 //! (`tvmd_law`, `tvmd_attitude`, `tvmd_allocate`) and so never receives a `TvmdOutput`.
 
 use crate::handle::{checked_size, inner, TvmdController};
-use crate::status::{TvmdStatus, TVMD_ERR_NULL_POINTER, TVMD_OK};
+use crate::status::{TvmdStatus, TVMD_ERR_CORRUPTED, TVMD_ERR_NULL_POINTER, TVMD_OK};
 
 /// The offset-free compensation as it stands: the wrench the offset-free state adds to the
 /// next law period's request (the observer's estimate of the unmodelled wrench is its
@@ -24,7 +24,8 @@ pub struct TvmdCompensation {
 /// records the delivered wrench for the observer): read after that allocation, it is
 /// `tvmd_step`'s `compensation_*` of the same period, bit for bit. Reads the controller,
 /// changes nothing. On an error after `out` was found usable (a handle not created or
-/// corrupted) the numbers are NaN.
+/// corrupted, `TVMD_ERR_CORRUPTED` also for a non-finite offset-free state, which only a stray
+/// write leaves) the numbers are NaN.
 ///
 /// # Safety
 /// `handle` is null or points to a `TvmdController`; `out` is null or points to a
@@ -40,17 +41,21 @@ pub unsafe extern "C" fn tvmd_compensation(
     if let Err(status) = checked_size::<TvmdCompensation>(out.size) {
         return status;
     }
-    match inner(handle) {
+    let status = match inner(handle) {
         Ok(inner) => {
             let c = inner.controller.offset_free_compensation();
-            out.force = c.force.into();
-            out.torque = c.torque.into();
-            TVMD_OK
+            // The offset-free state is bounded and finite by construction: anything else is a
+            // stray write into the storage, refused rather than handed on.
+            if c.force.iter().chain(c.torque.iter()).all(|v| v.is_finite()) {
+                out.force = c.force.into();
+                out.torque = c.torque.into();
+                return TVMD_OK;
+            }
+            TVMD_ERR_CORRUPTED
         }
-        Err(status) => {
-            out.force = [f32::NAN; 3];
-            out.torque = [f32::NAN; 3];
-            status
-        }
-    }
+        Err(status) => status,
+    };
+    out.force = [f32::NAN; 3];
+    out.torque = [f32::NAN; 3];
+    status
 }
