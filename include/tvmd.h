@@ -14,7 +14,8 @@
  *
  * The cycle by stages, each at its own rate: tvmd_law (state, reference -> body wrench),
  * tvmd_attitude (the torque for a planned attitude), tvmd_allocate (body wrench -> commands),
- * tvmd_plan (the planner alone); tvmd_step is tvmd_law then tvmd_allocate.
+ * tvmd_plan (the planner alone); tvmd_step is tvmd_law then tvmd_allocate. A caller of the
+ * stages reads the offset-free compensation with tvmd_compensation.
  */
 
 #ifndef TVMD_H
@@ -396,6 +397,26 @@ typedef struct TvmdActuatorOutputs {
    */
   float servos[TVMD_OUTPUT_CHANNELS];
 } TvmdActuatorOutputs;
+
+/*
+ The offset-free compensation as it stands: the wrench the offset-free state adds to the
+ next law period's request (the observer's estimate of the unmodelled wrench is its
+ negative). Zero without an offset-free action and while landed (`tvmd_set_landed`).
+ */
+typedef struct TvmdCompensation {
+  /*
+   `sizeof(TvmdCompensation)`, set by the caller.
+   */
+  uint32_t size;
+  /*
+   The offset-free force (N, inertial frame), as `TvmdOutput.compensation_force`.
+   */
+  float force[3];
+  /*
+   The offset-free torque (N m, body frame), as `TvmdOutput.compensation_torque`.
+   */
+  float torque[3];
+} TvmdCompensation;
 
 /*
  One agent of the team (paper, "Modeling"): its gimbal centre, yaw and mass.
@@ -1300,6 +1321,21 @@ TvmdStatus tvmd_actuator_commands(const struct TvmdController *handle,
                                   const struct TvmdActuatorOutputs *outputs,
                                   struct TvmdAgentCommand *commands,
                                   size_t count);
+
+/*
+ Fills `out` (its `size` set by the caller) with the offset-free compensation as it stands.
+ Run by stages, it is updated by the `tvmd_allocate` that follows a `tvmd_law` (which
+ records the delivered wrench for the observer): read after that allocation, it is
+ `tvmd_step`'s `compensation_*` of the same period, bit for bit. Reads the controller,
+ changes nothing. On an error after `out` was found usable (a handle not created or
+ corrupted, `TVMD_ERR_CORRUPTED` also for a non-finite offset-free state, which only a stray
+ write leaves) the numbers are NaN.
+
+ # Safety
+ `handle` is null or points to a `TvmdController`; `out` is null or points to a
+ `TvmdCompensation`.
+ */
+TvmdStatus tvmd_compensation(const struct TvmdController *handle, struct TvmdCompensation *out);
 
 /*
  Fills `config` with the library's default: the paper's team "A4 inc, 1 navigator" and

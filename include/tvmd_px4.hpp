@@ -226,6 +226,7 @@ class Cascade {
     StageReport law;      /* `position`: tvmd_law */
     StageReport attitude; /* `attitude_and_allocate`: tvmd_attitude (and "no law output yet") */
     StageReport allocate; /* `attitude_and_allocate`: tvmd_allocate */
+    StageReport compensation; /* `attitude_and_allocate`: tvmd_compensation */
   };
 
   explicit Cascade(TvmdController *controller) : controller_(controller) {
@@ -236,6 +237,9 @@ class Cascade {
     std::memset(&requested_, 0, sizeof requested_);
     requested_.size = sizeof requested_;
     force_world_.fill(0.0f);
+    std::memset(&compensation_, 0, sizeof compensation_);
+    compensation_.size = sizeof compensation_;
+    for (std::size_t i = 0; i < 3; ++i) compensation_.force[i] = compensation_.torque[i] = NAN;
   }
 
   /* The law stage. On an error the last good law output stays in force. */
@@ -274,6 +278,8 @@ class Cascade {
     /* On an error tvmd_allocate itself writes the held commands. */
     const TvmdStatus allocated = tvmd_allocate(controller_, &requested_, out);
     report_.allocate.record(allocated);
+    /* The allocation after a law period updates the offset-free state: read it now. */
+    report_.compensation.record(tvmd_compensation(controller_, &compensation_));
     return allocated;
   }
 
@@ -284,6 +290,11 @@ class Cascade {
   const TvmdAttitudeOutput &attitude() const { return attitude_; }
   const TvmdWrench &requested() const { return requested_; }
   bool has_law() const { return have_law_; }
+  /* The offset-free compensation (force N in tvmd's world frame, torque N m in its body frame)
+   * after the latest fast period that reached the allocation: what the next law period adds
+   * to its request; zero without an offset-free action and while landed, NaN before the first
+   * allocation. `tvmd_step`'s `compensation_*` of the same period. */
+  const TvmdCompensation &compensation() const { return compensation_; }
   const Report &report() const { return report_; }
 
  private:
@@ -308,6 +319,7 @@ class Cascade {
   TvmdWrench requested_;
   TvmdReference reference_{};
   Vec3 force_world_{};
+  TvmdCompensation compensation_;
   bool have_law_ = false;
   Report report_{};
 };

@@ -4,7 +4,7 @@
 # parameter and keeps running; with --fly, flies it on tvmd-sim in lockstep (tvmd-sim px4) and
 # checks the flights from their ulogs (docs/px4-module.md).
 #
-#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly]   (or PX4_DIR=... bash scripts/px4-module.sh)
+#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly] [--side-by-side]   (or PX4_DIR=... bash scripts/px4-module.sh)
 #
 # What it changes in PX4_DIR (each once; rerunning is safe):
 #   - installs the airframe px4/airframes/4090_tvmd_control_a4 (+ .post) into
@@ -22,20 +22,28 @@
 # gimbal offsets): takeoff, hover with a bad parameter refused in flight, the paper's tilt through
 # the sticks, landing; scripts/px4/tvmd_control.py checks each (hover rms error at most 2 cm, the
 # tilt held within 0.1 m, the largest planned roll within 0.02 rad of tvmd-sim's own flight of the
-# reference, the parameter refused, no refused period, no non-finite output, landed). It needs
+# reference, the parameter refused, no refused period, no non-finite output, landed). Then an
+# agent failure, told (scenario-agent-failure.toml): the hover certificate lost, tvmd_control
+# asks PX4 to land (land mode within 1 s), the team lands on three agents (tilt at most 0.8 rad,
+# standing within 0.15 m of the target, disarmed). It needs
 # pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
-# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs.
+# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies the
+# hover of tvmd_control and of the authors' modules (their PX4 fork) on the nominal vehicle,
+# under a steady wind and off its model, and prints the table of docs/px4-module.md
+# (scripts/px4/side_by_side.py; not asserted, about a minute).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
 px4_dir="${PX4_DIR:-}"
 smoke=0
 fly=0
+side=0
 for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
     --fly) fly=1 ;;
-    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    --side-by-side) side=1 ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -101,7 +109,7 @@ if ! (cd "$px4_dir" && GIT_SUBMODULES_ARE_EVIL="${GIT_SUBMODULES_ARE_EVIL:-1}" \
 fi
 echo "built in $(($(date +%s) - start)) s (log: $log)"
 
-[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || exit 0
+[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || exit 0
 case "$target" in
   px4_sitl*) ;;
   *) echo "error: --smoke and --fly need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
@@ -109,7 +117,7 @@ esac
 build="$px4_dir/build/$target"
 instance="${PX4_INSTANCE:-7}"
 
-if [ "$fly" -eq 1 ]; then
+if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ]; then
   python3 -c 'import pyulog' 2>/dev/null || {
     echo "error: --fly reads the ulogs with pyulog: install it in the Python environment (pip install pyulog)" >&2
     exit 2
@@ -123,6 +131,28 @@ if [ "$fly" -eq 1 ]; then
   out="$repo/target/px4-module-flights"
   mkdir -p "$out"
   flights="$repo/scripts/px4/tvmd_control"
+fi
+
+if [ "$side" -eq 1 ]; then
+  # Not in the test command (about a minute): the hover of each stack on the nominal vehicle,
+  # under a steady wind and off its model; the table of docs/px4-module.md. The authors' modules
+  # need their PX4 fork (airframe 4007).
+  authors="$repo/scripts/px4/authors"
+  for flight in nominal wind model-error; do
+    scenario=scenario; [ "$flight" = nominal ] || scenario="scenario-$flight"
+    step "side by side, $flight: tvmd_control (airframe 4090)"
+    "$sim" px4 "$flights/$scenario.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
+      --autostart 4090 --params "$flights/params" --instance "$instance" \
+      --out "$out/tvmd-$flight.mcap" >/dev/null
+    step "side by side, $flight: the authors' modules (airframe 4007, their position mode)"
+    "$sim" px4 "$authors/$scenario.toml" --flight "$authors/flight-hold.toml" --px4-dir "$px4_dir" \
+      --autostart 4007 --params "$authors/params" --instance "$instance" \
+      --out "$out/authors-$flight.mcap" >/dev/null
+  done
+  python3 "$repo/scripts/px4/side_by_side.py" "$out"
+fi
+
+if [ "$fly" -eq 1 ]; then
   step "tvmd-sim's own flight of the reference (the paper's tilt, tvmd_control's law)"
   "$sim" run "$flights/own-tilt.toml" --summary "$out/own-tilt.json" --out "$out/own-tilt.mcap" >/dev/null
   for flight in scenario scenario-model-error; do
@@ -135,7 +165,15 @@ if [ "$fly" -eq 1 ]; then
       --own "$out/own-tilt.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
       --json "$out/$flight.measures.json"
   done
-  echo "tvmd_control flew hover and the tilt in PX4 SITL (ulogs in $out)"
+  step "tvmd_control in PX4 on tvmd-sim: an agent failure, told (the certificate lost: PX4 lands it)"
+  start=$(date +%s)
+  "$sim" px4 "$flights/scenario-agent-failure.toml" --flight "$flights/flight-agent-failure.toml" \
+    --px4-dir "$px4_dir" --autostart 4090 --params "$flights/params" --instance "$instance" \
+    --out "$out/agent-failure.mcap"
+  echo "flown in $(($(date +%s) - start)) s wall"
+  python3 "$repo/scripts/px4/tvmd_control.py" "$out/agent-failure.ulg" "$out/agent-failure.px4.json" \
+    --failed-tilt 0.8 --failed-landing 0.15 --json "$out/agent-failure.measures.json"
+  echo "tvmd_control flew hover, the tilt and the agent failure in PX4 SITL (ulogs in $out)"
 fi
 
 [ "$smoke" -eq 1 ] || exit 0

@@ -17,6 +17,8 @@
 //!   relaxation and rate limits, seed the held commands at a mode switch.
 //! - [`stages`]: the cycle's stages on the same handle, each at its own rate: `tvmd_law`
 //!   (the body wrench), `tvmd_allocate` (a body wrench to commands) and `tvmd_plan`.
+//! - [`compensation`]: the offset-free compensation read from the handle, for a caller that
+//!   runs the stages.
 //! - [`actuator`]: commands to PX4-style normalized motor and servo outputs through a channel
 //!   map, and back.
 //!
@@ -39,6 +41,7 @@ extern crate std;
 
 pub mod actuator;
 mod blueprint;
+pub mod compensation;
 pub mod config;
 pub mod fault;
 pub mod fault_report;

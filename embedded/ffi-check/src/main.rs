@@ -8,6 +8,7 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use tvmd_ffi::actuator::*;
+use tvmd_ffi::compensation::*;
 use tvmd_ffi::config::*;
 use tvmd_ffi::fault_report::*;
 use tvmd_ffi::handle::*;
@@ -66,6 +67,9 @@ pub extern "C" fn _start() -> ! {
         hover.size = core::mem::size_of::<TvmdHover>() as u32;
         status[3] = tvmd_hover_capability(handle, &mut hover);
         status[3] += tvmd_validate_config(&config) + tvmd_check(handle);
+        let mut compensation: TvmdCompensation = core::mem::zeroed();
+        compensation.size = core::mem::size_of::<TvmdCompensation>() as u32;
+        status[3] += tvmd_compensation(handle, &mut compensation);
         write_volatile(
             addr_of_mut!(NAME),
             tvmd_ffi::status::tvmd_status_name(status[1]) as usize

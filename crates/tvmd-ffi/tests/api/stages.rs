@@ -4,6 +4,7 @@
 
 use std::mem::size_of;
 
+use tvmd_ffi::compensation::*;
 use tvmd_ffi::handle::*;
 use tvmd_ffi::stages::*;
 use tvmd_ffi::status::*;
@@ -48,6 +49,27 @@ fn wrench_of(law: &TvmdLawOutput) -> TvmdWrench {
     }
 }
 
+/// One period on two handles: `tvmd_step` on `whole`, `tvmd_law` then `tvmd_allocate` on
+/// `staged`; each must succeed.
+fn step_and_stages(
+    whole: &mut TvmdController,
+    staged: &mut TvmdController,
+    state: &TvmdState,
+    reference: &TvmdReference,
+) -> (TvmdOutput, TvmdLawOutput, TvmdAllocationOutput) {
+    let mut out: TvmdOutput = unsafe { std::mem::zeroed() };
+    out.size = size_of::<TvmdOutput>() as u32;
+    let mut law = law_output();
+    let mut alloc = allocation_output();
+    // SAFETY: valid pointers to live values.
+    unsafe {
+        assert_eq!(tvmd_step(whole, state, reference, &mut out), TVMD_OK);
+        assert_eq!(tvmd_law(staged, state, reference, &mut law), TVMD_OK);
+        assert_eq!(tvmd_allocate(staged, &wrench_of(&law), &mut alloc), TVMD_OK);
+    }
+    (out, law, alloc)
+}
+
 #[test]
 fn law_then_allocate_is_the_step_and_plan_is_its_planner() {
     for allocator in [
@@ -58,25 +80,7 @@ fn law_then_allocate_is_the_step_and_plan_is_its_planner() {
         let mut staged = created_with(allocator);
         for k in 0..40 {
             let (state, reference) = inputs(0.2 - 0.005 * k as f32, 0.03 * k as f32);
-            let mut out: TvmdOutput = unsafe { std::mem::zeroed() };
-            out.size = size_of::<TvmdOutput>() as u32;
-            let mut law = law_output();
-            let mut alloc = allocation_output();
-            // SAFETY: valid pointers to live values.
-            unsafe {
-                assert_eq!(
-                    tvmd_step(&mut *whole, &state, &reference, &mut out),
-                    TVMD_OK
-                );
-                assert_eq!(
-                    tvmd_law(&mut *staged, &state, &reference, &mut law),
-                    TVMD_OK
-                );
-                assert_eq!(
-                    tvmd_allocate(&mut *staged, &wrench_of(&law), &mut alloc),
-                    TVMD_OK
-                );
-            }
+            let (out, law, alloc) = step_and_stages(&mut whole, &mut staged, &state, &reference);
             assert_eq!(alloc.commands, out.commands, "period {k}");
             assert_eq!(alloc.force_error, out.e_f);
             assert_eq!(law.planned_attitude, out.planned_attitude);
@@ -172,6 +176,72 @@ fn stages_refuse_bad_inputs_cleanly() {
         assert_eq!(
             tvmd_allocate(&mut never, &wrench_of(&law), &mut alloc),
             TVMD_ERR_NOT_INITIALIZED
+        );
+    }
+}
+
+fn compensation_of(handle: &TvmdController) -> (TvmdStatus, TvmdCompensation) {
+    let mut c = TvmdCompensation {
+        size: size_of::<TvmdCompensation>() as u32,
+        ..TvmdCompensation::default()
+    };
+    // SAFETY: valid pointers to live values.
+    let status = unsafe { tvmd_compensation(handle, &mut c) };
+    (status, c)
+}
+
+/// A caller running the stages reads the offset-free compensation from the handle: after each
+/// period's allocation it is `tvmd_step`'s `compensation_*` of the same period, bit for bit.
+#[test]
+fn the_compensation_read_between_stages_is_the_steps() {
+    let config = super::config_from(tvmd_ffi::config::tvmd_config_default);
+    let ((s1, mut whole), (s2, mut staged)) = (super::create(&config), super::create(&config));
+    assert_eq!((s1, s2), (TVMD_OK, TVMD_OK));
+    let mut moved = 0;
+    for k in 0..60 {
+        // A state that does not follow the law's request: the observer sees a disturbance.
+        let (state, reference) = inputs(0.2 - 0.002 * k as f32, 0.0);
+        let (out, _, _) = step_and_stages(&mut whole, &mut staged, &state, &reference);
+        let (status, c) = compensation_of(&staged);
+        assert_eq!(status, TVMD_OK);
+        assert_eq!(c.force, out.compensation_force, "period {k}");
+        assert_eq!(c.torque, out.compensation_torque, "period {k}");
+        moved += usize::from(c.force != [0.0; 3]);
+    }
+    assert!(moved > 50, "the observer's force moved in {moved} periods");
+    // Landed: zero at once.
+    // SAFETY: a created handle.
+    assert_eq!(unsafe { tvmd_set_landed(&mut *staged, 1) }, TVMD_OK);
+    assert_eq!(compensation_of(&staged).1.force, [0.0; 3]);
+}
+
+#[test]
+fn the_compensation_getter_refuses_bad_arguments() {
+    let handle = created_with(TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION);
+    // The paper's law has no offset-free action: zero.
+    let (status, c) = compensation_of(&handle);
+    assert_eq!(status, TVMD_OK);
+    assert_eq!((c.force, c.torque), ([0.0; 3], [0.0; 3]));
+    let never: TvmdController = unsafe { std::mem::zeroed() };
+    let (status, c) = compensation_of(&never);
+    assert_eq!(status, TVMD_ERR_NOT_INITIALIZED);
+    assert!(c.force.iter().chain(&c.torque).all(|v| v.is_nan()));
+    let mut c = TvmdCompensation {
+        size: 3,
+        ..TvmdCompensation::default()
+    };
+    // SAFETY: valid pointers to live values, or null where the test says so.
+    unsafe {
+        assert_eq!(tvmd_compensation(&*handle, &mut c), TVMD_ERR_SIZE);
+        assert_eq!(c.force, [0.0; 3], "a wrongly sized struct is not written");
+        c.size = size_of::<TvmdCompensation>() as u32;
+        assert_eq!(
+            tvmd_compensation(std::ptr::null(), &mut c),
+            TVMD_ERR_NULL_POINTER
+        );
+        assert_eq!(
+            tvmd_compensation(&*handle, std::ptr::null_mut()),
+            TVMD_ERR_NULL_POINTER
         );
     }
 }

@@ -1,6 +1,7 @@
 /* The C test of the stages and the reconfiguration (run from tvmd_test.c's main): on two
  * handles of the same configuration, tvmd_law then tvmd_allocate gives tvmd_step's commands
- * bit for bit through a tilt the planner saturates on; tvmd_plan plans for a force; a refused
+ * bit for bit through a tilt the planner saturates on, and tvmd_compensation its offset-free
+ * compensation; tvmd_plan plans for a force; a refused
  * reconfiguration leaves the controller stepping exactly as before; the setters, the seed
  * and the storage guards refuse bad input with a clean status. */
 #include <math.h>
@@ -28,8 +29,11 @@ static TvmdReference tilted(float roll) {
   return r;
 }
 
-static void test_stages_match_the_step(TvmdController *whole, TvmdController *staged) {
-  int k, a;
+/* Returns the periods whose offset-free compensation (read from the staged handle with
+ * tvmd_compensation, equal to the step's bit for bit) was not zero. With `all_lift`, every
+ * agent lifts in every period (the paper's law). */
+static int test_stages_match_the_step(TvmdController *whole, TvmdController *staged, int all_lift) {
+  int k, a, moved = 0;
   for (k = 0; k < 30; ++k) {
     TvmdState s = at_rest(0.2f - 0.005f * (float)k, 0.0f, 1.5f);
     TvmdReference r = tilted(0.04f * (float)k);
@@ -37,6 +41,7 @@ static void test_stages_match_the_step(TvmdController *whole, TvmdController *st
     TvmdLawOutput law;
     TvmdAllocationOutput alloc;
     TvmdWrench w;
+    TvmdCompensation comp;
     memset(&law, 0, sizeof law);
     law.size = sizeof law;
     memset(&alloc, 0, sizeof alloc);
@@ -51,8 +56,29 @@ static void test_stages_match_the_step(TvmdController *whole, TvmdController *st
     CHECK(memcmp(law.planned_attitude, o.planned_attitude, sizeof law.planned_attitude) == 0);
     CHECK(law.planner_status == o.planner_status);
     CHECK(alloc.force_error == o.e_f);
-    for (a = 0; a < 4; ++a) CHECK(alloc.commands[a].thrust > 0.0f);
+    for (a = 0; a < 4 && all_lift; ++a) CHECK(alloc.commands[a].thrust > 0.0f);
+    memset(&comp, 0, sizeof comp);
+    comp.size = sizeof comp;
+    CHECK_STATUS(tvmd_compensation(staged, &comp), TVMD_OK);
+    CHECK(memcmp(comp.force, o.compensation_force, sizeof comp.force) == 0);
+    CHECK(memcmp(comp.torque, o.compensation_torque, sizeof comp.torque) == 0);
+    moved += comp.force[0] != 0.0f || comp.force[1] != 0.0f || comp.force[2] != 0.0f;
   }
+  return moved;
+}
+
+static void test_compensation_errors(TvmdController *c) {
+  static TvmdController never;
+  TvmdCompensation comp;
+  memset(&comp, 0, sizeof comp);
+  comp.size = 3;
+  CHECK_STATUS(tvmd_compensation(c, &comp), TVMD_ERR_SIZE);
+  CHECK(comp.force[0] == 0.0f); /* not written */
+  comp.size = sizeof comp;
+  CHECK_STATUS(tvmd_compensation(c, NULL), TVMD_ERR_NULL_POINTER);
+  CHECK_STATUS(tvmd_compensation(NULL, &comp), TVMD_ERR_NULL_POINTER);
+  CHECK_STATUS(tvmd_compensation(&never, &comp), TVMD_ERR_NOT_INITIALIZED);
+  CHECK(isnan(comp.force[0]) && isnan(comp.torque[2]));
 }
 
 static void test_plan(TvmdController *c) {
@@ -115,8 +141,18 @@ void test_stages(void) {
   TvmdConfig config = paper();
   CHECK_STATUS(tvmd_create(&whole_storage, sizeof whole_storage, &config), TVMD_OK);
   CHECK_STATUS(tvmd_create(&staged_storage, sizeof staged_storage, &config), TVMD_OK);
-  test_stages_match_the_step(&whole_storage, &staged_storage);
+  /* The paper's law has no offset-free action: the compensation stays zero. */
+  CHECK(test_stages_match_the_step(&whole_storage, &staged_storage, 1) == 0);
   test_plan(&staged_storage);
+  test_compensation_errors(&staged_storage);
+  /* The default (offset-free) law: a state that does not follow the request moves it. */
+  memset(&config, 0, sizeof config);
+  config.size = sizeof config;
+  CHECK_STATUS(tvmd_config_default(&config), TVMD_OK);
+  CHECK_STATUS(tvmd_create(&whole_storage, sizeof whole_storage, &config), TVMD_OK);
+  CHECK_STATUS(tvmd_create(&staged_storage, sizeof staged_storage, &config), TVMD_OK);
+  CHECK(test_stages_match_the_step(&whole_storage, &staged_storage, 0) > 20);
+  config = paper();
   CHECK_STATUS(tvmd_create(&whole_storage, sizeof whole_storage, &config), TVMD_OK);
   CHECK_STATUS(tvmd_create(&staged_storage, sizeof staged_storage, &config), TVMD_OK);
   test_reconfigure(&whole_storage, &staged_storage);

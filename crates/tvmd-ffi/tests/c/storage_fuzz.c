@@ -106,6 +106,7 @@ static int periods(TvmdController *c) {
   TvmdActuatorMap map;
   TvmdActuatorOutputs act;
   TvmdHover hover;
+  TvmdCompensation comp;
   TvmdStatus st;
   int bad = 0, period;
   for (period = 0; period < 2; ++period) {
@@ -117,6 +118,7 @@ static int periods(TvmdController *c) {
     SIZED(map);
     SIZED(act);
     SIZED(hover);
+    SIZED(comp);
     bad += judge("tvmd_check", tvmd_check(c), 1);
     bad += judge("tvmd_set_landed", tvmd_set_landed(c, 0), 1);
     st = tvmd_step(c, &s, &r, &out);
@@ -142,6 +144,8 @@ static int periods(TvmdController *c) {
       st = tvmd_actuator_outputs(c, &map, out.commands, TVMD_MAX_AGENTS, &act);
       bad += judge("tvmd_actuator_outputs", st, 1);
     }
+    st = tvmd_compensation(c, &comp);
+    bad += judge("tvmd_compensation", st, finite_all(comp.force, 3) && finite_all(comp.torque, 3));
     st = tvmd_hover_capability(c, &hover);
     bad += judge("tvmd_hover_capability", st, isfinite(hover.margin) && isfinite(hover.weight));
     st = tvmd_set_failures(c, period == 0 ? 1u : 0u, &hover);

@@ -4,7 +4,8 @@
 // bit), and a flight of hover and the saturating tilt through the cascade (the law at 50 Hz,
 // the attitude and the allocation at 250 Hz) against the full step at 250 Hz: the same
 // planned roll within 1e-3 rad; and the cascade through bad samples (a NaN gyro sample gets
-// the held commands, a refused law period keeps the last good law output).
+// the held commands, a refused law period keeps the last good law output); the offset-free
+// compensation read through the cascade converges to an unmodelled force's negative.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -316,6 +317,54 @@ void test_cascade_bad_samples() {
   CHECK(cascade.report().law.consecutive == 0 && cascade.report().law.errors == 1);
   CHECK(cascade.report().allocate.errors == 0);
 }
+
+// The offset-free compensation through the cascade (tvmd_compensation after each allocation):
+// NaN before the first allocation, then, in a hover under a constant unmodelled force d with
+// the default (offset-free) law, the observer's estimate -compensation converges to d.
+void test_cascade_compensation() {
+  TvmdConfig config;
+  std::memset(&config, 0, sizeof config);
+  config.size = sizeof config;
+  CHECK(tvmd_config_default(&config) == TVMD_OK);
+  CHECK(tvmd_create(&staged_storage, sizeof staged_storage, &config) == TVMD_OK);
+  tvmd::px4::Cascade cascade(&staged_storage);
+  CHECK(std::isnan(cascade.compensation().force[0]) && std::isnan(cascade.compensation().torque[2]));
+  float mass = config.navigator_mass;
+  for (std::size_t i = 0; i < config.agent_count; ++i) mass += config.agents[i].mass;
+  const Vec3 j{0.2f, 0.2f, 0.4f};
+  const float d[3] = {0.5f, -0.3f, -1.0f};  // N, world frame
+  const TvmdReference hover = tilt_reference(0.0f);
+  TvmdAllocationOutput alloc;
+  std::memset(&alloc, 0, sizeof alloc);
+  alloc.size = sizeof alloc;
+  Body body;
+  float torque[3] = {0}, force[3] = {0};
+  const int law_every = static_cast<int>(std::lround(config.period / 0.002f));
+  for (int k = 0; k < 5000; ++k) {  // 10 s at 500 Hz; the law at the configuration's period
+    const TvmdState s = state_of(body);
+    if (k % law_every == 0) CHECK(cascade.position(s, hover) == TVMD_OK);
+    CHECK(cascade.attitude_and_allocate(s, &alloc) == TVMD_OK);
+    std::memcpy(torque, alloc.allocated_torque, sizeof torque);
+    std::memcpy(force, alloc.allocated_force, sizeof force);
+    for (int sub = 0; sub < 2; ++sub) {
+      advance(body, torque, force, mass, j, 0.001f);
+      for (std::size_t i = 0; i < 3; ++i) body.v[i] += 0.001f * d[i] / mass;
+    }
+  }
+  const TvmdCompensation &c = cascade.compensation();
+  std::printf("compensation through the cascade: (%.3f, %.3f, %.3f) N for d = (%.1f, %.1f, %.1f) N\n",
+              static_cast<double>(c.force[0]), static_cast<double>(c.force[1]),
+              static_cast<double>(c.force[2]), static_cast<double>(d[0]), static_cast<double>(d[1]),
+              static_cast<double>(d[2]));
+  for (std::size_t i = 0; i < 3; ++i) CHECK(near(c.force[i], -d[i], 0.05f));
+  CHECK(all_finite(c.torque, 3));
+  CHECK(cascade.report().compensation.errors == 0 && cascade.report().allocate.errors == 0);
+  CHECK(std::fabs(body.x[2] - 1.5f) < 0.01f);
+  // Landed: zero at the next allocation.
+  CHECK(tvmd_set_landed(&staged_storage, 1) == TVMD_OK);
+  CHECK(cascade.attitude_and_allocate(state_of(body), &alloc) == TVMD_OK);
+  CHECK(cascade.compensation().force[0] == 0.0f && cascade.compensation().force[2] == 0.0f);
+}
 }  // namespace
 
 int main() {
@@ -323,6 +372,7 @@ int main() {
   test_hover_matches_c();
   test_cascade_flight();
   test_cascade_bad_samples();
+  test_cascade_compensation();
   std::printf("tvmd C++ PX4 adapter test: %d checks, %d failed\n", checks, failed);
   return failed == 0 ? 0 : 1;
 }

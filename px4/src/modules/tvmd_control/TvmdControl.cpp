@@ -1,3 +1,6 @@
+/* tvmd_control's loops: the rate loop (Run: the failure mask, the attitude stage, the
+ * allocation), the law (run_law: takeoff, the reference, the law stage, the land request).
+ * Configure.cpp, Publish.cpp and Commands.cpp hold the rest of the class. */
 #include "TvmdControl.hpp"
 
 #include <cmath>
@@ -5,35 +8,7 @@
 #include <cstring>
 
 #include <matrix/math.hpp>
-#include <px4_platform_common/getopt.h>
 #include <px4_platform_common/log.h>
-
-using namespace time_literals;
-using tvmd::px4::Mat3;
-using tvmd::px4::Vec3;
-
-namespace
-{
-
-/* tvmd's row-major attitude (z-up frames) as PX4's quaternion (body FRD to NED). */
-void quaternion_ned(const float r_zup[9], float q[4])
-{
-	Mat3 r;
-	std::memcpy(r.data(), r_zup, sizeof(float) * 9);
-	const auto out = tvmd::px4::quaternion_from_rotation(tvmd::px4::flip(r));
-
-	for (int i = 0; i < 4; ++i) { q[i] = out[i]; }
-}
-
-/* A tvmd vector (z-up world or body) in PX4's frame (NED or FRD). */
-void flipped(const float v[3], float out[3])
-{
-	const Vec3 f = tvmd::px4::flip(v);
-
-	for (int i = 0; i < 3; ++i) { out[i] = f[i]; }
-}
-
-} // namespace
 
 TvmdControl::TvmdControl() :
 	ModuleParams(nullptr),
@@ -62,8 +37,18 @@ bool TvmdControl::init()
 		return false;
 	}
 
-	if (!apply_parameters()) {
+	/* The creation (tvmd_create, 3,596 B of stack on a Cortex-M4F) in the configuration
+	 * task, as every later parameter change: start() returns when it is done. */
+	if (!_config_task.start(&TvmdControl::config_task_main)) {
+		PX4_ERR("configuration task not started");
+		return false;
+	}
+
+	_config_task.take_back();
+
+	if (!_created) {
 		PX4_ERR("no valid configuration: not started");
+		_config_task.stop();
 		return false;
 	}
 
@@ -88,69 +73,6 @@ bool TvmdControl::init()
 		return false;
 	}
 
-	return true;
-}
-
-bool TvmdControl::apply_parameters()
-{
-	updateParams();
-	const tvmd_control::Settings settings{
-		_param_law.get(), _param_pos_w.get(), _param_pos_z.get(), _param_att_w.get(), _param_att_z.get(),
-		_param_obs_bw.get(), _param_max_trq.get(), _param_s.get(), _param_rate_lim.get(),
-		_param_alloc.get(), _param_alloc_cap.get(), _param_law_hz.get(), _param_fault.get(),
-		_param_ag_count.get(), _param_ag_mass.get(), _param_nav_mass.get(), _param_sig_x.get(),
-		_param_sig_y.get(), _param_max_thr.get(), _param_mot_curve.get(), _param_sv_x_rng.get(),
-		_param_sv_y_rng.get()};
-
-	perf_begin(_reconfigure_perf);
-	TvmdConfig config;
-	TvmdStatus status = tvmd_control::config_from(settings, _agent_params, config);
-
-	if (status == TVMD_OK) {
-		status = _created ? tvmd_reconfigure(&_controller, &config)
-			 : tvmd_create(&_controller, sizeof(_controller), &config);
-	}
-
-	TvmdActuatorMap map;
-
-	if (status == TVMD_OK) {
-		status = tvmd_control::map_from(&_controller, settings, map);
-
-		if (status != TVMD_OK && _created) {
-			/* The map does not fit the new team: back to the last good configuration. */
-			const TvmdStatus back = tvmd_reconfigure(&_controller, &_config);
-
-			if (back != TVMD_OK) {
-				_log.record(tvmd_control::CONFIG, back);
-			}
-		}
-	}
-
-	perf_end(_reconfigure_perf);
-	_log.record(tvmd_control::CONFIG, status);
-
-	if (status != TVMD_OK) {
-		if (_created) {
-			PX4_ERR("parameters refused (%s): flying the last good configuration", tvmd_status_name(status));
-		}
-
-		return _created;
-	}
-
-	if (!_created) {
-		_created = true;
-		const TvmdStatus landed = tvmd_set_landed(&_controller, 1);
-		_log.record(tvmd_control::LANDED, landed);
-		_landed = true;
-	}
-
-	_config = config;
-	_map = map;
-	_hover.size = sizeof(_hover);
-	const TvmdStatus hover = tvmd_hover_capability(&_controller, &_hover);
-	_log.record(tvmd_control::FAILURES, hover);
-	PX4_INFO("configuration accepted: %u agents, law %s, allocator %u", static_cast<unsigned>(config.agent_count),
-		 settings.law == 0 ? "paper" : "offset-free", static_cast<unsigned>(config.allocator));
 	return true;
 }
 
@@ -324,8 +246,8 @@ void TvmdControl::run_law()
 {
 	vehicle_local_position_s lp;
 
-	if (!_law_position_sub.update(&lp)) {
-		return;
+	if (!_law_position_sub.update(&lp) || _config_task.state() != tvmd_control::ConfigTask::IDLE) {
+		return;  // no sample, or the configuration task holds the handle
 	}
 
 	if (!_have_attitude || !_have_angular_velocity || !lp.xy_valid || !lp.z_valid || !lp.v_xy_valid || !lp.v_z_valid) {
@@ -338,7 +260,6 @@ void TvmdControl::run_law()
 
 	perf_begin(_law_perf);
 	_law_timer.begin();
-	update_failures();
 	const TvmdState state = tvmd::px4::state_from(lp, _attitude, _angular_velocity);
 	const TvmdReference reference = reference_for(lp, _attitude);
 	const TvmdStatus status = _cascade.position(state, reference);
@@ -384,10 +305,14 @@ void TvmdControl::request_land(const char *reason)
 	cmd.param5 = static_cast<double>(NAN);
 	cmd.param6 = static_cast<double>(NAN);
 	cmd.param7 = NAN;
-	cmd.target_system = 1;
-	cmd.target_component = 1;
-	cmd.source_system = 1;
-	cmd.source_component = 1;
+	/* Addressed to this vehicle (MAV_SYS_ID, which SITL sets per instance), as PX4's own
+	 * modules do: commander ignores a command for another system. */
+	vehicle_status_s status{};
+	_vehicle_status_sub.copy(&status);
+	cmd.target_system = status.system_id;
+	cmd.target_component = status.component_id;
+	cmd.source_system = status.system_id;
+	cmd.source_component = status.component_id;
 	cmd.from_external = false;
 	cmd.timestamp = hrt_absolute_time();
 	_command_pub.publish(cmd);
@@ -399,6 +324,7 @@ void TvmdControl::Run()
 	if (should_exit()) {
 		_angular_velocity_sub.unregisterCallback();
 		_law_position_sub.unregisterCallback();
+		_config_task.stop();
 		exit_and_cleanup();
 		return;
 	}
@@ -406,14 +332,32 @@ void TvmdControl::Run()
 	perf_begin(_rate_perf);
 	perf_count(_rate_interval_perf);
 
-	if (_parameter_update_sub.updated()) {
-		parameter_update_s update;
-		_parameter_update_sub.copy(&update);
-		apply_parameters();
-	}
-
 	if (_angular_velocity_sub.update(&_angular_velocity)) {
 		_have_angular_velocity = true;
+	}
+
+	/* A parameter change: the handle goes to the configuration task (ConfigTask.hpp), and
+	 * until it is back the held outputs are sent again. */
+	const tvmd_control::ConfigTask::State config = _config_task.state();
+
+	if (config == tvmd_control::ConfigTask::DONE) {
+		_config_task.take_back();
+
+	} else if (config == tvmd_control::ConfigTask::REQUESTED) {
+		++_held_periods;
+		publish_held(_angular_velocity.timestamp_sample);
+		perf_end(_rate_perf);
+		return;
+
+	} else if (_parameter_update_sub.updated()) {
+		parameter_update_s update;
+		_parameter_update_sub.copy(&update);
+		_config_task.request();
+		++_config_requests;
+		++_held_periods;
+		publish_held(_angular_velocity.timestamp_sample);
+		perf_end(_rate_perf);
+		return;
 	}
 
 	_have_attitude |= _attitude_sub.update(&_attitude);
@@ -425,6 +369,11 @@ void TvmdControl::Run()
 		perf_end(_rate_perf);
 		return;
 	}
+
+	/* The failure mask at the rate loop's rate: a told failure reaches the allocation within
+	 * one period, and tvmd_set_failures (2,572 B on a Cortex-M4F) runs under Run()'s frame,
+	 * not under the law's larger one (docs/px4-module.md, On a flight controller). */
+	update_failures();
 
 	_rate_timer.begin();
 	const TvmdState state = tvmd::px4::state_from(_local_position, _attitude, _angular_velocity);
@@ -457,239 +406,4 @@ void TvmdControl::Run()
 	_rate_timer.end();
 	publish_status(alloc, _angular_velocity.timestamp_sample);
 	perf_end(_rate_perf);
-}
-
-void TvmdControl::publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample)
-{
-	/* On an error status alloc.commands are the held ones: map and send them all the same. */
-	TvmdActuatorOutputs outputs;
-	outputs.size = sizeof(outputs);
-	const TvmdStatus status = tvmd_actuator_outputs(&_controller, &_map, alloc.commands, TVMD_MAX_AGENTS, &outputs);
-	_log.record(tvmd_control::OUTPUT, status);
-
-	if (status == TVMD_OK) {
-		_outputs = outputs;
-		_have_outputs = true;
-
-	} else if (!_have_outputs) {
-		return;  // nothing good was ever mapped: publish nothing rather than a guess
-	}
-
-	actuator_motors_s motors{};
-	actuator_servos_s servos{};
-	tvmd::px4::actuators_from(_outputs, motors, servos);
-	motors.timestamp_sample = timestamp_sample;
-	servos.timestamp_sample = timestamp_sample;
-	motors.timestamp = servos.timestamp = hrt_absolute_time();
-	_motors_pub.publish(motors);
-	_servos_pub.publish(servos);
-
-	/* The collective thrust for PX4's land detector and hover thrust estimator, normalized by
-	 * the team's largest thrust n sigma_Tf (FRD). */
-	const float scale = static_cast<float>(_config.agent_count) * _config.limits.max_thrust;
-
-	if (status == TVMD_OK && alloc.status == TVMD_OK && scale > 0.f) {
-		vehicle_thrust_setpoint_s thrust{};
-		thrust.timestamp_sample = timestamp_sample;
-		float frd[3] {};
-
-		if (!_ground_idle) {
-			flipped(alloc.allocated_force, frd);
-		}
-
-		for (int i = 0; i < 3; ++i) { thrust.xyz[i] = frd[i] / scale; }
-
-		thrust.timestamp = hrt_absolute_time();
-		_thrust_pub.publish(thrust);
-	}
-}
-
-void TvmdControl::publish_status(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample)
-{
-	tvmd_control_status_s s{};
-	s.timestamp_sample = timestamp_sample;
-	const TvmdLawOutput &law = _cascade.law();
-
-	if (_cascade.has_law()) {
-		quaternion_ned(law.planned_attitude, s.q_planned);
-		flipped(law.position_error, s.position_error);
-
-	} else {
-		for (int i = 0; i < 4; ++i) { s.q_planned[i] = NAN; }
-
-		for (int i = 0; i < 3; ++i) { s.position_error[i] = NAN; }
-	}
-
-	std::memcpy(s.q_reference, _reference_q, sizeof(s.q_reference));
-	s.planner_theta = law.planner_theta;
-	s.planner_status = static_cast<uint8_t>(law.planner_status);
-	s.planner_iterations = static_cast<uint8_t>(law.planner_iterations > 255 ? 255 : law.planner_iterations);
-	flipped(_cascade.attitude().attitude_error, s.attitude_error);
-	flipped(_cascade.requested().torque, s.torque_requested);
-	flipped(_cascade.requested().force, s.force_requested);
-	flipped(alloc.allocated_torque, s.torque_allocated);
-	flipped(alloc.allocated_force, s.force_allocated);
-	s.force_unallocated = alloc.force_error;
-	s.torque_unallocated = alloc.torque_error;
-	s.saturated = static_cast<uint16_t>(alloc.saturated);
-
-	if (alloc.saturated != 0) {
-		++_saturated_periods;
-	}
-
-	s.saturated_periods = _saturated_periods;
-
-	/* The stage interface does not give the offset-free state: see docs/px4-module.md. */
-	for (int i = 0; i < 3; ++i) {
-		s.compensation_force[i] = NAN;
-		s.compensation_torque[i] = NAN;
-	}
-
-	s.hover_capable = _hover.capable != 0;
-	s.hover_margin = _hover.margin;
-	s.failed_agents = static_cast<uint16_t>(_failed_agents);
-	s.landed = _landed;
-	s.fault_verdict = static_cast<uint8_t>(_fault.verdict);
-	s.fault_agent = static_cast<int8_t>(_fault.agent);
-	s.fault_kind = static_cast<uint8_t>(_fault.kind);
-	s.fault_statistic = _fault.statistic;
-	s.fault_threshold = _fault.threshold;
-	s.law_status = static_cast<int16_t>(_log.last(tvmd_control::LAW));
-	s.attitude_status = static_cast<int16_t>(_log.last(tvmd_control::ATTITUDE));
-	s.allocate_status = static_cast<int16_t>(_log.last(tvmd_control::ALLOCATE));
-	s.output_status = static_cast<int16_t>(_log.last(tvmd_control::OUTPUT));
-	s.config_status = static_cast<int16_t>(_log.last(tvmd_control::CONFIG));
-	s.law_errors = _log.errors(tvmd_control::LAW);
-	s.attitude_errors = _log.errors(tvmd_control::ATTITUDE);
-	s.allocate_errors = _log.errors(tvmd_control::ALLOCATE);
-	s.output_errors = _log.errors(tvmd_control::OUTPUT);
-	s.config_errors = _log.errors(tvmd_control::CONFIG);
-	s.rate_loop_us = _rate_timer.last_us();
-	s.law_us = _law_timer.last_us();
-	s.timestamp = hrt_absolute_time();
-	_status_pub.publish(s);
-}
-
-int TvmdControl::print_status()
-{
-	PX4_INFO("tvmd %s (ABI %u), %u agents, %s", tvmd_version(), static_cast<unsigned>(tvmd_abi_version()),
-		 static_cast<unsigned>(_config.agent_count), _landed ? "landed" : "flying");
-	perf_print_counter(_rate_perf);
-	perf_print_counter(_rate_interval_perf);
-	perf_print_counter(_law_perf);
-	perf_print_counter(_reconfigure_perf);
-	PX4_INFO("wall clock: attitude+allocation %u periods, mean %.1f us, max %.1f us; law %u periods, mean %.1f us, max %.1f us",
-		 static_cast<unsigned>(_rate_timer.count()), static_cast<double>(_rate_timer.mean_us()),
-		 static_cast<double>(_rate_timer.max_us()), static_cast<unsigned>(_law_timer.count()),
-		 static_cast<double>(_law_timer.mean_us()), static_cast<double>(_law_timer.max_us()));
-
-	for (int i = 0; i < tvmd_control::STAGE_COUNT; ++i) {
-		const auto stage = static_cast<tvmd_control::Stage>(i);
-		PX4_INFO("%s: last %s, %u refused", tvmd_control::StatusLog::name(stage), tvmd_status_name(_log.last(stage)),
-			 static_cast<unsigned>(_log.errors(stage)));
-	}
-
-	PX4_INFO("hover certificate: %s, margin %.3f; failed agents 0x%x", _hover.capable ? "capable" : "NOT capable",
-		 static_cast<double>(_hover.margin), static_cast<unsigned>(_failed_agents));
-	return 0;
-}
-
-int TvmdControl::task_spawn(int argc, char *argv[])
-{
-	TvmdControl *instance = new TvmdControl();
-
-	if (instance) {
-		_object.store(instance);
-		_task_id = task_id_is_work_queue;
-
-		if (instance->init()) {
-			return PX4_OK;
-		}
-
-	} else {
-		PX4_ERR("alloc failed");
-	}
-
-	delete instance;
-	_object.store(nullptr);
-	_task_id = -1;
-	return PX4_ERROR;
-}
-
-int TvmdControl::custom_command(int argc, char *argv[])
-{
-	if (argc >= 2 && strcmp(argv[0], "pose") == 0 && strcmp(argv[1], "off") == 0 && is_running()) {
-		tvmd_pose_setpoint_s pose{};
-
-		for (int i = 0; i < 4; ++i) { pose.q[i] = NAN; }
-
-		for (int i = 0; i < 3; ++i) { pose.position[i] = NAN; }
-
-		pose.timestamp = hrt_absolute_time();
-		get_instance()->publish_pose(pose);
-		return PX4_OK;
-	}
-
-	if (argc >= 4 && strcmp(argv[0], "pose") == 0) {
-		if (!is_running()) {
-			PX4_ERR("not running");
-			return PX4_ERROR;
-		}
-
-		const float deg = static_cast<float>(M_PI) / 180.f;
-		matrix::Quatf q{matrix::Eulerf(strtof(argv[1], nullptr) * deg, strtof(argv[2], nullptr) * deg,
-						 strtof(argv[3], nullptr) * deg)};
-		q.normalize();
-		tvmd_pose_setpoint_s pose{};
-
-		for (int i = 0; i < 4; ++i) { pose.q[i] = q(i); }
-
-		for (int i = 0; i < 3; ++i) { pose.position[i] = argc >= 7 ? strtof(argv[4 + i], nullptr) : NAN; }
-
-		if (!q.isAllFinite()) {
-			PX4_ERR("pose: angles must be numbers (degrees)");
-			return PX4_ERROR;
-		}
-
-		pose.timestamp = hrt_absolute_time();
-		get_instance()->publish_pose(pose);
-		return PX4_OK;
-	}
-
-	return print_usage("unknown command");
-}
-
-int TvmdControl::print_usage(const char *reason)
-{
-	if (reason) {
-		PX4_WARN("%s\n", reason);
-	}
-
-	PRINT_MODULE_DESCRIPTION(
-		R"DESCR_STR(
-### Description
-tvmd's full-pose controller for a thrust-vectoring modular team (TVMD): the attitude planner,
-the full-pose law and the allocation to gimbal angles and rotor speeds (the tvmd C interface),
-in place of the position and attitude controllers and the control allocator.
-The law runs on vehicle_local_position (TVMD_LAW_HZ), the attitude stage and the allocation on
-every vehicle_angular_velocity sample; it publishes actuator_motors, actuator_servos and
-tvmd_control_status.
-
-### Examples
-Hold a 20 degree roll at the current position setpoint (until `pose off`, or for TVMD_POSE_TOUT
-when that is not 0):
-$ tvmd_control pose 20 0 0
-$ tvmd_control pose off
-)DESCR_STR");
-
-	PRINT_MODULE_USAGE_NAME("tvmd_control", "controller");
-	PRINT_MODULE_USAGE_COMMAND("start");
-	PRINT_MODULE_USAGE_COMMAND_DESCR("pose", "Publish a full-pose reference: roll pitch yaw (deg) [north east down (m)], or off");
-	PRINT_MODULE_USAGE_DEFAULT_COMMANDS();
-	return 0;
-}
-
-extern "C" __EXPORT int tvmd_control_main(int argc, char *argv[])
-{
-	return TvmdControl::main(argc, argv);
 }

@@ -4,7 +4,8 @@
  * (tvmd_px4.hpp): the law (attitude planner and the full-pose law) on vehicle_local_position
  * at TVMD_LAW_HZ, the attitude stage and the allocation on every vehicle_angular_velocity
  * sample, both on the rate_ctrl work queue (one thread, so the controller handle is never
- * used from two at once). It publishes actuator_motors, actuator_servos and
+ * used from two at once); a parameter change in a task of its own with the stack the
+ * reconfiguration needs, which holds the handle meanwhile (ConfigTask.hpp). It publishes actuator_motors, actuator_servos and
  * tvmd_control_status. */
 #pragma once
 
@@ -33,10 +34,12 @@
 #include <uORB/topics/vehicle_control_mode.h>
 #include <uORB/topics/vehicle_land_detected.h>
 #include <uORB/topics/vehicle_local_position.h>
+#include <uORB/topics/vehicle_status.h>
 #include <uORB/topics/vehicle_thrust_setpoint.h>
 
 #include <Takeoff.hpp>
 
+#include "ConfigTask.hpp"
 #include "CycleTimer.hpp"
 #include "StatusLog.hpp"
 #include "TeamConfig.hpp"
@@ -75,8 +78,13 @@ private:
 	void Run() override;  // the rate loop: attitude stage, allocation, outputs
 	void run_law();       // the position loop: the law stage
 
+	/* The configuration task (ConfigTask.hpp): each request runs apply_parameters there. */
+	static int config_task_main(int argc, char *argv[]);
+	void run_configuration();
+
 	/* Parameters to a configuration; applied all or nothing, a refused one reported and the
-	 * last good one kept. Returns whether a controller is running. */
+	 * last good one kept. Returns whether a controller is running. Runs in the configuration
+	 * task, while it holds the handle. */
 	bool apply_parameters();
 	/* PX4's takeoff (mc_pos_control's TakeoffHandling): idle on the ground until the flight
 	 * mode asks for a takeoff, then the law. Returns whether the law flies. */
@@ -85,6 +93,8 @@ private:
 	void update_failures();
 	TvmdReference reference_for(const vehicle_local_position_s &lp, const vehicle_attitude_s &att);
 	void publish_outputs(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample);
+	/* The last mapped outputs (the held commands) again, without the handle. */
+	void publish_held(hrt_abstime timestamp_sample);
 	void publish_status(const TvmdAllocationOutput &alloc, hrt_abstime timestamp_sample);
 	void request_land(const char *reason);
 
@@ -109,6 +119,7 @@ private:
 	uORB::Subscription _land_detected_sub{ORB_ID(vehicle_land_detected)};
 	uORB::Subscription _failure_detector_sub{ORB_ID(failure_detector_status)};
 	uORB::Subscription _vehicle_constraints_sub{ORB_ID(vehicle_constraints)};
+	uORB::Subscription _vehicle_status_sub{ORB_ID(vehicle_status)};
 
 	uORB::Publication<actuator_motors_s> _motors_pub{ORB_ID(actuator_motors)};
 	uORB::Publication<actuator_servos_s> _servos_pub{ORB_ID(actuator_servos)};
@@ -148,6 +159,8 @@ private:
 	TvmdActuatorOutputs _outputs{};  // the last good actuator outputs
 	bool _have_outputs{false};
 	uint32_t _saturated_periods{0};
+	uint32_t _config_requests{0};  // parameter changes handed to the configuration task
+	uint32_t _held_periods{0};     // rate periods that sent the held outputs meanwhile
 
 	perf_counter_t _rate_perf{perf_alloc(PC_ELAPSED, MODULE_NAME": attitude+allocation")};
 	perf_counter_t _law_perf{perf_alloc(PC_ELAPSED, MODULE_NAME": law")};
@@ -185,4 +198,7 @@ private:
 	)
 
 	tvmd_control::AgentParamHandles _agent_params{};
+
+	/* Last: destroyed first, so the task has ended before anything it touches goes. */
+	tvmd_control::ConfigTask _config_task{};
 };
