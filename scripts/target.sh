@@ -23,7 +23,9 @@ run_on_boards "target tests" "$elf" "target tests failed" || status=1
 
 # On-target cost (BENCHMARKS.md): instructions per f32 control cycle, counted with
 # `-icount shift=0` (one instruction = 1 ns of virtual time, read through the SysTick and
-# calibrated on nop loops by the firmware), and the cycle's peak stack (painted).
+# calibrated on nop loops by the firmware), and the cycle's peak stack (painted); and the
+# worst-case certificates per allocator and team size (docs/cost.md): a measured count above
+# its certificate fails.
 cost_elf="$target_dir/thumbv7em-none-eabihf/release/cost"
 run_on_boards "on-target cost (-icount shift=0)" "$cost_elf" "the cost measurement failed" \
   -icount shift=0 || status=1

@@ -126,6 +126,9 @@ pub enum FailureKind {
     /// The rotor delivers half of its commanded thrust from the failure time on (a partial
     /// loss: a damaged propeller, a browning-out ESC).
     HalfThrust,
+    /// The agent's command link falls silent: its actuators keep working on the last command
+    /// it received, then it fails safe as its link says (the simulator's `[links]`).
+    LinkLoss,
 }
 
 impl FailureKind {
@@ -137,6 +140,11 @@ impl FailureKind {
     /// True if the thrust is halved.
     pub fn halves_thrust(self) -> bool {
         matches!(self, Self::HalfThrust)
+    }
+
+    /// True if the agent's command link falls silent.
+    pub fn silences_link(self) -> bool {
+        matches!(self, Self::LinkLoss)
     }
 
     /// True if the gimbal sticks.

@@ -203,6 +203,26 @@ pub(crate) struct AllocationData {
 }
 
 impl AllocationData {
+    /// A record of its parts (a pickled `StepOutput`'s).
+    pub(crate) fn from_parts(
+        allocation: Allocation<f64, CAPACITY>,
+        n: usize,
+        method: &'static str,
+        report: Option<String>,
+    ) -> Self {
+        Self {
+            allocation,
+            n,
+            method,
+            report,
+        }
+    }
+
+    /// The allocator's name and its report.
+    pub(crate) fn method_and_report(&self) -> (&'static str, Option<String>) {
+        (self.method, self.report.clone())
+    }
+
     pub(crate) fn new(
         allocation: Allocation<f64, CAPACITY>,
         n: usize,

@@ -45,6 +45,7 @@ mod sim;
 mod sim_batch;
 mod sim_result;
 mod step_output;
+mod step_state;
 mod stepping;
 mod team;
 mod team_data;

@@ -11,6 +11,7 @@ use crate::convert::{commands_array, matrix, CAPACITY};
 use crate::law::PyLawOutput;
 use crate::planner::PyPlannerResult;
 use crate::record::record;
+use crate::step_state;
 
 /// One `Controller.step`: the core's output, the agent count and the allocation record.
 pub(crate) struct StepData {
@@ -53,6 +54,27 @@ record! {
         command_clamp => o.out.command_clamp,
         /// What the null-space stage changed.
         null_space => PyNullSpaceReport { inner: o.out.null_space },
+    }
+    methods {
+        /// `pickle` support: `StepOutput._restore` of the output's floats (NaN kept), the
+        /// agent count, the allocator's name and its report: the same output, bit for bit.
+        #[allow(clippy::type_complexity)]
+        fn __reduce__<'py>(
+            slf: &Bound<'py, Self>,
+        ) -> PyResult<(Bound<'py, PyAny>, (Vec<f64>, usize, &'static str, Option<String>))> {
+            let restore = slf.get_type().getattr(pyo3::intern!(slf.py(), "_restore"))?;
+            let o = &slf.get().inner;
+            let (method, report) = o.allocation.method_and_report();
+            Ok((restore, (step_state::values(&o.out), o.n, method, report)))
+        }
+
+        /// The output of `__reduce__`'s data (`ValueError` if it is not one).
+        #[staticmethod]
+        fn _restore(values: Vec<f64>, n: usize, method: &str, report: Option<String>) -> PyResult<Self> {
+            let out = step_state::output(&values)?;
+            let allocation = step_state::allocation(&out, n, method, report)?;
+            Ok(Self { inner: StepData::new(out, n, allocation) })
+        }
     }
 }
 

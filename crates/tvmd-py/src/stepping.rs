@@ -36,7 +36,8 @@ pub(crate) struct ObservationData {
 record! {
     /// One controller tick as a controller sees it: `t` (s), `state` (the fed-back
     /// `tvmd.State`, noise and latency applied), `true_state`, `velocity_world` (3,),
-    /// `reference` (a `tvmd.Reference`), `failed` (n,), `done` and `saturation` (n, 3).
+    /// `reference` (a `tvmd.Reference`), `failed` (n,), `done`, `saturation` (n, 3) and
+    /// `reports` (n, 4) or None.
     "Observation" in "tvmd.sim" => PyObservation(ObservationData) |py, o| {
         /// Simulation time `t_k` (s).
         t => o.observation.t,
@@ -58,6 +59,13 @@ record! {
         saturation => {
             let s = &o.saturation;
             shaped(py, s.iter().flat_map(|c| [c.eta_x, c.eta_y, c.thrust]).collect(), &[s.len(), 3])?
+        },
+        /// (n, 4) each agent's newest report arrived: rotor speed as thrust (N), `eta_x`,
+        /// `eta_y` (rad), age (s); NaN before its first; None without the scenario's `[reports]`.
+        reports => {
+            let r = &o.observation.reports;
+            let rows = r.iter().flat_map(|x| x.map_or([f64::NAN; 4], |x| [x.thrust, x.eta_x, x.eta_y, x.age]));
+            (!r.is_empty()).then(|| shaped(py, rows.collect(), &[r.len(), 4])).transpose()?
         },
     }
 }

@@ -2,8 +2,9 @@
 ``Gains`` round-trip bit for bit; a ``Controller`` deep copy is the controller mid-flight, its
 pickle the controller as constructed with its failures and landed flag; a ``Simulation`` copy
 (deep copy or pickle) replays its flight, so both go on exactly as the original would; records
-such as ``StepOutput`` are immutable and deep-copy to themselves. Gymnasium's tools then work on
-an environment made with a ``tvmd.Team``.
+such as ``StepOutput`` are immutable and deep-copy to themselves, and a ``StepOutput`` pickles to
+the same output, bit for bit. Gymnasium's tools then work on an environment made with a
+``tvmd.Team``.
 """
 
 from __future__ import annotations
@@ -98,6 +99,51 @@ def test_step_outputs_and_observations_deep_copy_to_themselves():
     assert copy.deepcopy(out) is out and copy.copy(out) is out
     obs = ts.Simulation("hover").reset()
     assert copy.deepcopy(obs) is obs
+
+
+def _same_record(a, b):
+    """Every field of two records equal, arrays bit for bit (NaN where NaN), nested records too."""
+    assert type(a) is type(b)
+    for name in type(a).FIELDS:
+        x, y = getattr(a, name), getattr(b, name)
+        if hasattr(x, "FIELDS"):
+            _same_record(x, y)
+        elif isinstance(x, np.ndarray):
+            assert x.dtype == y.dtype and x.shape == y.shape, name
+            assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name
+        elif isinstance(x, float):
+            assert np.float64(x).tobytes() == np.float64(y).tobytes(), name
+        else:
+            assert x == y, name
+
+
+@pytest.mark.parametrize("method", ["redistributed-pseudo-inverse", "exact-boundary-redistribution"])
+def test_a_step_output_pickles_to_the_same_output(method):
+    c = tvmd.Controller(tvmd.Team.preset("a6-inc"), allocator=method)
+    c.set_failures([2])
+    state, reference = _hover_inputs(0)
+    a = 1.2  # a roll no A6 holds: the planner searches, the allocation saturates
+    reference["attitude"] = [[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]]
+    out = c.step(state, reference)
+    assert out.planner.status == "planned" and out.allocation.method == method
+    back = pickle.loads(pickle.dumps(out))
+    assert back is not out
+    _same_record(out, back)
+    assert back.commands.shape == (6, 4)
+
+
+def test_a_malformed_step_output_state_is_refused():
+    out = tvmd.Controller(tvmd.Team.a4_inc()).step(*_hover_inputs(0))
+    restore, (values, n, method, report) = out.__reduce__()
+    for bad in [
+        (values[:-1], n, method, report),
+        (values + [0.0], n, method, report),
+        (values, 0, method, report),
+        (values, n, "no-such-allocator", report),
+        ([0.5] * len(values), n, method, report),
+    ]:
+        with pytest.raises(ValueError, match="StepOutput"):
+            restore(*bad)
 
 
 def _fly(sim, steps, start=0):

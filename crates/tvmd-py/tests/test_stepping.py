@@ -230,3 +230,22 @@ def test_a_batch_whose_every_team_failed_keeps_its_shapes():
     assert all(e is not None for e in out["errors"])
     assert out["saturation"].shape == (2, batch.n_agents, 3)
     assert np.isnan(out["saturation"]).all() and out["position"].shape == (2, 3)
+
+
+def test_observations_carry_the_agents_reports_and_links_apply():
+    """Issue 60: with ``[reports]`` each observation has (n, 4) reports (NaN before the first),
+    20 ms old by default; a ``[links]`` flight still holds its hover; without either, None."""
+    base = sim.scenario_toml("hover").replace('duration = 12.0', 'duration = 1.0')
+    s = sim.Simulation(toml=base + "\n[reports]\nlying = [1]\n\n[links]\nlatency = 0.02\nloss = 0.05\n")
+    controller = sim.ScenarioController(toml=base)
+    obs = s.reset()
+    assert obs.reports.shape == (4, 4) and np.isnan(obs.reports).all()
+    while not obs.done:
+        obs = s.step(controller.step(obs))
+    ages = obs.reports[:, 3]
+    assert np.all((ages >= 0.02 - 1e-9) & (ages <= 0.03 + 1e-9)), ages
+    assert abs(obs.reports[:, 0].sum() - 4 * obs.reports[0, 0]) < 1.0  # four agents share the weight
+    assert np.linalg.norm(obs.true_state.position - np.array([0.0, 0.0, 1.5])) < 0.05
+    assert sim.Simulation("hover").reset().reports is None
+    with pytest.raises(ValueError, match="reports.lying"):
+        sim.Simulation(toml=base + "\n[reports]\nlying = [9]\n")

@@ -51,7 +51,7 @@
 //! [[failures]]
 //! agent = 0
 //! time = 5.0
-//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal", "half-thrust"
+//! kind = "no-thrust"         # "stuck-gimbal", "no-thrust-stuck-gimbal", "half-thrust", "link-loss"
 //! controller_informed = true
 //! informed_after = 0.0        # s; told this long after the failure (telemetry or detector latency)
 //!
@@ -64,6 +64,24 @@
 //! external_wrench = { force = [0.0, 0.0, 0.0], torque = [0.0, 0.0, 0.1], start = 3.0, end = 4.0 }
 //! state_noise = { position = 0.01, velocity = 0.02, attitude = 0.005, angular_velocity = 0.01, seed = 7 }
 //! feedback_latency = 1       # the controller sees the state of one period before (default 0)
+//!
+//! [links]                    # each agent's command link (none by default: commands applied as sent)
+//! latency = 0.02             # s
+//! jitter = 0.005             # s, uniform extra delay
+//! loss = 0.05                # independent losses
+//! burst_start = 0.01         # bursts of losses (mean burst_length commands)
+//! burst_length = 5.0
+//! hold = 0.1                 # s an agent holds its last command without one, then:
+//! failsafe = "idle"          # rotor stopped, gimbal level; or "hold"
+//!
+//! [reports]                  # the agents' own reports (rotor speed as thrust, gimbal angles)
+//! rate = 100.0               # Hz
+//! latency = 0.02             # s
+//! thrust_noise = 0.05        # N
+//! angle_noise = 0.005        # rad
+//! loss = 0.0
+//! dead_esc = "silent"        # or "zero"
+//! # lying = [2]              # agents that report their command whatever they do
 //!
 //! [success]                  # the verdict's bounds (see `SuccessBounds`)
 //! max_steady_state_position_error = 0.05
@@ -90,11 +108,13 @@ mod failures;
 mod families;
 mod fault_detection;
 mod law;
+mod links;
 mod log_settings;
 mod name_or;
 mod null_space;
 mod overrides;
 mod plant;
+mod reports;
 mod scenario;
 mod success;
 mod team;
@@ -115,12 +135,14 @@ pub use law::{
     AttitudeRateConfig, GainScheduleConfig, LawConfig, NaturalGainsConfig, OffsetFreeConfig,
     LAW_NAMES,
 };
+pub use links::{CommandLinks, LinkFailsafe, MAX_LINK_DELAY};
 pub use log_settings::LogSettings;
 pub use null_space::{
     NullSpaceConfig, NullSpaceKind, DEFAULT_NULL_SPACE_ITERATIONS, NULL_SPACE_OBJECTIVES,
 };
 pub use overrides::Overrides;
 pub use plant::{Payload, PlantError};
+pub use reports::{AgentReports, DeadEsc};
 pub use scenario::{Scenario, MAX_SCENARIO_BYTES};
 pub use success::SuccessBounds;
 pub use team::{LimitsConfig, TeamSpec};

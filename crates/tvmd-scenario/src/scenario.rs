@@ -9,9 +9,9 @@ use tvmd_plant::{PhysicsConfig, ReferenceConfig, TeamBody, GRAVITY};
 
 use crate::error::invalid;
 use crate::{
-    Disturbances, Failure, FailureResponse, FaultDetectionConfig, GainsConfig, LawConfig,
-    LimitsConfig, LogSettings, NullSpaceConfig, Payload, PlantError, Precision, ScenarioError,
-    SuccessBounds, TeamSpec,
+    AgentReports, CommandLinks, Disturbances, Failure, FailureResponse, FaultDetectionConfig,
+    GainsConfig, LawConfig, LimitsConfig, LogSettings, NullSpaceConfig, Payload, PlantError,
+    Precision, ScenarioError, SuccessBounds, TeamSpec,
 };
 
 /// The largest scenario file read (1 MiB; the built-ins are under 3 KiB).
@@ -95,6 +95,13 @@ pub struct Scenario {
     pub fault_detection: Option<FaultDetectionConfig>,
     /// Disturbances.
     pub disturbances: Disturbances,
+    /// Each agent's command link (`[links]`, [`CommandLinks`]); none by default: commands are
+    /// applied as they are sent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub links: Option<CommandLinks>,
+    /// The agents' own reports (`[reports]`, [`AgentReports`]); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reports: Option<AgentReports>,
     /// Model error: how the flown team differs from the controller's model of it.
     #[serde(skip_serializing_if = "PlantError::is_nominal")]
     pub plant: PlantError,
@@ -135,6 +142,8 @@ impl Default for Scenario {
             failure_response: FailureResponse::default(),
             fault_detection: None,
             disturbances: Disturbances::default(),
+            links: None,
+            reports: None,
             plant: PlantError::nominal(),
             payloads: Vec::new(),
             log: LogSettings::default(),

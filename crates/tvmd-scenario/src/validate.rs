@@ -322,6 +322,12 @@ impl Scenario {
                 ),
             ));
         }
+        if let Some(links) = &self.links {
+            links.validate()?;
+        }
+        if let Some(reports) = &self.reports {
+            reports.validate(team.len(), self.physics.dt)?;
+        }
         self.law.validate()?;
         if let Some(detection) = &self.fault_detection {
             detection.validate(&self.law.offset_free)?;

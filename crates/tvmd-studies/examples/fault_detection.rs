@@ -87,6 +87,7 @@ fn kind_name(k: FailureKind) -> &'static str {
         FailureKind::HalfThrust => "50% thrust",
         FailureKind::StuckGimbal => "stuck gimbal",
         FailureKind::NoThrustStuckGimbal => "loss + stuck",
+        FailureKind::LinkLoss => "link loss",
     }
 }
 

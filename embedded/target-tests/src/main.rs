@@ -14,6 +14,7 @@ use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 
 mod cases;
+mod recorded_file;
 mod recording;
 
 use cases::{Case, MAX_OUTPUTS};

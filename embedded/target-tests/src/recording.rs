@@ -14,6 +14,8 @@
 
 use cortex_m_semihosting::hprintln;
 
+use crate::recorded_file::{open, words, Opened};
+
 // Shared with tvmd-sim (crate `tvmd-wire`): the recording's layout and the controller's
 // construction.
 use tvmd_wire as wire;
@@ -34,16 +36,6 @@ static RECORDINGS: [(&str, &[u8]); 2] = [
 
 /// Largest cycle of the recording format.
 const MAX_CYCLE_WORDS: usize = wire::cycle_words(AGENTS);
-
-/// Words `at..at + K` of a recording (little-endian).
-fn words<const K: usize>(recording: &[u8], at: usize, len: usize) -> Option<[u32; K]> {
-    let mut w = [0u32; K];
-    let bytes = recording.get(4 * at..4 * (at + len))?;
-    for (slot, c) in w.iter_mut().zip(bytes.chunks_exact(4)) {
-        *slot = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
-    }
-    Some(w)
-}
 
 /// The worst difference of a replay and where it is.
 #[derive(Clone, Copy, Default)]
@@ -140,27 +132,13 @@ fn replay_one(name: &str, recording: &[u8]) -> bool {
 
 /// Cycles, bit-identical cycles, cycles whose `R_d` or `theta` differ, the worst difference.
 fn run(recording: &[u8]) -> Result<(usize, usize, usize, Worst), &'static str> {
-    let [magic, version, n, cycles, c] =
-        words::<{ wire::RECORDING_HEADER_WORDS }>(recording, 0, wire::RECORDING_HEADER_WORDS)
-            .ok_or("truncated header")?;
-    if magic != wire::RECORDING_MAGIC || version != wire::RECORDING_VERSION {
-        return Err("not a version-1 recording");
-    }
-    let (n, cycles, c) = (n as usize, cycles as usize, c as usize);
-    let config_words =
-        words::<{ wire::config_words(AGENTS) }>(recording, wire::RECORDING_HEADER_WORDS, c)
-            .ok_or("truncated configuration")?;
-    let config = wire::CoreConfig::get(&mut Reader::new(config_words.get(..c).ok_or("config")?))
-        .filter(|k| k.n == n)
-        .ok_or("malformed configuration")?;
-    let mut ctl = config
-        .build()
-        .map_err(|_| "configuration refused by the core")?;
-    let len = wire::cycle_words(n);
-    let start = wire::RECORDING_HEADER_WORDS + c;
-    if recording.len() != 4 * (start + cycles * len) {
-        return Err("length does not match the header");
-    }
+    let Opened {
+        n,
+        cycles,
+        start,
+        len,
+        controller: mut ctl,
+    } = open(recording)?;
     let (mut identical, mut planner, mut worst) = (0, 0, Worst::default());
     for k in 0..cycles {
         let all =

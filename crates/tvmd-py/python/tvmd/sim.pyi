@@ -273,6 +273,8 @@ class Observation:
         saturation: (n, 3) by how much the plant clamped the last step's commands to the
             hardware's range: each command minus what the plant held (``eta_x``, ``eta_y`` rad,
             thrust N); zero inside the range and after a reset.
+        reports: (n, 4) each agent's newest report (``[reports]``): rotor speed as thrust (N),
+            ``eta_x``, ``eta_y`` (rad), age (s); NaN rows before the first; None without it.
     """
 
     FIELDS: ClassVar[Tuple[str, ...]]
@@ -301,6 +303,11 @@ class Observation:
     def saturation(self) -> _F64:
         """(n, 3) by how much the plant clamped the last step's commands (the command minus
         what it held)."""
+    @property
+    def reports(self) -> Optional[_F64]:
+        """(n, 4) each agent's newest report arrived: rotor speed as thrust (N), ``eta_x``,
+        ``eta_y`` (rad), age (s); NaN before its first; None without the scenario's
+        ``[reports]``."""
     def to_dict(self) -> dict[str, Any]:
         """Every field as a dict (the states and the reference as dicts)."""
 

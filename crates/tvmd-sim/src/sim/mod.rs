@@ -26,9 +26,12 @@
 //! [`Simulation::step_wrench`] with a body wrench).
 
 pub mod batch;
+mod command_path;
 pub mod difference;
 mod forces;
 pub mod latency;
+pub mod links;
+pub mod reports;
 pub mod retention;
 pub mod sample;
 mod saturation;
@@ -154,9 +157,8 @@ pub struct Simulation {
     controller_calls: usize,
     wall_time: f64,
     interrupted: bool,
-    /// The commands held until the next tick (zero-order hold), saturated by `saturation`.
-    held: Vec<ActuatorCommand>,
-    saturation: saturation::PlantSaturation,
+    /// The held commands, their saturation and the agents' links.
+    commands: command_path::CommandPath,
     /// The agents' body-frame forces, reused every physics step.
     forces: Vec<Vector3<f64>>,
     /// The forces must be recomputed (new commands, a failure, or actuators with memory).
@@ -201,8 +203,7 @@ impl Simulation {
             .check(total_steps.div_ceil(steps_per_control))?;
         Ok(Self {
             options,
-            held: vec![ActuatorCommand::default(); n],
-            saturation: saturation::PlantSaturation::new(scenario, n)?,
+            commands: command_path::CommandPath::new(scenario, n)?,
             forces: Vec::with_capacity(n),
             forces_stale: true,
             observed: None,
@@ -290,6 +291,7 @@ impl Simulation {
                 any = true;
                 self.applied[k] = true;
                 self.actuators.fail(f.agent, f.kind);
+                self.commands.fail(f.agent, f.kind, f.time);
                 self.failed_true[f.agent] = true;
             }
             if self.applied[k] && f.controller_informed && f.time + f.informed_after <= t + 1e-12 {
@@ -393,7 +395,7 @@ impl Simulation {
         sink: Option<(&mut (dyn TickSink + '_), &SinkPlan)>,
     ) -> Result<(), SimError> {
         self.check_commands(observation.t, &out.commands)?;
-        self.saturation.apply(&out.commands, &mut self.held);
+        self.commands.hold(observation.t, &out.commands);
         self.forces_stale = true;
         self.record(observation, out, sink)?;
         self.advance_period()

@@ -19,6 +19,7 @@ use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
+use super::reports::AgentReport;
 use super::{check_divergence, forces::body_forces, Simulation};
 use crate::control::WrenchAllocation;
 use crate::flight::{FlightInput, FlightOutput};
@@ -44,6 +45,9 @@ pub struct Observation {
     pub reference: ReferenceSample,
     /// `failed[i]`: agent `i` failed and the controller is told so.
     pub failed: Vec<bool>,
+    /// Per agent, its newest report arrived by `t_k` (`None`: none yet); empty when the
+    /// scenario has no `[reports]`.
+    pub reports: Vec<Option<AgentReport>>,
 }
 
 impl Observation {
@@ -114,6 +118,12 @@ impl Simulation {
         self.world.state()
     }
 
+    /// Per agent, what its command link did so far: commands sent, lost, overtaken, and
+    /// failsafes (`None`: the scenario has no links).
+    pub fn link_stats(&self) -> Option<Vec<super::links::LinkStats>> {
+        self.commands.link_stats()
+    }
+
     /// The number of agents (the length of every step's commands).
     pub fn agents(&self) -> usize {
         self.team.len()
@@ -123,7 +133,7 @@ impl Simulation {
     /// range (the command minus what it held: `eta_x`, `eta_y` in rad, thrust in N; zero
     /// inside the range and before the first step). See the module `saturation`.
     pub fn saturation(&self) -> &[ActuatorCommand] {
-        self.saturation.clamped()
+        self.commands.clamped()
     }
 
     /// The largest thrust of one agent, `sigma_Tf` (N): the thrust at the normalized rotor
@@ -236,6 +246,7 @@ impl Simulation {
             truth,
             reference: self.scenario.reference.at(t),
             failed: self.failed_told.clone(),
+            reports: self.commands.reports_at(t),
         })
     }
 
@@ -278,7 +289,10 @@ impl Simulation {
                 }
                 self.attach_payloads(t)?;
             }
-            self.actuators.step(&self.held, dt);
+            self.commands.sample_reports(t, &self.actuators);
+            let (applied, changed) = self.commands.applied(t);
+            self.forces_stale |= changed;
+            self.actuators.step(applied, dt);
             if self.forces_stale || !memoryless {
                 body_forces(
                     self.actuators.outputs(),

@@ -1,13 +1,14 @@
 //! What every flight of a Monte Carlo study meets besides its draw: servo dynamics, noise on
 //! the fed-back state and a feedback latency (`docs/method.md`, "Monte Carlo"), on by default
 //! so that a study's success rate is not that of a noise-free, delay-free, ideal-servo plant;
-//! and, when asked for, turbulence and a discrete gust, each seeded per flight.
+//! and, when asked for, turbulence, a discrete gust and the agents' command links, each seeded
+//! per flight.
 
 use serde::{Deserialize, Serialize};
 
 use tvmd_plant::actuators::ServoModel;
 use tvmd_plant::turbulence::Turbulence;
-use tvmd_scenario::{Air, Gust, Scenario, StateNoise};
+use tvmd_scenario::{Air, CommandLinks, Gust, Scenario, StateNoise};
 
 /// A `1 - cos` gust every flight meets, of a stated peak speed and length, horizontal, its
 /// heading and start drawn per flight (the start in the middle half of the flight).
@@ -40,6 +41,10 @@ pub struct Conditions {
     /// A discrete gust per flight; none by default.
     #[serde(default)]
     pub gust: Option<GustCondition>,
+    /// Every agent's command link ([`CommandLinks`]; its seed is replaced by one per flight);
+    /// none by default. A scenario's own `[links]` stay.
+    #[serde(default)]
+    pub links: Option<CommandLinks>,
 }
 
 impl Default for Conditions {
@@ -60,6 +65,7 @@ impl Default for Conditions {
             feedback_latency: 1,
             turbulence: None,
             gust: None,
+            links: None,
         }
     }
 }
@@ -73,6 +79,7 @@ impl Conditions {
             feedback_latency: 0,
             turbulence: None,
             gust: None,
+            links: None,
         }
     }
 
@@ -130,6 +137,12 @@ impl Conditions {
         }
         if scenario.disturbances.feedback_latency == 0 {
             scenario.disturbances.feedback_latency = self.feedback_latency;
+        }
+        if scenario.links.is_none() {
+            scenario.links = self.links.map(|l| CommandLinks {
+                seed: flight_seed(5),
+                ..l
+            });
         }
     }
 }
@@ -190,5 +203,30 @@ mod tests {
         let air = wind.disturbances.air.unwrap();
         assert_eq!(air.velocity, [1.0, 0.0, 0.0]);
         assert!(air.turbulence.is_some() && air.gusts.len() == 2);
+    }
+
+    #[test]
+    fn links_are_drawn_per_flight_and_a_scenarios_own_stay() {
+        let lossy = Conditions {
+            links: Some(CommandLinks {
+                latency: 0.02,
+                loss: 0.1,
+                ..CommandLinks::default()
+            }),
+            ..Conditions::none()
+        };
+        let flown = |index| {
+            let mut s = Scenario::builtin("hover").unwrap();
+            lossy.apply(&mut s, 3, index);
+            s.validate().unwrap();
+            s.links.unwrap()
+        };
+        let (a, b) = (flown(0), flown(1));
+        assert_eq!((a.latency, a.loss), (0.02, 0.1));
+        assert_ne!(a.seed, b.seed);
+        let mut own = Scenario::builtin("hover").unwrap();
+        own.links = Some(CommandLinks::default());
+        lossy.apply(&mut own, 3, 0);
+        assert_eq!(own.links, Some(CommandLinks::default()));
     }
 }

@@ -74,7 +74,7 @@ fn empty<const N: usize>(
     r.wrench.x
 }
 
-fn team<const N: usize>(name: &str) -> Option<TeamConfig<f32, N>> {
+pub fn team<const N: usize>(name: &str) -> Option<TeamConfig<f32, N>> {
     match name {
         "a4_inc" | "a4_inc_f1" => presets::a4_inc().ok(),
         "a6_inc" => presets::a6_inc().ok(),

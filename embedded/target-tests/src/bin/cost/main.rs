@@ -15,10 +15,14 @@
 //! 30,000 / 12,000 instructions (reported, not a failure: not met, see
 //! docs/allocation-benchmark.md), with a tighter estimate: the searching cycle around an
 //! allocation that hands back given forces, plus each allocation.
-//! Then the C handle's per-call storage check at n = 4 and 16 (`storage.rs`), issue 59's
-//! n = 16 saturating cycle with the redistribution capped (`capped.rs`; fails above twice the
-//! paper law's cycle at the default cap), and the whole-cycle estimate checked on the one cycle
-//! that can be measured whole (`estimate.rs`).
+//! Then the C handle's per-call storage check at n = 4 and 16 (`storage.rs`).
+//! Worst-case certificates (issue 59; `certificate.rs`, `cycle_certificate.rs`): per
+//! allocator and n = 4, 6, 8, 16 the bound from the code's loop limits times per-unit maxima
+//! measured on generated requests, checked against the allocation set's worst, every measured
+//! cycle, and the recorded flights' cycles (`recorded.rs`): a count above its certificate fails.
+//! Then issue 59's n = 16 saturating cycle with the redistribution capped (`capped.rs`; fails
+//! above twice the paper law's cycle at the default cap), and the n = 4 whole-cycle estimate
+//! checked on the one cycle that can be measured whole (`estimate.rs`).
 //! Prints one line per case over semihosting; exits with failure if the clock cannot be
 //! calibrated or a cycle does not run as intended. Run by `scripts/target.sh`.
 #![no_std]
@@ -34,17 +38,25 @@ use tvmd_core::nalgebra::{convert, ComplexField, Vector3};
 use tvmd_core::team::presets;
 use tvmd_core::RoundCap;
 use tvmd_core::{
-    Allocation, AllocationRequest, Allocator, Controller, ControllerSettings,
-    ExactBoundaryRedistribution, FaultDetection, FaultResponse, PlannerStatus, PseudoInverse,
-    RedistributedPseudoInverse, Reference, RigidState, TeamConfig,
+    Allocator, Controller, ControllerSettings, ExactBoundaryRedistribution, FaultDetection,
+    FaultResponse, PlannerStatus, PseudoInverse, RedistributedPseudoInverse, Reference, RigidState,
+    TeamConfig,
 };
 
 mod allocation;
 mod capped;
+mod certificate;
 mod clock;
+mod cycle_certificate;
 mod estimate;
+mod recorded;
+#[path = "../../recorded_file.rs"]
+mod recorded_file;
 mod stack;
 mod storage;
+
+use certificate::{Certificates, Certified};
+use cycle_certificate::{law_of, Around};
 
 /// Cycles per measurement: the tick quantization (one tick, 40 instructions, at each end of the
 /// cycles' timing and of the overhead's) is spread over them: each count is within
@@ -73,11 +85,15 @@ fn empty<const N: usize, A: Allocator<f32, N>>(
     s.position.x
 }
 
-/// The team of `examples/cycle_instructions.rs` (n = 4) and `benches/control_cycle.rs`
-/// (n = 16: an inconsistent ring of radius `0.5 sqrt(n / 4)`).
+/// The team of `examples/cycle_instructions.rs` (n = 4), the authors' A6-Inc and A8-Inc, and
+/// `benches/control_cycle.rs` (n = 16: an inconsistent ring of radius `0.5 sqrt(n / 4)`).
 fn team<const N: usize>() -> Option<TeamConfig<f32, N>> {
     if N == 4 {
         presets::a4_inc().ok()
+    } else if N == 6 {
+        presets::a6_inc().ok()
+    } else if N == 8 {
+        presets::a8_inc().ok()
     } else {
         let radius = 0.5 * ComplexField::sqrt(N as f32 / 4.0);
         presets::ring(N, radius, true, presets::paper_limits()).ok()
@@ -165,7 +181,7 @@ const FAULT_DETECTION_EXTRA_BOUND: u32 = 1_500;
 /// searching (issue 44's bound).
 const OFFSET_FREE_EXTRA_BOUND: u32 = 1_500;
 
-fn report<const N: usize>(per_tick: u32) -> bool {
+fn report<const N: usize>(per_tick: u32, certificates: &Certificates, around: &Around) -> bool {
     let mut ok = true;
     for searching in [false, true] {
         let name = if searching { "searching" } else { "hover" };
@@ -203,6 +219,13 @@ fn report<const N: usize>(per_tick: u32) -> bool {
             };
             let as_intended = (m.status == PlannerStatus::AlreadyFeasible) != searching;
             ok &= as_intended;
+            ok &= around.check(
+                (name, law),
+                law_of(law),
+                Certified::Redistributed,
+                certificates,
+                m.instructions,
+            );
             hprintln!(
                 "cost: n = {:2} {:9} cycle, {:11} law: {:6} instructions, peak stack {:5} B (Controller::new {:5} B; planner {:?}, {} iterations){}",
                 N,
@@ -251,21 +274,28 @@ fn report<const N: usize>(per_tick: u32) -> bool {
             }
         }
     }
-    // The default allocator's cycles (paper's law), and the pseudo-inverse's searching cycle:
-    // the law and planner with the cheapest allocation, to which each allocation of the set
-    // is added for an upper bound of the default's whole cycle.
-    for searching in [false, true] {
-        let name = if searching { "searching" } else { "hover" };
-        let default = ExactBoundaryRedistribution::<f32, N>::new();
-        let settings = ControllerSettings::paper();
-        match measure::<N, _>(searching, settings, default, per_tick) {
-            Some(m) => hprintln!(
-                "cost: n = {:2} {:9} cycle, paper law, exact-boundary-redistribution: {:6} instructions, peak stack {:5} B (Controller::new {:5} B)",
-                N, name, m.instructions, m.stack, m.setup_stack
-            ),
-            None => {
-                ok = false;
-                hprintln!("cost: n = {} {} default allocator: FAIL: refused", N, name);
+    // The default allocator's cycles under each certified law (the paper's first: the
+    // pseudo-inverse's searching cycle, the law and planner with the cheapest allocation, to
+    // which each allocation of the set is added for an upper bound of the default's whole cycle).
+    for (law, law_name) in cycle_certificate::LAWS.iter().enumerate() {
+        for searching in [false, true] {
+            let name = if searching { "searching" } else { "hover" };
+            let default = ExactBoundaryRedistribution::<f32, N>::new();
+            let settings = cycle_certificate::settings(law);
+            match measure::<N, _>(searching, settings, default, per_tick) {
+                Some(m) => {
+                    hprintln!(
+                        "cost: n = {:2} {:9} cycle, {} law, exact-boundary-redistribution: {:6} instructions, peak stack {:5} B (Controller::new {:5} B)",
+                        N, name, law_name, m.instructions, m.stack, m.setup_stack
+                    );
+                    let default = Certified::ExactBoundary(RoundCap::default());
+                    let case = (name, *law_name);
+                    ok &= around.check(case, law, default, certificates, m.instructions);
+                }
+                None => {
+                    ok = false;
+                    hprintln!("cost: n = {} {} default allocator: FAIL: refused", N, name);
+                }
             }
         }
     }
@@ -319,12 +349,45 @@ fn run() -> bool {
         );
         return false;
     }
-    let a = report::<4>(per_tick);
-    let b = report::<16>(per_tick);
+    let (ok4, c4, around4) =
+        certified::<4>(per_tick, &[&allocation::A4_INC, &allocation::A4_INC_F1]);
+    let (ok6, _, _) = certified::<6>(per_tick, &[&allocation::A6_INC]);
+    let (ok8, _, _) = certified::<8>(per_tick, &[&allocation::A8_INC]);
+    let (ok16, c16, around16) = certified::<16>(per_tick, &[&allocation::RING16_INC]);
+    let flights = recorded::check(&c16, &around16, per_tick);
     let checks = storage::report::<4>(per_tick) & storage::report::<16>(per_tick);
     let capped = capped::report::<16>(per_tick, &[1, 2, 3]);
     let estimate = estimate::report(per_tick).is_some();
-    a && b && checks && capped && estimate && report_set(per_tick)
+    ok4 && ok6
+        && ok8
+        && ok16
+        && flights
+        && checks
+        && capped
+        && estimate
+        && report_set(per_tick, &c4, &around4)
+}
+
+/// The certificates of a team of `N` (`certificate.rs`), checked over the allocation set's
+/// teams of that size, then the cycles of [`report`] checked against theirs.
+fn certified<const N: usize>(
+    per_tick: u32,
+    sets: &[&allocation::SetTeam<N>],
+) -> (bool, Certificates, Around) {
+    let (Some(team), Some(around)) = (team::<N>(), Around::measure::<N>(per_tick)) else {
+        hprintln!(
+            "cost: n = {}: FAIL: team or the cycle around the allocation refused",
+            N
+        );
+        return (false, Certificates::default(), Around::default());
+    };
+    let c = certificate::calibrate(&team, per_tick);
+    certificate::print_units(&c);
+    let mut ok = sets.iter().fold(true, |ok, set| {
+        ok & certificate::check_set(&c, set, per_tick)
+    });
+    ok &= report::<N>(per_tick, &c, &around);
+    (ok, c, around)
 }
 
 /// Issue 59's bounds on the whole n = 4 cycle with the default allocator, its walk capped at
@@ -334,14 +397,12 @@ const MEDIAN_CYCLE_BOUND: u32 = 12_000;
 
 /// The default allocator over the allocation set, and the n = 4 whole-cycle bound: the
 /// pseudo-inverse's searching cycle (law, planner, one solve) plus each allocation.
-fn report_set(per_tick: u32) -> bool {
+fn report_set(per_tick: u32, certificates: &Certificates, certified: &Around) -> bool {
     let base = measure::<4, _>(true, ControllerSettings::paper(), PseudoInverse, per_tick)
         .map(|m| m.instructions);
-    // The same cycle around an allocation that only hands back the pseudo-inverse's forces: the
-    // law, planner, commands and checks without the allocator's own work.
-    let around = searching_forces::<4>()
-        .and_then(|f| measure::<4, _>(true, ControllerSettings::paper(), Given(f), per_tick))
-        .map(|m| m.instructions);
+    // The same cycle around an allocation that only hands back the pseudo-inverse's allocation:
+    // the law, planner, commands and checks without the allocator's own work.
+    let around = estimate::around(per_tick);
     let a4 = allocation::report(&allocation::A4_INC, None, per_tick);
     let mut ok = [
         allocation::report(&allocation::A6_INC, None, per_tick).is_some(),
@@ -372,6 +433,10 @@ fn report_set(per_tick: u32) -> bool {
         MEDIAN_CYCLE_BOUND,
         if within { "" } else { "  OVER (reported, not failed)" }
     );
+    // The certificate of this configuration bounds the upper bound too (its cycle around the
+    // allocation is the paper law's searching cycle with the planner's most iterations).
+    let default = Certified::ExactBoundary(RoundCap::default());
+    let ok = ok & certified.check(("set's worst", "paper"), 0, default, certificates, worst);
     if let Some(around) = around {
         let (worst, median) = (worst - base + around, median - base + around);
         hprintln!(
@@ -392,32 +457,6 @@ fn report_set(per_tick: u32) -> bool {
         }
     }
     ok
-}
-
-/// An allocator that hands back a given allocation (forces, wrench and errors computed before:
-/// `Allocation::from_forces` is part of every allocation measured, so not counted here again),
-/// for the cycle around the allocation.
-#[derive(Clone)]
-struct Given<const N: usize>(Allocation<f32, N>);
-
-impl<const N: usize> Allocator<f32, N> for Given<N> {
-    fn allocate(&mut self, _: &AllocationRequest<'_, f32, N>) -> Allocation<f32, N> {
-        self.0
-    }
-
-    fn name(&self) -> &'static str {
-        "given"
-    }
-}
-
-/// The pseudo-inverse's allocation in the first searching cycle of [`measure`].
-fn searching_forces<const N: usize>() -> Option<Allocation<f32, N>> {
-    let settings = ControllerSettings::paper();
-    let mut c = Controller::new(team::<N>()?, settings, PseudoInverse).ok()?;
-    let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
-    let mut reference = Reference::hover(Vector3::new(0.0, 0.0, 1.5));
-    reference.attitude = roll(convert::<f64, f32>(core::f64::consts::FRAC_PI_3));
-    Some(c.step(&state, &reference).ok()?.allocation)
 }
 
 /// Round caps measured on the n = 4 set beside the default (`Rounds(2)`).
