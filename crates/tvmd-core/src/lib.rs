@@ -69,7 +69,7 @@ pub use law::{
 pub use admissible::AdmissibleSet;
 pub use afs::{AttainableForceSpace, EllipticCone, Relaxation, SemiAxes};
 pub use allocation::{
-    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator,
+    Allocation, AllocationRequest, Allocator, AllocatorOptions, AnyAllocator, CappedRedistribution,
     ExactBoundaryRedistribution, NullSpaceObjective, NullSpaceReport, NullSpaceStage,
     PseudoInverse, RedistributedPseudoInverse, RoundCap, WalkCost, WeightedPseudoInverse,
 };

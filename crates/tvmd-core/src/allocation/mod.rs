@@ -10,6 +10,7 @@ mod choice;
 #[cfg(feature = "clarabel")]
 mod clarabel;
 mod exact_boundary;
+mod interior;
 mod names;
 mod null_space;
 mod pseudo_inverse;
@@ -24,14 +25,14 @@ pub use clarabel::{
 };
 pub use exact_boundary::{ExactBoundaryRedistribution, RoundCap, WalkCost, DEFAULT_MAX_ROUNDS};
 pub use names::{
-    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
-    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+    CAPPED_REDISTRIBUTION, CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION,
+    PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 pub use null_space::{
     NullSpaceObjective, NullSpaceReport, NullSpaceStage, MAX_NULL_SPACE_ITERATIONS,
 };
 pub use pseudo_inverse::{PseudoInverse, WeightedPseudoInverse};
-pub use redistributed::RedistributedPseudoInverse;
+pub use redistributed::{CappedRedistribution, RedistributedPseudoInverse};
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 

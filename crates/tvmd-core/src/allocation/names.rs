@@ -7,6 +7,8 @@ pub const PSEUDO_INVERSE: &str = "pseudo-inverse";
 pub const WEIGHTED_PSEUDO_INVERSE: &str = "weighted-pseudo-inverse";
 /// Name of [`super::RedistributedPseudoInverse`] (the paper's).
 pub const REDISTRIBUTED_PSEUDO_INVERSE: &str = "redistributed-pseudo-inverse";
+/// Name of [`super::CappedRedistribution`].
+pub const CAPPED_REDISTRIBUTION: &str = "capped-redistribution";
 /// Name of [`super::ExactBoundaryRedistribution`], the default (`docs/method.md`, "Allocation").
 pub const EXACT_BOUNDARY_REDISTRIBUTION: &str = "exact-boundary-redistribution";
 /// Name of `ClarabelAllocator` (feature `clarabel`; known to every build so a build without

@@ -2,6 +2,7 @@
 
 use nalgebra::Vector3;
 
+use super::interior::Interior;
 use super::{
     gram_of, outside, pseudo_inverse_forces, working_mask, Allocation, AllocationRequest, Allocator,
 };
@@ -131,13 +132,16 @@ fn saturated_pseudo_inverse<T: Real, const N: usize>(
         &mut forces,
     );
     let mut saturated = [false; N];
+    // The agents' one set as a test without the gimbal inverse (the same decisions).
+    let interior = Interior::shared(request.sets);
     for (((f, set), sat), ok) in forces
         .iter_mut()
         .zip(request.sets)
         .zip(saturated.iter_mut())
         .zip(working)
     {
-        if ok && outside(set, f) {
+        let inside = interior.as_ref().is_some_and(|t| t.holds(f));
+        if ok && !inside && outside(set, f) {
             *f = set.saturate(f);
             *sat = true;
         }

@@ -192,6 +192,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for ExactBoundaryRedistribution<T,
             request,
             GimbalCommand::from_force_fast,
             AdmissibleSet::saturate_fast,
+            u32::MAX,
         );
         let mut forces = start.forces;
         let mut moved = false;

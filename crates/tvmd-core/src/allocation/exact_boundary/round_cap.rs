@@ -4,7 +4,7 @@
 /// Walk rounds of the default cap ([`RoundCap::default`]). Two: the allocation set's worst
 /// requests take 12-15 rounds uncapped at 10,000-13,000 Cortex-M4F instructions each, while two
 /// rounds keep 57 of its 64 attainable n = 4 requests exact (63 uncapped) and bound the whole
-/// n = 4 cycle at about 48,000 instructions (`docs/allocation-benchmark.md`, "Worst case, cost
+/// n = 4 cycle at about 46,000 instructions (`docs/allocation-benchmark.md`, "Worst case, cost
 /// cap and target").
 pub const DEFAULT_MAX_ROUNDS: u32 = 2;
 
