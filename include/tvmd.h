@@ -231,20 +231,30 @@
 #define TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION 3
 
 /*
+ `allocator`: the redistributed pseudo-inverse capped at a few rounds per period (default 2,
+ `allocator_round_cap` and `allocator_max_rounds` set it, at least 1): a bounded period where
+ a request loads most agents to their limits; what it cannot meet is in the output's `e_f`.
+ */
+#define TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION 4
+
+/*
  `allocator_round_cap`: the library's default cap of the exact-boundary redistribution's
- walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (another allocator has no walk to cap).
+ walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period, and of the capped redistribution, 2
+ rounds (the other allocators have no rounds to cap).
  */
 #define TVMD_ROUND_CAP_DEFAULT 0
 
 /*
  `allocator_round_cap`: exactly `allocator_max_rounds` walk rounds per period (`0`: the
- walk's start alone, the redistributed pseudo-inverse or the previous forces).
+ walk's start alone, the redistributed pseudo-inverse or the previous forces), or rounds of
+ the capped redistribution (at least 1).
  */
 #define TVMD_ROUND_CAP_ROUNDS 1
 
 /*
  `allocator_round_cap`: no cap beyond the walk's own `2 n + 4` rounds (research: about
- 166,000 Cortex-M4F instructions for the worst n = 4 allocation of the allocation set).
+ 166,000 Cortex-M4F instructions for the worst n = 4 allocation of the allocation set), or
+ one round per agent for the capped redistribution.
  */
 #define TVMD_ROUND_CAP_UNCAPPED 2
 
@@ -1191,7 +1201,7 @@ typedef struct TvmdPlanOutput {
 /*
  [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
  `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
- planned-rate bandwidth or bound) not positive.
+ planned-rate bandwidth or bound) not positive, or a capped redistribution's 0 rounds.
  */
 #define TVMD_ERR_CONFIG_PARAMETER 34
 

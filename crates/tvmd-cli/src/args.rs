@@ -49,8 +49,8 @@ pub enum Command {
         #[arg(long)]
         relaxation: Option<f64>,
         /// Override the scenario's allocator (exact-boundary-redistribution, the default;
-        /// redistributed-pseudo-inverse, pseudo-inverse, weighted-pseudo-inverse, clarabel,
-        /// clarabel-sequential).
+        /// redistributed-pseudo-inverse, pseudo-inverse, weighted-pseudo-inverse,
+        /// capped-redistribution, clarabel, clarabel-sequential).
         #[arg(long)]
         allocator: Option<String>,
         /// Run a null-space stage after the allocator: `margin`, or `inward-tilt=<rad>`

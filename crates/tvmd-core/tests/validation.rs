@@ -338,13 +338,14 @@ fn every_option_is_refused_by_the_allocators_it_is_not_for() {
         ),
         (
             ConfigField::AllocatorMaxRounds,
-            &["exact-boundary-redistribution"],
+            &["exact-boundary-redistribution", "capped-redistribution"],
         ),
     ];
     let names = [
         "pseudo-inverse",
         "redistributed-pseudo-inverse",
         "exact-boundary-redistribution",
+        "capped-redistribution",
         "weighted-pseudo-inverse",
         "clarabel",
         "clarabel-sequential",
@@ -369,6 +370,57 @@ fn every_option_is_refused_by_the_allocators_it_is_not_for() {
             Any::from_name("magic", &options).unwrap_err(),
             ConfigError::UnknownAllocator
         );
+    }
+}
+
+/// The capped redistribution by name: its rounds from `max_rounds` (at least 1; none: 2;
+/// uncapped: every agent's), each allocation within them.
+#[test]
+fn the_capped_redistribution_takes_its_rounds_by_name() {
+    use tvmd_core::nalgebra::Vector6;
+    use tvmd_core::{team::presets, AdmissibleSet, AllocationRequest, Allocator, FailureMask};
+    type Any = AnyAllocator<f64, 4>;
+    let with = |cap| AllocatorOptions::<f64, 4> {
+        max_rounds: cap,
+        ..AllocatorOptions::default()
+    };
+    assert_eq!(
+        Any::from_name(
+            "capped-redistribution",
+            &with(Some(tvmd_core::RoundCap::Rounds(0)))
+        )
+        .unwrap_err(),
+        ConfigError::Parameter {
+            field: ConfigField::AllocatorMaxRounds
+        }
+    );
+    let team = presets::a4_inc::<f64, 4>().unwrap();
+    let e = team.effectiveness(&FailureMask::none());
+    let sets = [AdmissibleSet::from_limits(team.limits()); 4];
+    // Far beyond the attainable set: the redistribution would fix every agent in turn.
+    let wrench = Vector6::new(40.0, -30.0, 5.0, 30.0, 20.0, 80.0);
+    let request = AllocationRequest {
+        effectiveness: &e,
+        sets: &sets,
+        wrench,
+    };
+    for (cap, most) in [
+        (Some(tvmd_core::RoundCap::Rounds(1)), 1),
+        (None, 2),
+        (Some(tvmd_core::RoundCap::Uncapped), 4),
+    ] {
+        let mut a = Any::from_name("capped-redistribution", &with(cap)).unwrap();
+        let out = a.allocate(&request);
+        assert!(
+            out.rounds <= most && out.rounds >= 1,
+            "{cap:?}: {}",
+            out.rounds
+        );
+        for (f, set) in out.forces.iter().zip(&sets) {
+            let cmd = tvmd_core::GimbalCommand::from_force(f);
+            assert!(set.contains(&cmd, 1e-9), "{cap:?}: {f:?} outside");
+        }
+        assert!(out.wrench_error > 1.0, "the cap's price is reported");
     }
 }
 

@@ -7,8 +7,8 @@ use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
 use tvmd_core::allocation::{
-    AllocatorChoice, AllocatorOptions, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
-    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+    AllocatorChoice, AllocatorOptions, CAPPED_REDISTRIBUTION, EXACT_BOUNDARY_REDISTRIBUTION,
+    PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
 use tvmd_core::{
     AgentSpec, ConfigError, ControllerSettings, GainSchedule, Navigator, RateLimits, Relaxation,
@@ -127,6 +127,7 @@ unsafe fn allocator(
         TVMD_ALLOCATOR_PSEUDO_INVERSE => PSEUDO_INVERSE,
         TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE => WEIGHTED_PSEUDO_INVERSE,
         TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION => EXACT_BOUNDARY_REDISTRIBUTION,
+        TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION => CAPPED_REDISTRIBUTION,
         _ => "",
     };
     let mut options = AllocatorOptions::default();

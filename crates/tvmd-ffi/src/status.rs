@@ -72,7 +72,7 @@ pub const TVMD_ERR_CONFIG_AGENT_COUNT: TvmdStatus = 32;
 pub const TVMD_ERR_CONFIG_RELAXATION: TvmdStatus = 33;
 /// [`ConfigError::Parameter`]: a gravity, period, rate limit, allocator weight or a number of
 /// `law` (natural frequency, damping ratio, observer bandwidth, integral gain, torque bound,
-/// planned-rate bandwidth or bound) not positive.
+/// planned-rate bandwidth or bound) not positive, or a capped redistribution's 0 rounds.
 pub const TVMD_ERR_CONFIG_PARAMETER: TvmdStatus = 34;
 /// [`ConfigError::FailureIndex`]: a failure mask bit at or beyond the team's agent count.
 pub const TVMD_ERR_CONFIG_FAILURE_INDEX: TvmdStatus = 35;

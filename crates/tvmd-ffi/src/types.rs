@@ -85,15 +85,22 @@ pub const TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE: u32 = 2;
 /// `tvmd_config_paper` (starts from the previous period's forces; `tvmd_reset` and
 /// `tvmd_set_failures` forget them).
 pub const TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION: u32 = 3;
+/// `allocator`: the redistributed pseudo-inverse capped at a few rounds per period (default 2,
+/// `allocator_round_cap` and `allocator_max_rounds` set it, at least 1): a bounded period where
+/// a request loads most agents to their limits; what it cannot meet is in the output's `e_f`.
+pub const TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION: u32 = 4;
 
 /// `allocator_round_cap`: the library's default cap of the exact-boundary redistribution's
-/// walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period (another allocator has no walk to cap).
+/// walk, [`TVMD_DEFAULT_MAX_ROUNDS`] rounds per period, and of the capped redistribution, 2
+/// rounds (the other allocators have no rounds to cap).
 pub const TVMD_ROUND_CAP_DEFAULT: u32 = 0;
 /// `allocator_round_cap`: exactly `allocator_max_rounds` walk rounds per period (`0`: the
-/// walk's start alone, the redistributed pseudo-inverse or the previous forces).
+/// walk's start alone, the redistributed pseudo-inverse or the previous forces), or rounds of
+/// the capped redistribution (at least 1).
 pub const TVMD_ROUND_CAP_ROUNDS: u32 = 1;
 /// `allocator_round_cap`: no cap beyond the walk's own `2 n + 4` rounds (research: about
-/// 166,000 Cortex-M4F instructions for the worst n = 4 allocation of the allocation set).
+/// 166,000 Cortex-M4F instructions for the worst n = 4 allocation of the allocation set), or
+/// one round per agent for the capped redistribution.
 pub const TVMD_ROUND_CAP_UNCAPPED: u32 = 2;
 /// Walk rounds of `TVMD_ROUND_CAP_DEFAULT` (the core's `DEFAULT_MAX_ROUNDS`).
 pub const TVMD_DEFAULT_MAX_ROUNDS: u32 = 2;

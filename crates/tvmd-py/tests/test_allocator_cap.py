@@ -56,3 +56,23 @@ def test_another_word_is_a_value_error_naming_max_rounds(bad):
             call()
     with pytest.raises(TypeError):
         tvmd.allocate(team, np.zeros(6), max_rounds=2.0)
+
+
+def test_the_capped_redistribution_takes_its_rounds_from_max_rounds():
+    assert "capped-redistribution" in tvmd.ALLOCATORS
+    team = tvmd.Team.a4_inc()
+    wrench = np.array([0.5, 0.3, 0.0, 5.0, 0.0, 70.0])
+    paper = tvmd.allocate(team, wrench, method="redistributed-pseudo-inverse")
+    assert paper.rounds > 1
+    for k, most in ((1, 1), (None, 2), ("uncapped", team.n)):
+        out = tvmd.allocate(team, wrench, method="capped-redistribution", max_rounds=k)
+        assert 1 <= out.rounds <= most and out.method == "capped-redistribution"
+        assert np.all(np.isfinite(out.forces))
+        # The miss is reported: the true error of the forces returned.
+        made = team.wrench(out.forces)
+        assert np.isclose(out.e_f, np.linalg.norm(made[3:] - wrench[3:]), rtol=1e-9)
+    with pytest.raises(ValueError, match="max_rounds|round"):
+        tvmd.allocate(team, wrench, method="capped-redistribution", max_rounds=0)
+    controller = tvmd.Controller(team, allocator="capped-redistribution", max_rounds=1)
+    out = controller.step({"position": [0.0, 0.0, 1.0]}, {"position": [0.0, 0.0, 1.0]})
+    assert np.all(np.isfinite(out.commands))

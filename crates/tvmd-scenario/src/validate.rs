@@ -140,17 +140,25 @@ impl Scenario {
                 max_rounds: self.allocator_max_rounds,
                 ..Default::default()
             };
-            if let Err(tvmd_core::ConfigError::UnusedOption { .. }) =
-                tvmd_core::allocation::AllocatorChoice::new(&self.allocator, &options)
-            {
-                return Err(invalid(
-                    "allocator_max_rounds",
-                    format!(
-                        "allocator `{}` takes no round cap (only `{}` does)",
-                        self.allocator,
-                        tvmd_core::allocation::EXACT_BOUNDARY_REDISTRIBUTION
-                    ),
-                ));
+            match tvmd_core::allocation::AllocatorChoice::new(&self.allocator, &options) {
+                Err(tvmd_core::ConfigError::UnusedOption { .. }) => {
+                    return Err(invalid(
+                        "allocator_max_rounds",
+                        format!(
+                            "allocator `{}` takes no round cap (only `{}` and `{}` do)",
+                            self.allocator,
+                            tvmd_core::allocation::EXACT_BOUNDARY_REDISTRIBUTION,
+                            tvmd_core::allocation::CAPPED_REDISTRIBUTION
+                        ),
+                    ));
+                }
+                Err(e) if e.field() == Some(tvmd_core::ConfigField::AllocatorMaxRounds) => {
+                    return Err(invalid(
+                        "allocator_max_rounds",
+                        format!("{e} (`{}` needs at least 1)", self.allocator),
+                    ));
+                }
+                _ => {}
             }
         }
         if let Some([x, y]) = self.controller_rate_limits {
@@ -378,6 +386,16 @@ mod tests {
         let s = Scenario::from_toml_str("allocator_max_rounds = 2\n").unwrap();
         assert_eq!(s.allocator_max_rounds, Some(tvmd_core::RoundCap::Rounds(2)));
         assert_eq!(Scenario::default().allocator_max_rounds, None);
+        let s = Scenario::from_toml_str(
+            "allocator = \"capped-redistribution\"\nallocator_max_rounds = 3\n",
+        )
+        .unwrap();
+        assert_eq!(s.allocator_max_rounds, Some(tvmd_core::RoundCap::Rounds(3)));
+        let e = Scenario::from_toml_str(
+            "allocator = \"capped-redistribution\"\nallocator_max_rounds = 0\n",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("allocator_max_rounds"), "{e}");
         for other in ["redistributed-pseudo-inverse", "pseudo-inverse", "clarabel"] {
             let e = Scenario::from_toml_str(&format!(
                 "allocator = \"{other}\"\nallocator_max_rounds = 2\n"

@@ -3,19 +3,19 @@
 
 use super::choice::{AllocatorChoice, AllocatorOptions, Choice};
 use super::{
-    Allocation, AllocationRequest, Allocator, ExactBoundaryRedistribution, PseudoInverse,
-    RedistributedPseudoInverse, WeightedPseudoInverse,
+    Allocation, AllocationRequest, Allocator, CappedRedistribution, ExactBoundaryRedistribution,
+    PseudoInverse, RedistributedPseudoInverse, WeightedPseudoInverse,
 };
 use crate::agent::effectiveness::Effectiveness;
 use crate::foundation::error::ConfigError;
 use crate::foundation::real::Real;
 
+use super::names::{
+    CAPPED_REDISTRIBUTION, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
+    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+};
 #[cfg(feature = "clarabel")]
 use super::names::{CLARABEL, CLARABEL_SEQUENTIAL};
-use super::names::{
-    EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE,
-    WEIGHTED_PSEUDO_INVERSE,
-};
 
 #[cfg(feature = "clarabel")]
 const NAMES: &[&str] = &[
@@ -23,6 +23,7 @@ const NAMES: &[&str] = &[
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
+    CAPPED_REDISTRIBUTION,
     CLARABEL,
     CLARABEL_SEQUENTIAL,
 ];
@@ -32,6 +33,7 @@ const NAMES: &[&str] = &[
     REDISTRIBUTED_PSEUDO_INVERSE,
     PSEUDO_INVERSE,
     WEIGHTED_PSEUDO_INVERSE,
+    CAPPED_REDISTRIBUTION,
 ];
 
 /// One of the crate's allocators, chosen at run time. Its checked-but-not-made counterpart is
@@ -63,6 +65,8 @@ pub enum AnyAllocator<T: Real, const N: usize> {
     RedistributedPseudoInverse(RedistributedPseudoInverse),
     /// [`ExactBoundaryRedistribution`].
     ExactBoundaryRedistribution(ExactBoundaryRedistribution<T, N>),
+    /// [`CappedRedistribution`].
+    CappedRedistribution(CappedRedistribution),
     /// [`super::ClarabelAllocator`] (feature `clarabel`).
     #[cfg(feature = "clarabel")]
     Clarabel(super::ClarabelAllocator<T, N>),
@@ -99,6 +103,7 @@ impl<T: Real, const N: usize> AnyAllocator<T, N> {
                 ExactBoundaryRedistribution::new().with_round_cap(max_rounds),
             ),
             Choice::Weighted(a) => Self::WeightedPseudoInverse(a),
+            Choice::Capped(a) => Self::CappedRedistribution(a),
             #[cfg(feature = "clarabel")]
             Choice::Clarabel(a) => Self::Clarabel(a),
             #[cfg(feature = "clarabel")]
@@ -121,8 +126,8 @@ impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
 
 impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
     unsafe fn storage_intact(this: *const Self) -> bool {
-        // The variants in declaration order (repr(u8)): 4, or 6 with `clarabel`.
-        const VARIANTS: u8 = if cfg!(feature = "clarabel") { 6 } else { 4 };
+        // The variants in declaration order (repr(u8)): 5, or 7 with `clarabel`.
+        const VARIANTS: u8 = if cfg!(feature = "clarabel") { 7 } else { 5 };
         this.cast::<u8>().read() < VARIANTS
     }
 
@@ -132,6 +137,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::WeightedPseudoInverse(a) => a.configure(effectiveness),
             Self::RedistributedPseudoInverse(a) => a.configure(effectiveness),
             Self::ExactBoundaryRedistribution(a) => a.configure(effectiveness),
+            Self::CappedRedistribution(a) => Allocator::<T, N>::configure(a, effectiveness),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.configure(effectiveness),
             #[cfg(feature = "clarabel")]
@@ -145,6 +151,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::WeightedPseudoInverse(a) => a.reset(),
             Self::RedistributedPseudoInverse(a) => Allocator::<T, N>::reset(a),
             Self::ExactBoundaryRedistribution(a) => a.reset(),
+            Self::CappedRedistribution(a) => Allocator::<T, N>::reset(a),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.reset(),
             #[cfg(feature = "clarabel")]
@@ -158,6 +165,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::WeightedPseudoInverse(a) => a.allocate(request),
             Self::RedistributedPseudoInverse(a) => a.allocate(request),
             Self::ExactBoundaryRedistribution(a) => a.allocate(request),
+            Self::CappedRedistribution(a) => a.allocate(request),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.allocate(request),
             #[cfg(feature = "clarabel")]
@@ -171,6 +179,7 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             Self::WeightedPseudoInverse(a) => a.name(),
             Self::RedistributedPseudoInverse(a) => Allocator::<T, N>::name(a),
             Self::ExactBoundaryRedistribution(a) => a.name(),
+            Self::CappedRedistribution(a) => Allocator::<T, N>::name(a),
             #[cfg(feature = "clarabel")]
             Self::Clarabel(a) => a.name(),
             #[cfg(feature = "clarabel")]

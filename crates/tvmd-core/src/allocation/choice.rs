@@ -4,10 +4,10 @@
 //! ([`crate::Controller::init_in`]).
 
 use super::names::{
-    CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION, PSEUDO_INVERSE,
-    REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
+    CAPPED_REDISTRIBUTION, CLARABEL, CLARABEL_SEQUENTIAL, EXACT_BOUNDARY_REDISTRIBUTION,
+    PSEUDO_INVERSE, REDISTRIBUTED_PSEUDO_INVERSE, WEIGHTED_PSEUDO_INVERSE,
 };
-use super::{RoundCap, WeightedPseudoInverse};
+use super::{CappedRedistribution, RoundCap, WeightedPseudoInverse};
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::real::Real;
 
@@ -24,9 +24,11 @@ pub struct AllocatorOptions<T: Real, const N: usize> {
     pub regularization: Option<T>,
     /// Round cap of [`super::ExactBoundaryRedistribution::with_round_cap`] (`None`: the
     /// allocator's default, [`super::DEFAULT_MAX_ROUNDS`] rounds; [`RoundCap::Uncapped`] for
-    /// the walk's own `2 n + 4`): bounds the allocator's work per period, see
-    /// `docs/allocation-benchmark.md`. `Some(RoundCap::Rounds(_))` is refused by the other
-    /// allocators; `Uncapped` is accepted by all (none caps anything).
+    /// the walk's own `2 n + 4`) and of [`CappedRedistribution`] (its rounds, at least 1;
+    /// `None`: [`CappedRedistribution::DEFAULT_MAX_ROUNDS`]; `Uncapped`: every agent's
+    /// round): bounds the allocator's work per period, see `docs/allocation-benchmark.md`.
+    /// `Some(RoundCap::Rounds(_))` is refused by the other allocators; `Uncapped` is accepted
+    /// by all (none caps anything).
     pub max_rounds: Option<RoundCap>,
 }
 
@@ -76,6 +78,7 @@ pub(super) enum Choice<T: Real, const N: usize> {
         max_rounds: RoundCap,
     },
     Weighted(WeightedPseudoInverse<T, N>),
+    Capped(CappedRedistribution),
     #[cfg(feature = "clarabel")]
     Clarabel(super::ClarabelAllocator<T, N>),
     #[cfg(feature = "clarabel")]
@@ -103,6 +106,7 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
                     | REDISTRIBUTED_PSEUDO_INVERSE
                     | EXACT_BOUNDARY_REDISTRIBUTION
                     | WEIGHTED_PSEUDO_INVERSE
+                    | CAPPED_REDISTRIBUTION
             )
         {
             return Err(ConfigError::UnknownAllocator);
@@ -122,11 +126,12 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
                 ConfigField::ClarabelLambda,
             )?;
         }
-        // A cap of some rounds is the walk's alone; "uncapped" promises no bound, which every
-        // allocator keeps (so a scenario naming it may switch allocators).
+        // A cap of some rounds is the walk's and the capped redistribution's alone;
+        // "uncapped" promises no bound, which every allocator keeps (so a scenario naming it
+        // may switch allocators).
         refuse(
             matches!(options.max_rounds, Some(RoundCap::Rounds(_)))
-                && name != EXACT_BOUNDARY_REDISTRIBUTION,
+                && !matches!(name, EXACT_BOUNDARY_REDISTRIBUTION | CAPPED_REDISTRIBUTION),
             ConfigField::AllocatorMaxRounds,
         )?;
         let choice = match name {
@@ -139,6 +144,11 @@ impl<T: Real, const N: usize> AllocatorChoice<T, N> {
                 let weights = options.agent_weights.unwrap_or([T::one(); N]);
                 Choice::Weighted(WeightedPseudoInverse::new(weights)?)
             }
+            CAPPED_REDISTRIBUTION => Choice::Capped(match options.max_rounds {
+                None => CappedRedistribution::default(),
+                Some(RoundCap::Rounds(k)) => CappedRedistribution::new(k)?,
+                Some(RoundCap::Uncapped) => CappedRedistribution::new(u32::MAX)?,
+            }),
             _ => clarabel(name, options)?,
         };
         Ok(Self(choice))

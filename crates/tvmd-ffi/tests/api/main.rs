@@ -148,6 +148,7 @@ fn every_allocator_constant_creates_a_controller_that_flies() {
         TVMD_ALLOCATOR_PSEUDO_INVERSE,
         TVMD_ALLOCATOR_WEIGHTED_PSEUDO_INVERSE,
         TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION,
+        TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION,
     ] {
         let mut storage = created_with(allocator);
         for x in [0.2, 0.1, 0.0] {

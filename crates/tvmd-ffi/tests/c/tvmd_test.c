@@ -217,8 +217,9 @@ static void test_create_errors(void) {
   bad.limits.lift_coefficient = 0.11f; bad.limits.max_rotor_speed = 900.0f;
   CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
 
-  /* The round cap is the exact-boundary redistribution's alone. Capped, a step is as good as
-   * the cap allows: never a smaller e_f than the uncapped walk's. */
+  /* The round cap is the exact-boundary redistribution's and the capped redistribution's
+   * alone. Capped, a step is as good as the cap allows: never a smaller e_f than the uncapped
+   * walk's. */
   bad = config; bad.allocator = TVMD_ALLOCATOR_REDISTRIBUTED_PSEUDO_INVERSE;
   bad.allocator_round_cap = TVMD_ROUND_CAP_ROUNDS;
   bad.allocator_max_rounds = 2;
@@ -248,6 +249,13 @@ static void test_create_errors(void) {
     CHECK_STATUS(tvmd_step(&storage, &s, &r, &capped_out), TVMD_OK);
     CHECK_STATUS(tvmd_step(&uncapped, &s, &r, &uncapped_out), TVMD_OK);
     CHECK(capped_out.e_f >= uncapped_out.e_f - 1e-5f);
+    /* The capped redistribution takes its rounds the same way, at least one. */
+    bad.allocator = TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION;
+    CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&storage, &s, &r, &capped_out), TVMD_OK);
+    CHECK(capped_out.e_f >= uncapped_out.e_f - 1e-5f);
+    bad.allocator_max_rounds = 0;
+    CHECK_STATUS(tvmd_create(&storage, sizeof storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
   }
 }
 

@@ -43,6 +43,7 @@ AllocatorName = Literal[
     "redistributed-pseudo-inverse",
     "pseudo-inverse",
     "weighted-pseudo-inverse",
+    "capped-redistribution",
     "clarabel",
     "clarabel-sequential",
 ]
@@ -864,6 +865,9 @@ def allocate(
             ``E_f`` (closed form) and moving it along that boundary afterwards; never clamps (a
             one-shot call has no previous period to start from; the controller's allocator
             keeps one).
+        "capped-redistribution": the redistribution stopped after ``max_rounds`` rounds
+            (default 2, at least 1), the agents still outside clamped and the miss in ``e_f``: a
+            bounded period for large teams.
         "clarabel": ``min ||W (M f - u_d)||^2 + lambda ||f||^2`` over a convex inner bound of
             ``E_f`` (SOC-constrained QP); needs the cargo feature ``clarabel``. ``weights`` (6,) is the
             diagonal of ``W``, ``regularization`` is ``lambda`` (default 1e-6).
@@ -887,11 +891,12 @@ def allocate(
             ``|eta - eta_prev| <= rate dt``.
         dt: the control period (s), required with ``rate_limits``.
         regularization: ``lambda`` of "clarabel" and "clarabel-sequential".
-        max_rounds: "exact-boundary-redistribution" only: caps its walk at this many rounds
+        max_rounds: "exact-boundary-redistribution": caps its walk at this many rounds
             (an int >= 0; 0 is its start, the redistributed pseudo-inverse's forces or better),
             or "uncapped" for the walk's own ``2 n + 4`` rounds. A capped call returns the best
             forces found so far, inside ``E_f``, with their true ``e_f``. Default None: the
-            library's default cap, 2 rounds (a bounded worst case).
+            library's default cap, 2 rounds (a bounded worst case). "capped-redistribution":
+            its rounds (an int >= 1; default 2; "uncapped": one per agent). Refused by the others.
 
     Returns:
         Allocation(forces, wrench, e_f, wrench_error, rounds, saturated, fallback, method, report).

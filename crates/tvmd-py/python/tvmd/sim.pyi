@@ -646,7 +646,7 @@ def run(
         relaxation: override the planner's AFS relaxation ``s``, in (0, 1].
         allocator: override the allocator ("exact-boundary-redistribution", the default;
             "redistributed-pseudo-inverse", the paper's; "pseudo-inverse",
-            "weighted-pseudo-inverse"; "clarabel" and "clarabel-sequential" with the cargo
+            "weighted-pseudo-inverse"; "capped-redistribution"; "clarabel" and "clarabel-sequential" with the cargo
             feature).
         precision: override the controller's float type (scenario field
             ``controller_precision``): "f32" flies ``tvmd_core::Controller<f32, ..>``, the type a

@@ -109,8 +109,10 @@ inline TvmdStatus config_from(const Settings &settings, const AgentParamHandles 
 	config.period = settings.law_rate_hz > 0 ? 1.0f / static_cast<float>(settings.law_rate_hz) : 0.0f;
 	config.allocator = static_cast<uint32_t>(settings.allocator);
 	// TVMD_ALLOC_CAP: rounds per period, -1 uncapped; only the exact-boundary redistribution
-	// (TVMD_ALLOC 3) has a walk to cap, the others take the default.
-	if (settings.allocator != static_cast<int32_t>(TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION)) {
+	// (TVMD_ALLOC 3, its walk) and the capped redistribution (TVMD_ALLOC 4) have rounds to cap,
+	// the others take the default.
+	if (settings.allocator != static_cast<int32_t>(TVMD_ALLOCATOR_EXACT_BOUNDARY_REDISTRIBUTION)
+	    && settings.allocator != static_cast<int32_t>(TVMD_ALLOCATOR_CAPPED_REDISTRIBUTION)) {
 		config.allocator_round_cap = TVMD_ROUND_CAP_DEFAULT;
 
 	} else if (settings.allocator_max_rounds < 0) {

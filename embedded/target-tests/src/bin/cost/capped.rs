@@ -11,14 +11,22 @@ use tvmd_core::{
     ExactBoundaryRedistribution, RedistributedPseudoInverse, Reference, RigidState, RoundCap,
 };
 
+use crate::certificate::{Certificates, Certified};
+use crate::cycle_certificate::Around;
 use crate::{measure, team};
 
 /// Issue 59: the n = 16 offset-free searching cycle at most twice the paper law's.
 const RATIO_BOUND: u32 = 2;
 
-/// Prints the capped cycles (each cap in `caps`) beside the paper's; `false` if one was
-/// refused or the default cap is above the bound.
-pub fn report<const N: usize>(per_tick: u32, caps: &[u32]) -> bool {
+/// Prints the capped cycles (each cap in `caps`) beside the paper's, each checked against its
+/// certificate (`around`, `certificates`: the team's of `N`); `false` if one was refused, is
+/// above its certificate, or the default cap is above the bound.
+pub fn report<const N: usize>(
+    per_tick: u32,
+    caps: &[u32],
+    certificates: &Certificates,
+    around: &Around,
+) -> bool {
     let paper = measure::<N, _>(
         true,
         ControllerSettings::paper(),
@@ -49,6 +57,11 @@ pub fn report<const N: usize>(per_tick: u32, caps: &[u32]) -> bool {
         };
         let within = m.instructions <= RATIO_BOUND * paper.instructions;
         let checked = cap == CappedRedistribution::DEFAULT_MAX_ROUNDS;
+        if checked {
+            let certified = Certified::Capped(cap);
+            let case = ("searching", "capped");
+            ok &= around.check(case, 1, certified, certificates, m.instructions);
+        }
         ok &= within || !checked;
         hprintln!(
             "cost: n = {:2} searching cycle, offset-free law, capped-redistribution ({} rounds): {:6} instructions, peak stack {:5} B ({:.2} x the paper law's {}; issue 59: <= {}{}); torque requested {:.1} N m (attainable along it with its force: {:.1} N m), missed {:.2} N m",

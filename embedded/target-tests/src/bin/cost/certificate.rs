@@ -10,7 +10,11 @@
 //! - redistributed pseudo-inverse (at most `n` rounds, `redistributed.rs`): a one-round
 //!   allocation's cost, and per further round the largest mean over a request's further
 //!   rounds (a round fixes one agent, so a later round has fewer free agents and costs less:
-//!   the largest mean, over the family, bounds any request's further rounds);
+//!   `n - 1` times the largest mean is at least the full-saturation request's further rounds,
+//!   which are at least any request's first ones);
+//! - capped redistribution: a one-round allocation, plus per further round the largest
+//!   difference of the same request capped at `k` and `k - 1` rounds (its first rounds are its
+//!   costliest, so a mean would not do);
 //! - exact-boundary redistribution: its start the same way (`Rounds(0)`, the start alone, with
 //!   its set-up), and a walk round's cost as the difference of the same request capped at `k`
 //!   and `k - 1` rounds (every marginal the family reaches, the last direction that finds
@@ -23,8 +27,8 @@ use core::hint::black_box;
 use cortex_m_semihosting::hprintln;
 use tvmd_core::nalgebra::{Vector3, Vector6};
 use tvmd_core::{
-    AdmissibleSet, AllocationRequest, Allocator, ExactBoundaryRedistribution, FailureMask,
-    PseudoInverse, RedistributedPseudoInverse, RoundCap, TeamConfig, WalkCost,
+    AdmissibleSet, AllocationRequest, Allocator, CappedRedistribution, ExactBoundaryRedistribution,
+    FailureMask, PseudoInverse, RedistributedPseudoInverse, RoundCap, TeamConfig, WalkCost,
     WeightedPseudoInverse,
 };
 
@@ -50,6 +54,8 @@ pub struct Units {
     start_base: u32,
     start_round: u32,
     walk_round: u32,
+    capped_base: u32,
+    capped_round: u32,
 }
 
 /// The certificates of a team of `N` agents (instructions per allocation).
@@ -70,6 +76,9 @@ impl Certificates {
             Certified::PseudoInverse => u.pseudo_inverse,
             Certified::Weighted => u.weighted,
             Certified::Redistributed => u.rpi_base + further * u.rpi_round,
+            Certified::Capped(k) => {
+                u.capped_base + (k.min(self.n as u32).saturating_sub(1)) * u.capped_round
+            }
             Certified::ExactBoundary(cap) => {
                 let walk = WalkCost::bound(self.n, cap_limit(cap)).rounds + 1;
                 u.start_base + further * u.start_round + walk * u.walk_round
@@ -87,16 +96,19 @@ pub enum Certified {
     Weighted,
     /// `RedistributedPseudoInverse`, the paper's.
     Redistributed,
+    /// `CappedRedistribution` at this many rounds (its default: 2).
+    Capped(u32),
     /// `ExactBoundaryRedistribution` with its walk capped (the default: `Rounds(2)`).
     ExactBoundary(RoundCap),
 }
 
 impl Certified {
     /// Every certified allocator and cap.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
         Self::PseudoInverse,
         Self::Weighted,
         Self::Redistributed,
+        Self::Capped(CappedRedistribution::DEFAULT_MAX_ROUNDS),
         Self::ExactBoundary(RoundCap::Rounds(tvmd_core::allocation::DEFAULT_MAX_ROUNDS)),
         Self::ExactBoundary(RoundCap::Uncapped),
     ];
@@ -107,6 +119,7 @@ impl Certified {
             Self::PseudoInverse => "pseudo-inverse",
             Self::Weighted => "weighted-pseudo-inverse",
             Self::Redistributed => "redistributed-pseudo-inverse",
+            Self::Capped(_) => "capped-redistribution",
             Self::ExactBoundary(RoundCap::Uncapped) => "exact-boundary, uncapped",
             Self::ExactBoundary(_) => "exact-boundary (default)",
         }
@@ -219,6 +232,23 @@ pub fn calibrate<const N: usize>(team: &TeamConfig<f32, N>, per_tick: u32) -> Ce
             cost(&mut RedistributedPseudoInverse, &r, per_tick),
             rounds.saturating_sub(1),
         );
+        // The capped redistribution: one round, then each further round's own cost (its
+        // first rounds are its most expensive: a mean would not bound a cap of 2).
+        let mut previous = match CappedRedistribution::new(1) {
+            Ok(mut c) => cost(&mut c, &r, per_tick),
+            Err(_) => 0,
+        };
+        units.capped_base = units.capped_base.max(previous);
+        let needed = CappedRedistribution::new(u32::MAX)
+            .map(|mut c| c.allocate(&r).rounds)
+            .unwrap_or(0);
+        for k in 2..=needed.min(N as u32) {
+            if let Ok(mut c) = CappedRedistribution::new(k) {
+                let now = cost(&mut c, &r, per_tick);
+                units.capped_round = units.capped_round.max(now.saturating_sub(previous));
+                previous = now;
+            }
+        }
         // The start alone, then every walk round the uncapped walk takes, and the next.
         let mut capped = eb.with_round_cap(RoundCap::Rounds(0));
         let c0 = cost(&mut capped, &r, per_tick);
@@ -298,6 +328,10 @@ pub fn check_set<const N: usize>(
                     Err(_) => u32::MAX,
                 },
                 Certified::Redistributed => cost(&mut RedistributedPseudoInverse, &r, per_tick),
+                Certified::Capped(k) => match CappedRedistribution::new(k) {
+                    Ok(mut c) => cost(&mut c, &r, per_tick),
+                    Err(_) => u32::MAX,
+                },
                 Certified::ExactBoundary(cap) => cost(
                     &mut ExactBoundaryRedistribution::<f32, N>::new().with_round_cap(cap),
                     &r,
@@ -326,7 +360,7 @@ pub fn check_set<const N: usize>(
 pub fn print_units(c: &Certificates) {
     let u = &c.units;
     hprintln!(
-        "certificate: units n = {:2} (max over {} generated requests): pseudo-inverse {}, weighted {}, redistributed one round {} + {} per further round (at most {}), exact-boundary start {} + {} per further start round, {} per walk round (at most {} + 1 walk rounds capped at 2, {} + 1 uncapped)",
+        "certificate: units n = {:2} (max over {} generated requests): pseudo-inverse {}, weighted {}, redistributed one round {} + {} per further round (at most {}), capped {} + {} per further round, exact-boundary start {} + {} per further start round, {} per walk round (at most {} + 1 walk rounds capped at 2, {} + 1 uncapped)",
         c.n,
         FAMILY,
         u.pseudo_inverse,
@@ -334,6 +368,8 @@ pub fn print_units(c: &Certificates) {
         u.rpi_base,
         u.rpi_round,
         c.n.saturating_sub(1),
+        u.capped_base,
+        u.capped_round,
         u.start_base,
         u.start_round,
         u.walk_round,

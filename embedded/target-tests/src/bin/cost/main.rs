@@ -356,7 +356,7 @@ fn run() -> bool {
     let (ok16, c16, around16) = certified::<16>(per_tick, &[&allocation::RING16_INC]);
     let flights = recorded::check(&c16, &around16, per_tick);
     let checks = storage::report::<4>(per_tick) & storage::report::<16>(per_tick);
-    let capped = capped::report::<16>(per_tick, &[1, 2, 3]);
+    let capped = capped::report::<16>(per_tick, &[1, 2, 3], &c16, &around16);
     let estimate = estimate::report(per_tick).is_some();
     ok4 && ok6
         && ok8
