@@ -11,6 +11,7 @@ pub mod boxplot;
 pub mod catalogue;
 pub mod conditions;
 pub mod distributions;
+pub mod feasibility;
 pub mod flight;
 pub mod report;
 mod study_run;
