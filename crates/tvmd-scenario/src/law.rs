@@ -11,7 +11,7 @@
 //! [law]
 //! gains = "paper"               # the [gains] table as given; "team-scaled"; or natural gains:
 //! # gains = { natural = { position_frequency = [1.5, 1.5, 1.5], position_damping = [1.0, 1.0, 1.0],
-//! #                       attitude_frequency = [5.0, 5.0, 5.0], attitude_damping = [0.7, 0.7, 0.7] } }
+//! #                       attitude_frequency = [6.0, 6.0, 6.0], attitude_damping = [0.6, 0.6, 0.6] } }
 //! offset_free = { kind = "observer", force_bandwidth = 10.0, torque_bandwidth = 10.0, max_torque = 5.0 }
 //! # offset_free = { kind = "integral", k_x = [1.0, 1.0, 1.0], k_r = [0.5, 0.5, 0.5], max_torque = 5.0 }
 //! # offset_free = "off"
@@ -173,9 +173,9 @@ pub struct NaturalGainsConfig {
     pub position_frequency: [f64; 3],
     /// Position damping ratios; 1.
     pub position_damping: [f64; 3],
-    /// Attitude frequencies; 5 rad/s (6 until issue 61).
+    /// Attitude frequencies; 6 rad/s.
     pub attitude_frequency: [f64; 3],
-    /// Attitude damping ratios; 0.7 (1 until issue 61).
+    /// Attitude damping ratios; 0.6 (1 until issue 61).
     pub attitude_damping: [f64; 3],
 }
 

@@ -22,17 +22,17 @@ pub const MAX_PERIOD: f64 = 1.0;
 
 /// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s position axes.
 pub const POSITION_FREQUENCY: f64 = 1.5;
-/// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s attitude axes; 6 until
-/// issue 61 (with [`ATTITUDE_DAMPING`] the rate gain `2 zeta w` fell from 12 to 7 rad/s).
-pub const ATTITUDE_FREQUENCY: f64 = 5.0;
+/// Natural frequency (rad/s) of [`ControllerSettings::offset_free_law`]'s attitude axes.
+pub const ATTITUDE_FREQUENCY: f64 = 6.0;
 /// Damping ratio of [`ControllerSettings::offset_free_law`]'s position axes.
 pub const DAMPING_RATIO: f64 = 1.0;
 /// Damping ratio of [`ControllerSettings::offset_free_law`]'s attitude axes; 1 until issue 61.
 /// The gains scale with the model's inertia, so on a plant lighter than the model the attitude
 /// loop's rate gain `2 zeta w J / J_true` grows (twice at half the inertia) towards the gimbal
-/// servos' bandwidth; with 5 rad/s and 0.7 it stays below it, and every flight of the Monte
-/// Carlo families at five times the default model error holds (`docs/monte-carlo.md`).
-pub const ATTITUDE_DAMPING: f64 = 0.7;
+/// servos' bandwidth; at 0.6 (7.2 rad/s instead of 12 on the model) it stays below it, and every
+/// flight of the Monte Carlo families at five times the default model error holds
+/// (`docs/monte-carlo.md`).
+pub const ATTITUDE_DAMPING: f64 = 0.6;
 /// Observer bandwidth `L_f = L_tau` (rad/s) of [`ControllerSettings::offset_free_law`].
 pub const OBSERVER_BANDWIDTH: f64 = 10.0;
 /// Bound of the offset-free torque (N m) of [`ControllerSettings::offset_free_law`].
