@@ -1350,8 +1350,8 @@ TvmdStatus tvmd_compensation(const struct TvmdController *handle, struct TvmdCom
 /*
  Fills `config` with the library's default: the paper's team "A4 inc, 1 navigator" and
  settings (as `tvmd_config_paper`) flown with the offset-free law (the core's
- `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position, 6 rad/s attitude,
- damping 1 on every axis, scaled by the team's mass and inertia), the disturbance observer
+ `ControllerSettings::offset_free_law`): natural gains (1.5 rad/s position with damping 1,
+ 6 rad/s attitude with damping 0.6, scaled by the team's mass and inertia), the disturbance observer
  (10 rad/s force and torque bandwidths, 5 N m torque bound) and the planned attitude's rates
  (20 rad/s, 5 rad/s bound), with the exact-boundary redistribution's walk capped at
  `TVMD_DEFAULT_MAX_ROUNDS` rounds per period (`TVMD_ROUND_CAP_DEFAULT`). This law holds its setpoint under model error and unmodelled

@@ -26,7 +26,7 @@ pub const FAMILY_NAMES: &[&str] = &[
 ];
 
 /// Release height of the initial-attitude family (m): recovering from 2.5 rad costs A4-Inc
-/// about 19 m of height with the paper's law, 13 m with the default one (measured:
+/// about 19 m of height with the paper's law, 14 m with the default one (measured:
 /// `tvmd-sim run initial-attitude-2.5`).
 pub const RELEASE_HEIGHT: f64 = 30.0;
 

@@ -11,7 +11,7 @@
 //! [law]
 //! gains = "paper"               # the [gains] table as given; "team-scaled"; or natural gains:
 //! # gains = { natural = { position_frequency = [1.5, 1.5, 1.5], position_damping = [1.0, 1.0, 1.0],
-//! #                       attitude_frequency = [6.0, 6.0, 6.0], attitude_damping = [1.0, 1.0, 1.0] } }
+//! #                       attitude_frequency = [6.0, 6.0, 6.0], attitude_damping = [0.6, 0.6, 0.6] } }
 //! offset_free = { kind = "observer", force_bandwidth = 10.0, torque_bandwidth = 10.0, max_torque = 5.0 }
 //! # offset_free = { kind = "integral", k_x = [1.0, 1.0, 1.0], k_r = [0.5, 0.5, 0.5], max_torque = 5.0 }
 //! # offset_free = "off"
@@ -31,8 +31,8 @@ pub const LAW_NAMES: &[&str] = &["paper", "offset-free"];
 /// The defaults of `"offset-free"`, defined once in the core
 /// (`tvmd_core::ControllerSettings::offset_free_law`).
 pub use tvmd_core::controller::{
-    ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX, DAMPING_RATIO,
-    OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
+    ATTITUDE_DAMPING, ATTITUDE_FREQUENCY, ATTITUDE_RATE_BANDWIDTH, ATTITUDE_RATE_MAX,
+    DAMPING_RATIO, OBSERVER_BANDWIDTH, OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
 };
 
 /// The control law's settings: gains, offset-free action, planned rates. In TOML a table, or
@@ -175,7 +175,7 @@ pub struct NaturalGainsConfig {
     pub position_damping: [f64; 3],
     /// Attitude frequencies; 6 rad/s.
     pub attitude_frequency: [f64; 3],
-    /// Attitude damping ratios; 1.
+    /// Attitude damping ratios; 0.6 (1 until issue 61).
     pub attitude_damping: [f64; 3],
 }
 
@@ -185,7 +185,7 @@ impl Default for NaturalGainsConfig {
             position_frequency: [POSITION_FREQUENCY; 3],
             position_damping: [DAMPING_RATIO; 3],
             attitude_frequency: [ATTITUDE_FREQUENCY; 3],
-            attitude_damping: [DAMPING_RATIO; 3],
+            attitude_damping: [ATTITUDE_DAMPING; 3],
         }
     }
 }

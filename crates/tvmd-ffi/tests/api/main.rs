@@ -247,7 +247,7 @@ fn the_default_config_is_the_offset_free_law_and_the_paper_config_the_paper() {
     assert_eq!(law.position_frequency, [POSITION_FREQUENCY as f32; 3]);
     assert_eq!(law.attitude_frequency, [ATTITUDE_FREQUENCY as f32; 3]);
     assert_eq!(law.position_damping, [DAMPING_RATIO as f32; 3]);
-    assert_eq!(law.attitude_damping, [DAMPING_RATIO as f32; 3]);
+    assert_eq!(law.attitude_damping, [ATTITUDE_DAMPING as f32; 3]);
     assert_eq!(law.force_bandwidth, OBSERVER_BANDWIDTH as f32);
     assert_eq!(law.torque_bandwidth, OBSERVER_BANDWIDTH as f32);
     assert_eq!(law.max_torque, OFFSET_FREE_MAX_TORQUE as f32);

@@ -916,8 +916,8 @@ class Controller:
 
     The law: by default the offset-free law (``law="offset-free"``, ``tvmd_core::ControllerSettings::
     offset_free_law``; docs/method.md "Beyond the paper"), the one that holds its setpoint under
-    model error and unmodelled forces: natural gains (1.5 rad/s position, 6 rad/s attitude,
-    damping 1, scaled by the team's mass and inertia), a disturbance observer (10 rad/s, torque
+    model error and unmodelled forces: natural gains (1.5 rad/s position with damping 1,
+    6 rad/s attitude with damping 0.6, scaled by the team's mass and inertia), a disturbance observer (10 rad/s, torque
     bound 5 N m) and the planned attitude's rates. ``law="paper"`` is the paper's eq. (12) bit for
     bit (``gains`` as given, no offset-free action, the reference's ``Omega_d``); under any
     unmodelled force it leaves a steady error.

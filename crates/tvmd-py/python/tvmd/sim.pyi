@@ -902,9 +902,11 @@ def monte_carlo(
     Returns:
         ``{"flights": [row, ...], "groups": [group, ...], "success_rate": float,
         "files": {"flights": path, "groups": path, "plots": [path, ...]} or None}``: one row
-        dict per flight (what it drew and its metrics: ``success``, ``position_steady_state``,
-        ``position_settling_time``, ...; ``None`` where the run has no value), one dict per
-        group (``success_rate``, medians); ``pandas.DataFrame(result["flights"])`` or
+        dict per flight (what it drew and its metrics: ``success``, ``feasibility``
+        (``"feasible"``, ``"infeasible"``: no admissible command of the plant as built holds
+        the reference, or ``"undecided"``), ``position_steady_state``, ...; ``None`` where the
+        run has no value), one dict per group (``success_rate``, ``infeasible``,
+        ``feasible_success_rate``, medians); ``pandas.DataFrame(result["flights"])`` or
         ``polars.DataFrame(result["flights"])`` loads them.
 
     Raises:

@@ -6,6 +6,7 @@ use std::sync::atomic::AtomicBool;
 use serde::{Deserialize, Serialize};
 
 use super::distributions::{Distributions, Draw};
+use super::feasibility::Plant;
 use crate::StudyError;
 use tvmd_scenario::Scenario;
 use tvmd_sim::runner::{fly, RunSpec};
@@ -99,6 +100,13 @@ pub struct FlightRow {
     pub initial_tilt: f64,
     /// The verdict.
     pub success: bool,
+    /// Whether any admissible command of the plant as built can hold the reference at the
+    /// sampled instants: `"feasible"`, `"infeasible"` or `"undecided"`
+    /// ([`super::feasibility`]). A failed flight that was infeasible is no fault of the
+    /// controller.
+    pub feasibility: String,
+    /// The first sampled instant no admissible command could hold (s), if any.
+    pub infeasible_at: Option<f64>,
     /// The bounds missed, `; `-separated (empty on success).
     pub failures: String,
     /// The error that ended the flight early, if any.
@@ -155,6 +163,7 @@ pub fn fly_flight_until(
         samples: SampleRetention::None,
     };
     let flight = fly(&run, None, cancel)?;
+    let feasibility = Plant::new(&scenario)?.verdict(&scenario);
     if flight.result.summary.interrupted {
         return Ok(None);
     }
@@ -194,6 +203,8 @@ pub fn fly_flight_until(
         initial_offset: draw.initial_offset[0].hypot(draw.initial_offset[1]),
         initial_tilt: draw.initial_tilt[0],
         success: s.verdict.success,
+        feasibility: feasibility.feasibility.name().into(),
+        infeasible_at: feasibility.first_infeasible,
         failures: s.verdict.failures.join("; "),
         error: s.error.clone(),
         time: s.time,

@@ -11,6 +11,7 @@ pub mod boxplot;
 pub mod catalogue;
 pub mod conditions;
 pub mod distributions;
+pub mod feasibility;
 pub mod flight;
 pub mod report;
 mod study_run;
@@ -296,6 +297,16 @@ mod tests {
         let groups = group_summaries(&one);
         assert_eq!(groups.len(), 4);
         assert!(groups.iter().all(|g| g.runs == 3));
+        // Small errors: every plant can hold the hover, and the groups count it so.
+        assert!(one
+            .iter()
+            .all(|r| r.feasibility == "feasible" && r.infeasible_at.is_none()));
+        assert!(groups
+            .iter()
+            .all(|g| g.feasible == 3 && g.infeasible == 0 && g.undecided == 0));
+        assert!(groups
+            .iter()
+            .all(|g| g.feasible_success_rate == Some(g.success_rate)));
         // The nominal plant hovers: every flight of model error 0 succeeds.
         let nominal: Vec<_> = groups.iter().filter(|g| g.model_error == 0.0).collect();
         assert!(nominal.iter().all(|g| g.success_rate == 1.0), "{nominal:?}");

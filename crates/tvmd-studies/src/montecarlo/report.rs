@@ -23,6 +23,16 @@ pub struct GroupSummary {
     pub successes: usize,
     /// `successes / runs`.
     pub success_rate: f64,
+    /// Flights no admissible command could hold ([`super::feasibility`]).
+    pub infeasible: usize,
+    /// Flights neither judged feasible nor infeasible.
+    pub undecided: usize,
+    /// Flights judged feasible.
+    pub feasible: usize,
+    /// Feasible flights whose verdict is a success.
+    pub feasible_successes: usize,
+    /// `feasible_successes / feasible` (`None` without a feasible flight).
+    pub feasible_success_rate: Option<f64>,
     /// Flights that ended early (a flight error).
     pub errors: usize,
     /// Median steady-state position error (m).
@@ -73,6 +83,12 @@ pub fn group_summaries(rows: &[FlightRow]) -> Vec<GroupSummary> {
         .map(|k| {
             let g: Vec<&FlightRow> = rows.iter().filter(|r| group_key(r) == k).collect();
             let successes = g.iter().filter(|r| r.success).count();
+            let judged = |name: &str| g.iter().filter(|r| r.feasibility == name).count();
+            let feasible = judged("feasible");
+            let feasible_successes = g
+                .iter()
+                .filter(|r| r.success && r.feasibility == "feasible")
+                .count();
             let median = |f: &dyn Fn(&FlightRow) -> Option<f64>| {
                 quantile(g.iter().filter_map(|r| f(r)), 0.5)
             };
@@ -80,6 +96,12 @@ pub fn group_summaries(rows: &[FlightRow]) -> Vec<GroupSummary> {
                 runs: g.len(),
                 successes,
                 success_rate: successes as f64 / g.len().max(1) as f64,
+                infeasible: judged("infeasible"),
+                undecided: judged("undecided"),
+                feasible,
+                feasible_successes,
+                feasible_success_rate: (feasible > 0)
+                    .then(|| feasible_successes as f64 / feasible as f64),
                 errors: g.iter().filter(|r| r.error.is_some()).count(),
                 median_position_steady_state: median(&|r| r.position_steady_state),
                 p90_position_steady_state: quantile(
@@ -129,12 +151,14 @@ pub fn write_csv<T: Serialize>(rows: &[T], path: &Path) -> Result<(), StudyError
 pub fn text_table(groups: &[GroupSummary]) -> String {
     let opt = |v: Option<f64>, p: usize| v.map_or_else(|| "-".into(), |x| format!("{x:.p$}"));
     let mut out = format!(
-        "{:<16} {:<30} {:>6} {:>6} {:>8} {:>10} {:>10} {:>10} {:>9}\n",
+        "{:<16} {:<30} {:>6} {:>6} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n",
         "team",
         "allocator",
         "error",
         "runs",
         "success",
+        "infeasible",
+        "feas. ok",
         "steady (m)",
         "peak (m)",
         "settle (s)",
@@ -142,12 +166,19 @@ pub fn text_table(groups: &[GroupSummary]) -> String {
     );
     for g in groups {
         out.push_str(&format!(
-            "{:<16} {:<30} {:>6} {:>6} {:>7.1}% {:>10} {:>10} {:>10} {:>9}\n",
+            "{:<16} {:<30} {:>6} {:>6} {:>7.1}% {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n",
             g.team,
             g.allocator,
             g.model_error,
             g.runs,
             100.0 * g.success_rate,
+            if g.undecided > 0 {
+                format!("{} (+{}?)", g.infeasible, g.undecided)
+            } else {
+                g.infeasible.to_string()
+            },
+            g.feasible_success_rate
+                .map_or_else(|| "-".into(), |r| format!("{:.1}%", 100.0 * r)),
             opt(g.median_position_steady_state, 4),
             opt(g.median_position_peak, 3),
             opt(g.median_position_settling_time, 2),
