@@ -229,7 +229,7 @@ impl PySimulation {
     }
 
     /// Starts over (optionally reseeding the state noise, from another initial pose); the
-    /// first observation. `seed` reseeds the state noise; `position` (3,) and `attitude_rpy`
+    /// first observation. `seed` reseeds the state noise, links and reports; `position` (3,) and `attitude_rpy`
     /// (3,) replace the scenario's initial pose.
     #[pyo3(signature = (seed = None, *, position = None, attitude_rpy = None))]
     fn reset(

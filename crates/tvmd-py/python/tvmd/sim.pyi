@@ -410,9 +410,9 @@ class Simulation:
         recorded) and returns the first observation.
 
         Args:
-            seed: 0 to 2**64 - 1, reseeds the state noise; without it the scenario's
-                ``disturbances.state_noise.seed`` is used, so every reset replays the same
-                noise. No effect without state noise.
+            seed: 0 to 2**64 - 1, reseeds the state noise and the draws of the agents' links
+                and reports; without it the scenario's seeds are used, so every reset replays
+                the same noise. No effect without any of them.
             position: (3,) another initial position of the centre of mass (m).
             attitude_rpy: (3,) another initial attitude, roll, pitch, yaw (rad, ZYX).
                 ``position`` and ``attitude_rpy`` replace the scenario's initial pose (later

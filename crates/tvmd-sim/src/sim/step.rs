@@ -79,7 +79,8 @@ impl Simulation {
 
     /// Starts over: the scenario's initial state, actuators at rest, no failure applied, time
     /// 0, nothing recorded. `seed` reseeds the state noise (the scenario's
-    /// `disturbances.state_noise.seed` otherwise); it has no effect without state noise.
+    /// `disturbances.state_noise.seed` otherwise) and the draws of the agents' links and
+    /// reports (streams of their own derived from it); it has no effect without any of them.
     pub fn reset(&mut self, seed: Option<u64>) -> Result<(), SimError> {
         self.reset_at(seed, None, None)
     }
@@ -97,6 +98,14 @@ impl Simulation {
         let mut scenario = self.scenario.clone();
         if let (Some(seed), Some(noise)) = (seed, scenario.disturbances.state_noise.as_mut()) {
             noise.seed = seed;
+        }
+        // splitmix64's increment: streams apart from the noise's.
+        let stream = |k: u64| seed.map(|s| s.wrapping_add(k.wrapping_mul(0x9E37_79B9_7F4A_7C15)));
+        if let (Some(seed), Some(links)) = (stream(1), scenario.links.as_mut()) {
+            links.seed = seed;
+        }
+        if let (Some(seed), Some(reports)) = (stream(2), scenario.reports.as_mut()) {
+            reports.seed = seed;
         }
         if let Some(p) = position {
             scenario.initial_position = p;

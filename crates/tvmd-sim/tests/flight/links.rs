@@ -113,3 +113,26 @@ fn a_silent_link_holds_the_last_command_then_idles_the_agent() {
         );
     }
 }
+
+#[test]
+fn a_reset_seed_draws_the_links_anew_and_repeats_itself() {
+    let lossy = CommandLinks {
+        loss: 0.3,
+        ..CommandLinks::default()
+    };
+    let mut s = hover("a4-inc", Some(lossy));
+    s.duration = 0.5;
+    let lost = |seed: Option<u64>| {
+        let mut sim = Simulation::new(&s).unwrap();
+        sim.reset(seed).unwrap();
+        while !sim.is_finished() {
+            let n = sim.agents();
+            sim.observe().unwrap();
+            sim.step(&vec![Default::default(); n]).unwrap();
+        }
+        sim.link_stats().unwrap()
+    };
+    assert_eq!(lost(None), lost(None));
+    assert_eq!(lost(Some(7)), lost(Some(7)));
+    assert_ne!(lost(Some(7)), lost(Some(8)));
+}
