@@ -141,10 +141,10 @@ mod tests {
             );
             let mut c = controller();
             let p: *mut Checked = &mut *c;
-            // Past the last variant with or without `clarabel` (4 or 6 variants).
+            // Past the last variant with or without `clarabel` (5 or 7 variants).
             assert!(
-                !intact_after(p, addr_of_mut!((*p).allocator), 6),
-                "allocator 6"
+                !intact_after(p, addr_of_mut!((*p).allocator), 7),
+                "allocator 7"
             );
             let mut c = controller();
             let p: *mut Checked = &mut *c;
