@@ -96,7 +96,8 @@ static void test_configs(void) {
   CHECK(def.law.offset_free == TVMD_OFFSET_FREE_OBSERVER);
   CHECK(def.law.attitude_rate != 0);
   CHECK(def.law.position_frequency[0] == 1.5f && def.law.position_frequency[2] == 1.5f);
-  CHECK(def.law.attitude_frequency[1] == 6.0f && def.law.attitude_damping[2] == 1.0f);
+  CHECK(def.law.attitude_frequency[1] == 6.0f && def.law.attitude_damping[2] == 0.6f);
+  CHECK(def.law.position_damping[0] == 1.0f);
   CHECK(def.law.force_bandwidth == 10.0f && def.law.torque_bandwidth == 10.0f);
   CHECK(def.law.max_torque == 5.0f);
   CHECK(def.law.attitude_rate_bandwidth == 20.0f && def.law.attitude_rate_max == 5.0f);
