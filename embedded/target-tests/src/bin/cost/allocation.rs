@@ -121,10 +121,7 @@ pub fn report<const N: usize>(
         let overhead = clock::ticks(REPS, &mut || {
             black_box(empty(black_box(&mut a), black_box(&request)));
         });
-        let per_call = |work: u32| {
-            let per = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-            ((per + u64::from(REPS) / 2) / u64::from(REPS)) as u32
-        };
+        let per_call = |work: u32| clock::per_call(work, overhead, per_tick, REPS);
         *slot = per_call(work);
         *paper_slot = per_call(clock::ticks(REPS, &mut || {
             black_box(allocate_rpi(black_box(&mut a), black_box(&request)));

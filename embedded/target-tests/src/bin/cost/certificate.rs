@@ -164,8 +164,7 @@ pub fn cost<A: Allocator<f32, N>, const N: usize>(
     let overhead = clock::ticks(REPS, &mut || {
         black_box(empty(black_box(&mut *a), black_box(r)));
     });
-    let per = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-    ((per + u64::from(REPS) / 2) / u64::from(REPS)) as u32
+    clock::per_call(work, overhead, per_tick, REPS)
 }
 
 /// A deterministic generator of the family (Numerical Recipes' LCG).

@@ -45,6 +45,14 @@ pub fn ticks(reps: u32, f: &mut dyn FnMut()) -> u32 {
     elapsed(t0, now())
 }
 
+/// Instructions of one call from the ticks of `reps` calls (`work`) and of as many calls of
+/// the same shape with no work (`overhead`), rounded to the nearest.
+pub fn per_call(work: u32, overhead: u32, per_tick: u32, reps: u32) -> u32 {
+    let total = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
+    let reps = u64::from(reps.max(1));
+    ((total + reps / 2) / reps) as u32
+}
+
 /// `iterations` (>= 1) passes of a loop whose body is 1,000 `nop`s plus `subs` and `bne`:
 /// exactly `1,002 * iterations` instructions besides the call's own few, which cancel in
 /// [`calibrate`]'s difference of two loops.

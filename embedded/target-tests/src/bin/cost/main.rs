@@ -153,8 +153,7 @@ fn measure<const N: usize, A: Allocator<f32, N> + Clone>(
             black_box(&reference),
         ));
     });
-    let per_cycle = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-    let instructions = ((per_cycle + u64::from(REPS) / 2) / u64::from(REPS)) as u32;
+    let instructions = clock::per_call(work, overhead, per_tick, REPS);
     // The stack on the controller itself (a copy would sit on the painted stack).
     let stack = stack::peak(&mut || {
         black_box(cycle(

@@ -84,8 +84,7 @@ fn time(recording: &[u8], per_tick: u32) -> Result<(usize, usize, u32, usize), &
                 black_box(&reference),
             ));
         });
-        let per = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-        let instructions = ((per + u64::from(REPS) / 2) / u64::from(REPS)) as u32;
+        let instructions = clock::per_call(work, overhead, per_tick, REPS);
         if instructions > worst {
             (worst, at) = (instructions, k);
         }

@@ -48,8 +48,7 @@ pub fn report<const N: usize>(per_tick: u32) -> bool {
     let overhead = clock::ticks(REPS, &mut || {
         black_box(empty(black_box(at)));
     });
-    let per_call = u64::from(work.saturating_sub(overhead)) * u64::from(per_tick);
-    let instructions = (per_call + u64::from(REPS) / 2) / u64::from(REPS);
+    let instructions = clock::per_call(work, overhead, per_tick, REPS);
     hprintln!(
         "cost: n = {:2} storage check of a C handle (Controller::storage_intact, per entry point call): {} instructions{}",
         N,
