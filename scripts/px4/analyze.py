@@ -3,15 +3,15 @@
 what the flight must show; the same measures for a flight on tvmd-sim and on PX4's SIH.
 
     analyze.py FLIGHT.ulg --hover A B [--step C D --step-north 1.0] [--tilt E F --tilt-min R]
-               [--expect-flight | --expect-airborne] [--tilt-held STD] [--json OUT]
+               [--expect-flight | --expect-airborne] [--tilt-held STD] [--tilt-height M] [--json OUT]
 
 Positions are relative to where the vehicle was armed: the hover target is 1.5 m (--height)
 above it, the step target `--step-north` metres north of that. Prints a JSON report; with
 --expect-flight exits 1 unless the flight armed, flew (above 1 m), raised no failsafe and
-no estimator failure flag while armed, and landed (on the ground and disarmed at the end);
+no estimator failure flag while armed, and landed (on the ground when it disarmed, and at the end);
 --expect-airborne checks all but the landing; with --tilt, exits 1 unless the mean true roll
 over the tilt window reached --tilt-min (and with --tilt-held, its standard deviation stayed
-below it).
+below it; with --tilt-height, the height stayed that close to the hover's mean height).
 Needs pyulog (pip install pyulog).
 """
 import argparse
@@ -48,6 +48,15 @@ def ned_from(lat, lon, alt, lat0, lon0, alt0):
     return np.stack([north, east, -(alt - alt0)], axis=1)
 
 
+def param_at(ulog, name, t):
+    """A parameter's value in force at time t (s): its last change before t, else its value at boot."""
+    value = ulog.initial_parameters.get(name)
+    for stamp, key, changed in ulog.changed_parameters:
+        if key == name and stamp * 1e-6 <= t:
+            value = changed
+    return value
+
+
 def quat_rows(data):
     return np.stack([data[f"q[{i}]"] for i in range(4)], axis=1)
 
@@ -72,9 +81,13 @@ def main():
     p.add_argument("--tilt", nargs=2, type=float, metavar=("FROM", "TO"))
     p.add_argument("--tilt-min", type=float, default=0.0)
     p.add_argument("--tilt-held", type=float, help="largest roll standard deviation over the tilt window")
+    p.add_argument("--tilt-height", type=float,
+                   help="largest distance of the height in the tilt window from the hover's mean height (m)")
     p.add_argument("--expect-flight", action="store_true")
     p.add_argument("--expect-airborne", action="store_true",
                    help="only: armed, above 1 m, no failsafe or estimator failure flag while armed")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter PX4 must hold from arming on (e.g. one the flight sets)")
     p.add_argument("--json")
     a = p.parse_args()
 
@@ -87,6 +100,7 @@ def main():
     flags = topic(u, "failsafe_flags")
     planner = topic(u, "attitude_planner_meta_data")
     allocation = topic(u, "control_allocation_meta_data")
+    servos = topic(u, "actuator_servos")
     if any(x is None for x in (status, gpos, gpos_gt, att, att_gt)):
         sys.exit(f"{a.ulog}: a topic is missing (vehicle_status, vehicle_global_position(_groundtruth), "
                  "vehicle_attitude(_groundtruth))")
@@ -109,7 +123,8 @@ def main():
         pos = truth[inside]
         dist = np.linalg.norm(pos - target, axis=1)
         out = {"from": t0, "to": t1, "hold_max": float(dist.max()), "hold_rms": float(np.sqrt(np.mean(dist ** 2))),
-               "height_min": float(-pos[:, 2].max()), "height_max": float(-pos[:, 2].min())}
+               "height_min": float(-pos[:, 2].max()), "height_max": float(-pos[:, 2].min()),
+               "height_mean": float(-pos[:, 2].mean())}
         outside = np.nonzero(dist > 0.1)[0]
         times = t_gt[inside]
         if len(outside) == 0:
@@ -153,6 +168,23 @@ def main():
             if len(asked):
                 # The authors' allocator's force it could not allocate (N, body frame).
                 out["unallocated_force_max"] = float(np.linalg.norm(asked - got, axis=1).max())
+                # The share of the asked change its redistribution allocated (the sum of its
+                # increments, 1: all; it stops when an agent saturates and the rest lose rank).
+                inc = np.stack([allocation[f"increment[{i}]"][sel] for i in range(4)], axis=1)
+                out["allocated_share_min"] = float(np.where(inc > 0, inc, 0).sum(axis=1).min())
+        if servos is not None:
+            tv = seconds(servos)
+            sel = (tv >= t0) & (tv <= t1)
+            # Servo i's command in [-1, 1] spans CA_SV_TLi_MINA..MAXA (deg): even i eta_x, odd eta_y.
+            largest = [0.0, 0.0]
+            for i in range(8):
+                lo = param_at(u, f"CA_SV_TL{i}_MINA", t0)
+                hi = param_at(u, f"CA_SV_TL{i}_MAXA", t0)
+                if lo is None or hi is None or not sel.any():
+                    continue
+                deg = np.abs(servos[f"control[{i}]"][sel]) * (hi - lo) / 2
+                largest[i % 2] = max(largest[i % 2], float(np.nanmax(deg)))
+            out["gimbal_command_max_deg"] = largest
         return out
 
     report = {"ulog": a.ulog, "armed_at": arm_t}
@@ -166,10 +198,12 @@ def main():
         # Rise time: from the step's command to 90 % of the way (a noise-independent measure).
         report["step"]["rise_time_90"] = float(t_gt[inside][reached[0]] - a.step[0]) if len(reached) else None
     if a.tilt:
-        report["tilt"] = window(*a.tilt, np.array([0.0, 0.0, -a.height]))
+        tilt = report["tilt"] = window(*a.tilt, np.array([0.0, 0.0, -a.height]))
+        hover_height = report["hover"]["height_mean"]
+        tilt["height_off_hover_max"] = max(hover_height - tilt["height_min"], tilt["height_max"] - hover_height)
     height = -truth[:, 2]
     report["max_height"] = float(height.max())
-    report["final_height"] = float(height[-1])
+    report["final_height"] = float(height[-1]) + 0.0
     fs = status["failsafe"][armed] if armed.any() else np.array([])
     report["failsafe_while_armed"] = bool(fs.any())
     bad_flags = []
@@ -184,6 +218,10 @@ def main():
     # Without PX4's land detector (the authors' airframe runs none): on the ground at the end.
     report["landed_at_end"] = bool(land["landed"][-1]) if land is not None else report["final_height"] < 0.2
     report["armed_at_end"] = bool(armed[-1])
+    # Where it was when it disarmed (a disarm in the air would fall and still end on the ground).
+    disarms = np.nonzero(armed[:-1] & ~armed[1:])[0]
+    report["height_at_disarm"] = (float(-at(t_gt, truth, t_status[disarms[-1:] + 1])[0, 2]) + 0.0
+                                  if len(disarms) else None)
 
     text = json.dumps(report, indent=2)
     print(text)
@@ -200,14 +238,25 @@ def main():
             problems.append("a failsafe while armed")
         if bad_flags:
             problems.append(f"estimator failure flags while armed: {bad_flags}")
-        if a.expect_flight and (not report["landed_at_end"] or report["armed_at_end"] or report["final_height"] > 0.2):
-            problems.append("not landed and disarmed at the end")
+        at_disarm = report["height_at_disarm"]
+        if a.expect_flight and (not report["landed_at_end"] or report["armed_at_end"] or report["final_height"] > 0.2
+                                or at_disarm is None or at_disarm > 0.2):
+            problems.append(f"not landed and disarmed at the end (height at the disarm: {at_disarm})")
+    for item in a.param:
+        name, _, want = item.partition("=")
+        got = param_at(u, name, arm_t if arm_t is not None else 0.0)
+        if got is None or abs(float(got) - float(want)) > 1e-6:
+            problems.append(f"parameter {name} is {got} at arming, expected {want}")
     if a.tilt:
         tilt = report["tilt"]
         if abs(tilt["roll_mean"]) < a.tilt_min:
             problems.append(f"tilt not reached: mean roll {tilt['roll_mean']:.3f} rad < {a.tilt_min}")
         if a.tilt_held is not None and tilt["roll_std"] > a.tilt_held:
             problems.append(f"tilt not held: roll std {tilt['roll_std']:.3f} rad > {a.tilt_held}")
+        if a.tilt_height is not None and tilt["height_off_hover_max"] > a.tilt_height:
+            problems.append(f"height not held in the tilt: {tilt['height_min']:.2f}-{tilt['height_max']:.2f} m "
+                            f"against {report['hover']['height_mean']:.2f} m in the hover "
+                            f"(more than {a.tilt_height} m off)")
     for msg in problems:
         print(f"FAIL: {a.ulog}: {msg}", file=sys.stderr)
     sys.exit(1 if problems else 0)

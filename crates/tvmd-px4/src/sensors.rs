@@ -4,7 +4,10 @@
 //! The accelerometer reads the specific force `R^T (a - g)`, `a` the centre of mass's mean
 //! acceleration over the last period (the velocity's change: thrust, wind, drag and ground
 //! contact alike), so that a team resting on the ground reads `-g` along FRD's z, as a real
-//! IMU does.
+//! IMU does. It saturates at its range (`accel_range`, PX4's simulated 16 g): a touchdown's
+//! one-tick impulse can exceed it, and PX4's `simulator_mavlink` packs each sample into an int16
+//! at `g/2048` per count, where a larger one wraps round to the opposite sign (EKF2 then
+//! integrates a false velocity); saturated, PX4 sees the sample as clipping, as with a real IMU.
 
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -31,6 +34,10 @@ pub mod fields {
     pub const BARO: u32 = 0b1_1010_0000_0000;
 }
 
+/// PX4's simulated accelerometer range (m/s^2): 32767.5 counts of `g/2048`, PX4's `CONSTANTS_ONE_G`
+/// (`simulator_mavlink`'s int16 FIFO; 16 g less half a count).
+pub const PX4_ACCEL_RANGE: f64 = 32767.5 * 9.80665 / 2048.0;
+
 /// Noise, biases and rates of the simulated sensors (`[sensors]` of a flight file). Standard
 /// deviations are per sample; defaults are those of PX4's Gazebo sensor plugins at 250 Hz
 /// (gyroscope 0.0030 rad/s, accelerometer 0.029 m/s^2) with an RTK-grade GPS (2 cm).
@@ -47,6 +54,10 @@ pub struct SensorConfig {
     pub accel_noise: f64,
     /// Accelerometer bias, FRD (m/s^2).
     pub accel_bias: [f64; 3],
+    /// Largest specific force each accelerometer axis reads (m/s^2): default PX4's simulated
+    /// range, 16 g (32767.5 counts of `g/2048`: PX4 flags the sample as clipping and one count
+    /// more would wrap its int16 to the opposite sign).
+    pub accel_range: f64,
     /// Magnetometer noise (gauss).
     pub mag_noise: f64,
     /// Barometer noise (hPa; 0.012 hPa is about 0.1 m).
@@ -73,6 +84,7 @@ impl Default for SensorConfig {
             gyro_bias: [0.0; 3],
             accel_noise: 0.029,
             accel_bias: [0.0; 3],
+            accel_range: PX4_ACCEL_RANGE,
             mag_noise: 0.0005,
             baro_noise: 0.006,
             gps_horizontal_noise: 0.02,
@@ -106,12 +118,14 @@ impl SensorConfig {
             }
         }
         for (name, v) in [
+            ("accel_range", self.accel_range),
             ("mag_baro_rate", self.mag_baro_rate),
             ("gps_rate", self.gps_rate),
             ("truth_rate", self.truth_rate),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(bad(name, format!("must be > 0 Hz, got {v}")));
+                let unit = if name == "accel_range" { "m/s^2" } else { "Hz" };
+                return Err(bad(name, format!("must be > 0 {unit}, got {v}")));
             }
         }
         for (name, b) in [
@@ -221,8 +235,11 @@ impl SensorModel {
         let r = &state.rotation;
         let gravity = Vector3::new(0.0, 0.0, -GRAVITY);
         let specific = flip(&(r.transpose() * (accel - gravity)));
-        let accel_frd =
-            specific + Vector3::from(self.config.accel_bias) + self.noise3(self.config.accel_noise);
+        let range = self.config.accel_range;
+        let accel_frd = (specific
+            + Vector3::from(self.config.accel_bias)
+            + self.noise3(self.config.accel_noise))
+        .map(|a| a.clamp(-range, range));
         let gyro_frd = flip(&state.omega)
             + Vector3::from(self.config.gyro_bias)
             + self.noise3(self.config.gyro_noise);
@@ -361,6 +378,24 @@ mod tests {
         // The pressure of home's altitude.
         let (p, _) = standard_atmosphere(488.0);
         assert!((f64::from(r.pressure) - p).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_touchdown_beyond_the_range_saturates_the_accelerometer_instead_of_wrapping() {
+        let mut s = quiet();
+        let level = PlantState::at_rest(Vector3::zeros());
+        // 0.7 m/s stopped within one 4 ms tick: 175 m/s^2 up, past 16 g with gravity.
+        let r = s.imu(&level, &Vector3::new(0.0, 0.0, 175.0), false);
+        assert_eq!(r.accel[2], -PX4_ACCEL_RANGE as f32);
+        // PX4 packs it as -32767 counts of g/2048 (its clipping mark), not past the int16.
+        let counts = r.accel[2] / (9.80665f32 / 2048.0);
+        assert!(counts < -32766.9 && counts > -32768.0, "{counts}");
+        let bad = SensorConfig {
+            accel_range: 0.0,
+            ..Default::default()
+        };
+        let err = bad.check().unwrap_err().to_string();
+        assert!(err.contains("accel_range"), "{err}");
     }
 
     #[test]
