@@ -94,6 +94,31 @@ pub enum Telemetry {
     },
 }
 
+impl Telemetry {
+    /// The message with its PX4 time moved by `dt` seconds (untimed messages unchanged).
+    pub fn shifted(self, dt: f64) -> Self {
+        match self {
+            Self::LocalPosition { t, position } => Self::LocalPosition {
+                t: t + dt,
+                position,
+            },
+            Self::Attitude { t, q } => Self::Attitude { t: t + dt, q },
+            Self::AttitudeTarget { t, q } => Self::AttitudeTarget { t: t + dt, q },
+            other => other,
+        }
+    }
+
+    /// The message if it carries no PX4 time, else `None`.
+    pub fn untimed(self) -> Option<Self> {
+        match self {
+            Self::LocalPosition { .. } | Self::Attitude { .. } | Self::AttitudeTarget { .. } => {
+                None
+            }
+            other => Some(other),
+        }
+    }
+}
+
 /// The UDP link to PX4's GCS port.
 pub struct GcsLink {
     socket: UdpSocket,
