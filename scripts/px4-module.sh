@@ -35,7 +35,7 @@
 # (PX4's SITL without lockstep: its clock, and so its perf counters, on the wall clock) and flies
 # both stacks' hover and tilt on tvmd-sim in real time (`tvmd-sim px4 --real-time`), reading
 # PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
-# (PX4_TARGET=px4_sitl_nolockstep builds that one alone).
+# (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
@@ -143,6 +143,17 @@ if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ]; then
   flights="$repo/scripts/px4/tvmd_control"
 fi
 
+if [ "$perf" -eq 1 ]; then
+  # Not in the test command: PX4's perf counters read hrt, which in lockstep SITL is the
+  # simulated clock (0 us a cycle). A build without lockstep runs on the wall clock; tvmd-sim
+  # paces it in real time.
+  perf_target=px4_sitl_nolockstep
+  [ "$target" = "$perf_target" ] || build_px4 "$perf_target"
+  step "perf: each stack's time per cycle on real time ($perf_target, tvmd-sim px4 --real-time)"
+  python3 "$repo/scripts/px4/perf.py" --sim "$sim" --px4-dir "$px4_dir" --build "$perf_target" \
+    --instance "$instance" --out "$out/perf"
+fi
+
 if [ "$side" -eq 1 ]; then
   # Not in the test command (about a minute): the hover of each stack on the nominal vehicle,
   # under a steady wind and off its model; the table of docs/px4-module.md. The authors' modules
@@ -160,17 +171,6 @@ if [ "$side" -eq 1 ]; then
       --out "$out/authors-$flight.mcap" >/dev/null
   done
   python3 "$repo/scripts/px4/side_by_side.py" "$out"
-fi
-
-if [ "$perf" -eq 1 ]; then
-  # Not in the test command: PX4's perf counters read hrt, which in lockstep SITL is the
-  # simulated clock (0 us a cycle). A build without lockstep runs on the wall clock; tvmd-sim
-  # paces it in real time.
-  perf_target=px4_sitl_nolockstep
-  [ "$target" = "$perf_target" ] || build_px4 "$perf_target"
-  step "perf: each stack's time per cycle on real time ($perf_target, tvmd-sim px4 --real-time)"
-  python3 "$repo/scripts/px4/perf.py" --sim "$sim" --px4-dir "$px4_dir" --build "$perf_target" \
-    --instance "$instance" --out "$out/perf"
 fi
 
 if [ "$fly" -eq 1 ]; then

@@ -14,17 +14,19 @@ simulator connected (its console), the script runs PX4's own `perf reset` at the
 measured window and `perf` at its end (the daemon client `build/BUILD/bin/px4-perf --instance
 N`, as the `perf` command of PX4's shell), so the counters cover that window alone. The flights
 and windows (simulated s, which the real-time bridge keeps on the wall clock):
-  tvmd        scripts/px4/tvmd_control/flight.toml  hover 22.5-29.5 (before its parameter test), tilt 38.5-45.5
-  authors     scripts/px4/authors/flight-hold.toml  hover 28-35 (their position mode)
-  authors-rc  scripts/px4/authors/flight.toml       hover 18.5-21.5, tilt 24.5-27.5 (their manual mode)
-The windows' edges are found on the wall clock from PX4's console line, within a tenth of a
-second. Also reads the ulogs' `perf_counter_postflight` (PX4's logger writes every counter at
-disarm: from the last `perf reset` here, the last window's start, to the disarm, the landing
-included) where a flight disarmed. Writes DIR/perf.json and
-prints a Markdown table: per counter, the events, mean and largest time in the window, and per
-stack the time per rate-loop period (its rate-loop modules' mean plus the position loop's mean
-times its share of periods). The machine's load average is printed with each reading: the
-numbers are wall-clock times on a shared machine. Exits 1 when a flight or a reading fails.
+  tvmd        tvmd_control/flight.toml  hover 22.5-29.5 (before its parameter test), tilt 38.5-45.5
+  authors     authors/flight-hold.toml  hover 28-35 (their position mode)
+  authors-rc  authors/flight.toml       hover 18.5-21.5, tilt 24.5-27.5 (their manual mode)
+(in scripts/px4/). The windows' edges are found on the wall clock from PX4's console line,
+within a tenth of a second. Also reads the ulogs' `perf_counter_postflight` (PX4's logger writes
+every counter at disarm: from the last `perf reset` here, the last window's start, to the
+disarm, the landing included) where a flight disarmed. Writes DIR/perf.json (side_by_side.py
+reads the hovers' time per period from it) and prints a Markdown table: per counter, the
+events, mean and largest time in the window, and per stack the time per rate-loop period (its
+rate-loop modules' mean plus the position loop's mean times its share of periods). The
+machine's load average is printed with each reading: the numbers are wall-clock times on a
+shared machine. Exits 1 when a flight or a reading fails, or a flight fell behind real time
+(more than 1% of its ticks late).
 """
 import argparse
 import json
@@ -154,6 +156,8 @@ def main():
         print(f"==> perf: {name} (airframe {autostart}, {flight.name}, real time)", flush=True)
         r = fly(a, out, name, scenario, flight, autostart, params, windows)
         r["stack"] = stack
+        for w in r["readings"]:
+            w["per_period_us"] = per_period(stack, w["counters"])
         results.append(r)
     json.dump(results, open(out / "perf.json", "w"), indent=1)
 
@@ -168,7 +172,7 @@ def main():
     print("|---|---|---:|")
     for r in results:
         for w in r["readings"]:
-            total = per_period(r["stack"], w["counters"])
+            total = w["per_period_us"]
             print(f"| {r['flight']} | {w['window']} | " + (f"{total:.2f} us |" if total is not None else "- |"))
     print("\nFrom the flight's last `perf reset` (its last window's start) to the disarm (the ulog's "
           "perf_counter_postflight; none for a flight that ends in the air):")
@@ -177,7 +181,7 @@ def main():
             print(f"  {r['flight']:<11} {c:<36} {v['events']:>7} events, mean {v['mean_us']:.2f} us, "
                   f"largest {v['max_us']} us")
     missing = [f"{r['flight']} {w['window']}" for r in results for w in r["readings"]
-               if per_period(r["stack"], w["counters"]) is None]
+               if w["per_period_us"] is None]
     if missing:
         print(f"error: no rate-loop counter read in {', '.join(missing)}", file=sys.stderr)
         return 1
