@@ -4,7 +4,7 @@
 # parameter and keeps running; with --fly, flies it on tvmd-sim in lockstep (tvmd-sim px4) and
 # checks the flights from their ulogs (docs/px4-module.md).
 #
-#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly] [--side-by-side]   (or PX4_DIR=... bash scripts/px4-module.sh)
+#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly] [--side-by-side] [--perf]   (or PX4_DIR=... bash scripts/px4-module.sh)
 #
 # What it changes in PX4_DIR (each once; rerunning is safe):
 #   - installs the airframe px4/airframes/4090_tvmd_control_a4 (+ .post) into
@@ -15,7 +15,7 @@
 # px4_sitl_default; GIT_SUBMODULES_ARE_EVIL defaults to 1, so PX4 does not update submodules
 # over the network). PX4's Python build dependencies must be importable: activate their
 # virtual environment first, or name it in PX4_VENV. The build log goes to
-# PX4_DIR/build/tvmd-module-build.log.
+# PX4_DIR/build/tvmd-module-build-<target>.log.
 #
 # --fly builds tvmd-sim (cargo, release; or TVMD_SIM names a tvmd-sim binary) and flies
 # scripts/px4/tvmd_control/flight.toml twice, on the nominal team and with model error (+3% mass,
@@ -30,7 +30,12 @@
 # PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies the
 # hover of tvmd_control and of the authors' modules (their PX4 fork) on the nominal vehicle,
 # under a steady wind and off its model, and prints the table of docs/px4-module.md
-# (scripts/px4/side_by_side.py; not asserted, about a minute).
+# (scripts/px4/side_by_side.py; not asserted, about a minute). --perf (not in the test
+# command: a second PX4 build, then about 4 minutes of flights) builds px4_sitl_nolockstep too
+# (PX4's SITL without lockstep: its clock, and so its perf counters, on the wall clock) and flies
+# both stacks' hover and tilt on tvmd-sim in real time (`tvmd-sim px4 --real-time`), reading
+# PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
+# (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
@@ -38,12 +43,14 @@ px4_dir="${PX4_DIR:-}"
 smoke=0
 fly=0
 side=0
+perf=0
 for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
     --fly) fly=1 ;;
     --side-by-side) side=1 ;;
-    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
+    --perf) perf=1 ;;
+    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -97,27 +104,30 @@ EOF
 fi
 grep -q '"tvmd_control_status"' "$topics"
 
-step "make $target EXTERNAL_MODULES_LOCATION=$repo/px4"
-log="$px4_dir/build/tvmd-module-build.log"
-mkdir -p "$px4_dir/build"
-start=$(date +%s)
-if ! (cd "$px4_dir" && GIT_SUBMODULES_ARE_EVIL="${GIT_SUBMODULES_ARE_EVIL:-1}" \
-  make "$target" EXTERNAL_MODULES_LOCATION="$repo/px4" >"$log" 2>&1); then
-  tail -40 "$log"
-  echo "error: the PX4 build failed; its log: $log" >&2
-  exit 1
-fi
-echo "built in $(($(date +%s) - start)) s (log: $log)"
+build_px4() {
+  step "make $1 EXTERNAL_MODULES_LOCATION=$repo/px4"
+  local log="$px4_dir/build/tvmd-module-build-$1.log" start
+  mkdir -p "$px4_dir/build"
+  start=$(date +%s)
+  if ! (cd "$px4_dir" && GIT_SUBMODULES_ARE_EVIL="${GIT_SUBMODULES_ARE_EVIL:-1}" \
+    make "$1" EXTERNAL_MODULES_LOCATION="$repo/px4" >"$log" 2>&1); then
+    tail -40 "$log"
+    echo "error: the PX4 build failed; its log: $log" >&2
+    exit 1
+  fi
+  echo "built in $(($(date +%s) - start)) s (log: $log)"
+}
+build_px4 "$target"
 
-[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || exit 0
+[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ] || exit 0
 case "$target" in
   px4_sitl*) ;;
-  *) echo "error: --smoke and --fly need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
+  *) echo "error: --smoke, --fly, --side-by-side and --perf need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
 esac
 build="$px4_dir/build/$target"
 instance="${PX4_INSTANCE:-7}"
 
-if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ]; then
+if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ]; then
   python3 -c 'import pyulog' 2>/dev/null || {
     echo "error: --fly reads the ulogs with pyulog: install it in the Python environment (pip install pyulog)" >&2
     exit 2
@@ -133,6 +143,17 @@ if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ]; then
   flights="$repo/scripts/px4/tvmd_control"
 fi
 
+if [ "$perf" -eq 1 ]; then
+  # Not in the test command: PX4's perf counters read hrt, which in lockstep SITL is the
+  # simulated clock (0 us a cycle). A build without lockstep runs on the wall clock; tvmd-sim
+  # paces it in real time.
+  perf_target=px4_sitl_nolockstep
+  [ "$target" = "$perf_target" ] || build_px4 "$perf_target"
+  step "perf: each stack's time per cycle on real time ($perf_target, tvmd-sim px4 --real-time)"
+  python3 "$repo/scripts/px4/perf.py" --sim "$sim" --px4-dir "$px4_dir" --build "$perf_target" \
+    --instance "$instance" --out "$out/perf"
+fi
+
 if [ "$side" -eq 1 ]; then
   # Not in the test command (about a minute): the hover of each stack on the nominal vehicle,
   # under a steady wind and off its model; the table of docs/px4-module.md. The authors' modules
@@ -142,11 +163,11 @@ if [ "$side" -eq 1 ]; then
     scenario=scenario; [ "$flight" = nominal ] || scenario="scenario-$flight"
     step "side by side, $flight: tvmd_control (airframe 4090)"
     "$sim" px4 "$flights/$scenario.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
-      --autostart 4090 --params "$flights/params" --instance "$instance" \
+      --px4-build "$target" --autostart 4090 --params "$flights/params" --instance "$instance" \
       --out "$out/tvmd-$flight.mcap" >/dev/null
     step "side by side, $flight: the authors' modules (airframe 4007, their position mode)"
     "$sim" px4 "$authors/$scenario.toml" --flight "$authors/flight-hold.toml" --px4-dir "$px4_dir" \
-      --autostart 4007 --params "$authors/params" --instance "$instance" \
+      --px4-build "$target" --autostart 4007 --params "$authors/params" --instance "$instance" \
       --out "$out/authors-$flight.mcap" >/dev/null
   done
   python3 "$repo/scripts/px4/side_by_side.py" "$out"
@@ -159,7 +180,8 @@ if [ "$fly" -eq 1 ]; then
     step "tvmd_control in PX4 on tvmd-sim: $flight"
     start=$(date +%s)
     "$sim" px4 "$flights/$flight.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
-      --autostart 4090 --params "$flights/params" --instance "$instance" --out "$out/$flight.mcap"
+      --px4-build "$target" --autostart 4090 --params "$flights/params" --instance "$instance" \
+      --out "$out/$flight.mcap"
     echo "flown in $(($(date +%s) - start)) s wall"
     python3 "$repo/scripts/px4/tvmd_control.py" "$out/$flight.ulg" "$out/$flight.px4.json" \
       --own "$out/own-tilt.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
@@ -168,8 +190,8 @@ if [ "$fly" -eq 1 ]; then
   step "tvmd_control in PX4 on tvmd-sim: an agent failure, told (the certificate lost: PX4 lands it)"
   start=$(date +%s)
   "$sim" px4 "$flights/scenario-agent-failure.toml" --flight "$flights/flight-agent-failure.toml" \
-    --px4-dir "$px4_dir" --autostart 4090 --params "$flights/params" --instance "$instance" \
-    --out "$out/agent-failure.mcap"
+    --px4-dir "$px4_dir" --px4-build "$target" --autostart 4090 --params "$flights/params" \
+    --instance "$instance" --out "$out/agent-failure.mcap"
   echo "flown in $(($(date +%s) - start)) s wall"
   python3 "$repo/scripts/px4/tvmd_control.py" "$out/agent-failure.ulg" "$out/agent-failure.px4.json" \
     --failed-tilt 0.8 --failed-landing 0.15 --json "$out/agent-failure.measures.json"

@@ -189,8 +189,8 @@ pub enum Command {
         /// Built-in scenario name.
         name: String,
     },
-    /// Serve PX4 SITL as its simulator (simulator_mavlink, lockstep) and fly a flight file's
-    /// script with it (docs/px4.md).
+    /// Serve PX4 SITL as its simulator (simulator_mavlink, lockstep or real time) and fly a
+    /// flight file's script with it (docs/px4.md, docs/px4-module.md).
     Px4(Px4Args),
 }
 
@@ -213,6 +213,15 @@ pub struct Px4Args {
     /// yourself (`PX4_SYS_AUTOSTART=... build/px4_sitl_default/bin/px4`).
     #[arg(long, value_name = "PX4_DIR")]
     pub px4_dir: Option<PathBuf>,
+    /// The SITL build of the tree to start, a directory under its build/, with --px4-dir:
+    /// px4_sitl_default (lockstep) or px4_sitl_nolockstep (wall clock, with --real-time).
+    #[arg(long, default_value = tvmd_px4::launch::DEFAULT_BUILD, requires = "px4_dir")]
+    pub px4_build: String,
+    /// Pace the flight in real time for a PX4 build without lockstep (px4_sitl_nolockstep):
+    /// sensors at PX4's rate on the wall clock, the newest controls applied, so that PX4's
+    /// clock and its `perf` counters measure real time. Without it, lockstep.
+    #[arg(long, conflicts_with = "sih")]
+    pub real_time: bool,
     /// The airframe PX4 starts with (PX4_SYS_AUTOSTART), with --px4-dir.
     #[arg(long, default_value_t = 10016, requires = "px4_dir")]
     pub autostart: u32,

@@ -63,6 +63,23 @@ pub enum Px4Error {
         /// Simulation time (s).
         t: f64,
     },
+    /// PX4's build and the bridge's pacing disagree: a lockstep build (`px4_sitl_default`)
+    /// needs the lockstep bridge, a build without lockstep (`px4_sitl_nolockstep`) the
+    /// real-time one (`--real-time`).
+    #[error(
+        "PX4 runs {} but the bridge paces {}: {}",
+        if *px4_lockstep { "in lockstep" } else { "without lockstep (wall clock)" },
+        if *px4_lockstep { "in real time" } else { "in lockstep" },
+        if *px4_lockstep {
+            "fly a lockstep build (px4_sitl_default) without --real-time"
+        } else {
+            "fly a build without lockstep (px4_sitl_nolockstep) with --real-time"
+        }
+    )]
+    Pacing {
+        /// PX4's controls carry the lockstep flag.
+        px4_lockstep: bool,
+    },
     /// A socket to PX4 failed.
     #[error("the link to PX4 failed ({what}): {source}")]
     Link {

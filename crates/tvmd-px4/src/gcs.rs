@@ -94,6 +94,31 @@ pub enum Telemetry {
     },
 }
 
+impl Telemetry {
+    /// The message with its PX4 time moved by `dt` seconds (untimed messages unchanged).
+    pub fn shifted(self, dt: f64) -> Self {
+        match self {
+            Self::LocalPosition { t, position } => Self::LocalPosition {
+                t: t + dt,
+                position,
+            },
+            Self::Attitude { t, q } => Self::Attitude { t: t + dt, q },
+            Self::AttitudeTarget { t, q } => Self::AttitudeTarget { t: t + dt, q },
+            other => other,
+        }
+    }
+
+    /// The message if it carries no PX4 time, else `None`.
+    pub fn untimed(self) -> Option<Self> {
+        match self {
+            Self::LocalPosition { .. } | Self::Attitude { .. } | Self::AttitudeTarget { .. } => {
+                None
+            }
+            other => Some(other),
+        }
+    }
+}
+
 /// The UDP link to PX4's GCS port.
 pub struct GcsLink {
     socket: UdpSocket,
@@ -338,5 +363,42 @@ impl GcsLink {
             }),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shift_moves_the_timed_messages_only_and_untimed_keeps_the_untimed() {
+        let position = Telemetry::LocalPosition {
+            t: 1000.5,
+            position: [1.0, 2.0, 3.0],
+        };
+        assert_eq!(
+            position.clone().shifted(-1000.0),
+            Telemetry::LocalPosition {
+                t: 0.5,
+                position: [1.0, 2.0, 3.0]
+            }
+        );
+        let q = [1.0, 0.0, 0.0, 0.0];
+        assert_eq!(
+            Telemetry::Attitude { t: 3.0, q }.shifted(2.0),
+            Telemetry::Attitude { t: 5.0, q }
+        );
+        assert_eq!(
+            Telemetry::AttitudeTarget { t: 3.0, q }.shifted(-1.0),
+            Telemetry::AttitudeTarget { t: 2.0, q }
+        );
+        let text = Telemetry::Text {
+            severity: 6,
+            text: "Takeoff detected".into(),
+        };
+        assert_eq!(text.clone().shifted(5.0), text);
+        assert_eq!(text.clone().untimed(), Some(text));
+        assert_eq!(position.untimed(), None);
+        assert_eq!(Telemetry::Attitude { t: 3.0, q }.untimed(), None);
     }
 }

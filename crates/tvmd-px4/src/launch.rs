@@ -1,7 +1,8 @@
 //! Starting PX4 SITL from a user's PX4 tree for one flight, headless, its outputs on
 //! `simulator_mavlink`.
 //!
-//! The tree is used as built (`make px4_sitl_default`); nothing in it is changed. The airframe
+//! The tree is used as built (`make px4_sitl_default`, or another SITL build such as
+//! `px4_sitl_nolockstep`: [`Px4Launch::build`]); nothing in it is changed. The airframe
 //! is PX4's own (`PX4_SYS_AUTOSTART`), and the flight's parameters (a params file of `param
 //! set` lines) reach PX4 through its own hook: PX4's startup script sources `px4-rc.params`
 //! from the `PATH` after the airframe and before the simulator starts, so the bridge writes
@@ -14,14 +15,17 @@ use std::process::{Child, Command, Stdio};
 
 use crate::Px4Error;
 
-/// The PX4 binary inside a tree built with `make px4_sitl_default`.
-pub const PX4_BINARY: &str = "build/px4_sitl_default/bin/px4";
+/// PX4's default SITL build (lockstep): the build directory under the tree's `build/`.
+pub const DEFAULT_BUILD: &str = "px4_sitl_default";
 
 /// How to start PX4 for a flight.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Px4Launch {
     /// The PX4 tree (`PX4_DIR`).
     pub tree: PathBuf,
+    /// The SITL build to start, a directory under the tree's `build/` ([`DEFAULT_BUILD`];
+    /// `px4_sitl_nolockstep` runs on the wall clock and needs the real-time bridge).
+    pub build: String,
     /// The airframe (`PX4_SYS_AUTOSTART`).
     pub autostart: u32,
     /// A file of `param set NAME VALUE` lines applied after the airframe.
@@ -44,8 +48,10 @@ pub enum Simulator {
     Sih,
 }
 
-/// The PX4 binary of `tree`, or a clear error: no such directory, not a PX4 tree, not built.
-pub fn px4_binary(tree: &Path) -> Result<PathBuf, Px4Error> {
+/// The PX4 binary of `build` (a directory under `tree/build`, e.g. [`DEFAULT_BUILD`]) in
+/// `tree`, or a clear error: no such directory, not a PX4 tree, not built, a build name that
+/// is not one directory.
+pub fn px4_binary(tree: &Path, build: &str) -> Result<PathBuf, Px4Error> {
     let refuse = |reason: String| Px4Error::Px4Tree {
         path: tree.display().to_string(),
         reason,
@@ -62,11 +68,20 @@ pub fn px4_binary(tree: &Path) -> Result<PathBuf, Px4Error> {
             "not a PX4 source tree (no ROMFS/px4fmu_common/init.d-posix/rcS)".into(),
         ));
     }
-    let binary = tree.join(PX4_BINARY);
+    let single = Path::new(build).components().count() == 1
+        && !matches!(build, "" | "." | "..")
+        && !build.contains('/');
+    if !single {
+        return Err(refuse(format!(
+            "`{build}` is not a build name (a directory under build/, e.g. {DEFAULT_BUILD})"
+        )));
+    }
+    let relative = format!("build/{build}/bin/px4");
+    let binary = tree.join(&relative);
     if !binary.is_file() {
         return Err(refuse(format!(
-            "PX4 SITL is not built ({PX4_BINARY} is missing): run `make px4_sitl_default` in \
-             the tree (scripts/px4.sh builds it)"
+            "PX4 SITL is not built ({relative} is missing): run `make {build}` in the tree \
+             (scripts/px4.sh builds {DEFAULT_BUILD})"
         )));
     }
     Ok(binary)
@@ -81,7 +96,7 @@ pub struct Px4Process {
 impl Px4Process {
     /// Starts PX4 as `launch` says, its console output into `work_dir/px4-console.txt`.
     pub fn start(launch: &Px4Launch) -> Result<Self, Px4Error> {
-        let binary = px4_binary(&launch.tree)?;
+        let binary = px4_binary(&launch.tree, &launch.build)?;
         let io = |what: &str| {
             let what = format!("PX4 start: {what}");
             move |source| Px4Error::Link { what, source }
@@ -115,7 +130,7 @@ impl Px4Process {
             .arg(launch.instance.to_string())
             .arg("-w")
             .arg(work.join("rootfs"))
-            .arg(tree.join("build/px4_sitl_default/etc"))
+            .arg(tree.join("build").join(&launch.build).join("etc"))
             .env("PATH", format!("{}:{path}", hooks.display()))
             .env("PX4_SYS_AUTOSTART", launch.autostart.to_string())
             // An external simulator on simulator_mavlink: neither SIH nor Gazebo.
@@ -214,7 +229,7 @@ mod tests {
 
     #[test]
     fn a_missing_tree_and_an_unbuilt_tree_are_named() {
-        let e = px4_binary(Path::new("/nonexistent/px4"))
+        let e = px4_binary(Path::new("/nonexistent/px4"), DEFAULT_BUILD)
             .unwrap_err()
             .to_string();
         assert!(
@@ -223,14 +238,26 @@ mod tests {
         );
         let dir = std::env::temp_dir().join(format!("tvmd-px4-tree-{}", std::process::id()));
         std::fs::create_dir_all(dir.join("ROMFS/px4fmu_common/init.d-posix")).unwrap();
-        let e = px4_binary(&dir).unwrap_err().to_string();
+        let e = px4_binary(&dir, DEFAULT_BUILD).unwrap_err().to_string();
         assert!(e.contains("not a PX4 source tree"), "{e}");
         std::fs::write(dir.join("ROMFS/px4fmu_common/init.d-posix/rcS"), "").unwrap();
-        let e = px4_binary(&dir).unwrap_err().to_string();
+        let e = px4_binary(&dir, DEFAULT_BUILD).unwrap_err().to_string();
         assert!(
             e.contains("not built") && e.contains("make px4_sitl_default"),
             "{e}"
         );
+        let e = px4_binary(&dir, "px4_sitl_nolockstep")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("build/px4_sitl_nolockstep/bin/px4 is missing")
+                && e.contains("make px4_sitl_nolockstep"),
+            "{e}"
+        );
+        for bad in ["", "..", "../elsewhere", "a/b"] {
+            let e = px4_binary(&dir, bad).unwrap_err().to_string();
+            assert!(e.contains("is not a build name"), "{bad}: {e}");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

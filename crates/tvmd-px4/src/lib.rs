@@ -1,5 +1,6 @@
 //! tvmd-sim as PX4's simulator: PX4 SITL's `simulator_mavlink` connects to the bridge, which
-//! flies the scenario's team on tvmd's plant in lockstep with PX4.
+//! flies the scenario's team on tvmd's plant in lockstep with PX4 (or in real time, for a PX4
+//! build without lockstep).
 //!
 //! Modules, in import order (a module uses only modules above it):
 //! - [`error`] ([`Px4Error`]);
@@ -11,8 +12,9 @@
 //!   ground-station link over UDP);
 //! - [`flight`] (the flight file: script, mapping, sensors, windows) and [`measure`] (what a
 //!   flight showed);
-//! - [`bridge`] (the lockstep bridge as the loop's flight controller), [`launch`] (PX4 started
-//!   from a user's tree) and [`run`] (one flight, its log and its report).
+//! - [`bridge`] (the bridge as the loop's flight controller, lockstep or real time),
+//!   [`launch`] (PX4 started from a user's tree) and [`run`] (one flight, its log and its
+//!   report).
 //!
 //! See the book's chapter "PX4 in the loop" (docs/px4.md).
 

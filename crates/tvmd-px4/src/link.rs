@@ -100,6 +100,7 @@ pub struct SimLink {
     reader: MavlinkReader<TcpStream>,
     sequence: u8,
     port: u16,
+    slice: Option<Duration>,
 }
 
 impl SimLink {
@@ -119,7 +120,22 @@ impl SimLink {
             reader,
             sequence: 0,
             port,
+            slice: None,
         })
+    }
+
+    /// Reads without blocking, a wait sleeping `slice` between looks (the real-time bridge:
+    /// a socket's read timeout counts in the kernel's ticks, up to 4 ms, a period of PX4's
+    /// sensors). Writes then fail rather than wait when PX4 stops reading.
+    pub fn set_nonblocking(&mut self, slice: Duration) -> Result<(), Px4Error> {
+        self.writer
+            .set_nonblocking(true)
+            .map_err(|source| Px4Error::Link {
+                what: format!("non-blocking mode on port {}", self.port),
+                source,
+            })?;
+        self.slice = Some(slice);
+        Ok(())
     }
 
     /// The port of the link.
@@ -154,8 +170,12 @@ impl SimLink {
                 Err(MessageReadError::Io(e))
                     if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) =>
                 {
-                    if Instant::now() >= deadline {
+                    let now = Instant::now();
+                    if now >= deadline {
                         return Ok(Received::Timeout);
+                    }
+                    if let Some(slice) = self.slice {
+                        std::thread::sleep(slice.min(deadline - now));
                     }
                 }
                 Err(MessageReadError::Io(e)) if is_closed(&e) => return Ok(Received::Closed),

@@ -11,7 +11,7 @@ use tvmd_sim::load::write_result_metadata;
 use tvmd_sim::runner::write_scenario_metadata;
 use tvmd_sim::{McapSink, RunSummary, SampleRetention, SimOptions, Simulation, TickSink, Verdict};
 
-use crate::bridge::{Bridge, BridgeTiming, LockstepStats};
+use crate::bridge::{Bridge, BridgeTiming, LockstepStats, Pacing};
 use crate::flight::FlightPlan;
 use crate::gcs::GcsLink;
 use crate::launch::{Px4Launch, Px4Process};
@@ -36,6 +36,8 @@ pub struct Px4Flight {
     pub launch: Option<Px4Launch>,
     /// Wall time to wait for PX4 to connect.
     pub connect_timeout: Duration,
+    /// Lockstep (PX4's default SITL build) or real time (a build without lockstep).
+    pub pacing: Pacing,
     /// Wall time PX4 may take to answer one tick in lockstep.
     pub stall_timeout: Duration,
     /// Wall time PX4 may take from connecting to its first actuator controls.
@@ -59,6 +61,8 @@ pub struct Px4Report {
     pub failsafe_texts: Vec<String>,
     /// Estimator samples matched to the truth (position, attitude).
     pub estimator_samples: (usize, usize),
+    /// How the bridge kept time with PX4.
+    pub pacing: Pacing,
     /// The lockstep's accounting.
     pub lockstep: LockstepStats,
     /// Simulated seconds per wall second while in lockstep.
@@ -116,6 +120,7 @@ pub fn fly_px4(
     let gcs = GcsLink::new(flight.instance)?;
     let timing = BridgeTiming {
         period: scenario.controller_period,
+        pacing: flight.pacing,
         stall_timeout: flight.stall_timeout,
         boot_timeout: flight.boot_timeout,
     };
@@ -178,6 +183,7 @@ pub fn fly_px4(
             let simulated = result.summary.time - from;
             (stats.lockstep_wall > 0.0).then(|| simulated / stats.lockstep_wall)
         }),
+        pacing: flight.pacing,
         lockstep: stats,
         sim_time: result.summary.time,
         wall_time,
@@ -281,6 +287,7 @@ pub fn fly_sih(
         failsafe_texts: failsafe_texts(&texts),
         texts,
         estimator_samples: (0, 0),
+        pacing: Pacing::RealTime,
         lockstep: LockstepStats::default(),
         realtime_factor: Some(t / wall_time),
         sim_time: t,

@@ -3,6 +3,7 @@
 use std::time::Duration;
 
 use tvmd_log::paths::check_outputs;
+use tvmd_px4::bridge::Pacing;
 use tvmd_px4::launch::{Px4Launch, Simulator};
 use tvmd_px4::{fly_px4, write_report, FlightPlan, Px4Flight};
 use tvmd_scenario::Scenario;
@@ -24,6 +25,7 @@ pub fn cmd_px4(a: Px4Args) -> Result<(), CliError> {
     )?;
     let launch = a.px4_dir.map(|tree| Px4Launch {
         tree,
+        build: a.px4_build.clone(),
         autostart: if a.sih { 10040 } else { a.autostart },
         params: a.params,
         work_dir: a.out.with_extension("px4"),
@@ -35,7 +37,7 @@ pub fn cmd_px4(a: Px4Args) -> Result<(), CliError> {
         },
     });
     if let Some(l) = &launch {
-        tvmd_px4::launch::px4_binary(&l.tree).map_err(px4)?;
+        tvmd_px4::launch::px4_binary(&l.tree, &l.build).map_err(px4)?;
         if a.sih {
             let report =
                 tvmd_px4::run::fly_sih(&plan, l, scenario.duration, &a.out.with_extension("ulg"))
@@ -58,6 +60,11 @@ pub fn cmd_px4(a: Px4Args) -> Result<(), CliError> {
         instance: a.instance,
         log: Some(a.out.clone()),
         launch,
+        pacing: if a.real_time {
+            Pacing::RealTime
+        } else {
+            Pacing::Lockstep
+        },
         connect_timeout: Duration::from_secs_f64(a.connect_timeout),
         stall_timeout: Duration::from_secs_f64(a.stall_timeout),
         boot_timeout: Duration::from_secs_f64(a.connect_timeout),
@@ -67,14 +74,20 @@ pub fn cmd_px4(a: Px4Args) -> Result<(), CliError> {
     })
     .map_err(px4)?;
     write_report(&report_path, &report).map_err(px4)?;
-    println!(
-        "flown:    {:.1} s simulated in {:.1} s wall ({} lockstep)",
-        report.sim_time,
-        report.wall_time,
-        report
-            .realtime_factor
-            .map_or("no".into(), |f| format!("{f:.2}x real time in")),
-    );
+    match report.pacing {
+        Pacing::Lockstep => println!(
+            "flown:    {:.1} s simulated in {:.1} s wall ({} lockstep)",
+            report.sim_time,
+            report.wall_time,
+            report
+                .realtime_factor
+                .map_or("no".into(), |f| format!("{f:.2}x real time in")),
+        ),
+        Pacing::RealTime => println!(
+            "flown:    {:.1} s simulated in {:.1} s wall (real time; {} ticks late)",
+            report.sim_time, report.wall_time, report.lockstep.late_ticks,
+        ),
+    }
     for w in &report.windows {
         println!("{}", serde_json::to_string(w)?);
     }
