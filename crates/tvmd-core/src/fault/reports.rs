@@ -5,14 +5,15 @@
 //!
 //! Per period ([`ReportState::update`]), for each working agent with a command in force
 //! `(T_c, eta_x,c, eta_y,c)`:
-//! - the model: the thrust a first-order lag of the command ([`FAULT_ACTUATOR_LAG`]), each
-//!   gimbal angle moving towards its command at most at the servo rate
-//!   ([`ReportCheck::servo_rate`]); with the model's change over the period, decayed by half
-//!   a period, as its recent swing `s`;
-//! - a new report of age `a` is compared with the model now, allowing the stated tolerance
-//!   plus the swing over the report's age and the command's stated delay
-//!   (`s ((a + d) / dt + 1)`, the model extrapolated back to when the report was measured):
-//!   a thrust short of the model by more is a thrust fault of efficiency `T_reported / T_model`
+//! - the model of the slowest healthy actuator: the thrust a first-order lag of the command
+//!   ([`FAULT_ACTUATOR_LAG`]), each gimbal angle moving towards its command at the slowest
+//!   healthy servo rate ([`ReportCheck::servo_rate`]); with the model's change over the
+//!   period, decayed by half a period, as its recent swing `s`;
+//! - a healthy actuator lies between that model and the command in force (the fastest); a new
+//!   report of age `a` is compared with that interval now, allowing the stated tolerance plus
+//!   the swing over the report's age and the command's stated delay (`s ((a + d) / dt + 1)`,
+//!   the model extrapolated back to when the report was measured): a thrust short of the
+//!   interval by more is a thrust fault of efficiency `T_reported / min(T_model, T_c)`
 //!   (a [`FaultKind::Loss`] at `<= 0.2`, else [`FaultKind::PartialLoss`]), an angle off by
 //!   more a [`FaultKind::StuckGimbal`]. A thrust above the model names nothing (no kind is
 //!   a runaway rotor; the residual sees it as unexplained);
@@ -21,7 +22,7 @@
 //!   larger allowance its age gives, and is no fault by itself.
 //!
 //! Proven (by the construction): a report within the tolerance of an actuator that follows the
-//! model exactly is never named, whatever the command does; a report that does not arrive is
+//! model or the command exactly is never named, whatever the command does; a report that does not arrive is
 //! named only after the link timeout. Measured, not proven: how fast real faults are named and
 //! that the model's allowance covers the real actuators' lag and the command link's jitter
 //! (the simulator's fault study, `docs/fault-detection.md`). What the reports cannot see: a
@@ -43,9 +44,10 @@ pub const REPORT_THRUST_TOLERANCE: f64 = 0.1;
 /// [`ReportCheck::angle_tolerance`] of [`ReportCheck::recommended`] (rad): about 3 degrees,
 /// ten times a servo potentiometer's typical noise.
 pub const REPORT_ANGLE_TOLERANCE: f64 = 0.05;
-/// [`ReportCheck::servo_rate`] of [`ReportCheck::recommended`] (rad/s): the simulator's
-/// default servos.
-pub const REPORT_SERVO_RATE: f64 = 40.0;
+/// [`ReportCheck::servo_rate`] of [`ReportCheck::recommended`] (rad/s): the slowest rate a
+/// healthy gimbal servo turns at (the simulator's Monte Carlo servos are rate-limited at 6
+/// rad/s; a hobby servo's 60 degrees in 0.1 s is 10 rad/s).
+pub const REPORT_SERVO_RATE: f64 = 6.0;
 /// [`ReportCheck::command_delay`] of [`ReportCheck::recommended`] (s): the command link's
 /// latency and jitter the allowance covers.
 pub const REPORT_COMMAND_DELAY: f64 = 0.01;
@@ -129,7 +131,7 @@ impl<T: Real> ReportCheck<T> {
         self.angle_tolerance
     }
 
-    /// The modelled servo rate (rad/s).
+    /// The slowest healthy servo rate (rad/s) the model turns at.
     pub fn servo_rate(&self) -> T {
         self.servo_rate
     }
@@ -331,7 +333,7 @@ impl<T: Real, const N: usize> ReportState<T, N> {
                 continue;
             }
             if fresh {
-                let kind = disagreement(check, slot, &reading, max_thrust, period);
+                let kind = disagreement(check, slot, c, &reading, max_thrust, period);
                 (slot.kind, slot.efficiency) = match kind {
                     Some(FaultKind::StuckGimbal) => (2, T::zero()),
                     Some(_) => (1, reading.thrust() / t),
@@ -362,10 +364,13 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     }
 }
 
-/// What a new report says against the model: `None` when it agrees within the allowance.
+/// What a new report says against the model and the command `c` in force: `None` when it
+/// agrees within the allowance. A healthy actuator lies between the model (the slowest
+/// healthy one) and the command (the fastest), each quantity apart.
 fn disagreement<T: Real>(
     check: &ReportCheck<T>,
     slot: &Slot<T>,
+    c: &AgentCommand<T>,
     reading: &AgentReading<T>,
     max_thrust: T,
     period: T,
@@ -375,11 +380,17 @@ fn disagreement<T: Real>(
     let lead = (reading.age() + check.command_delay) / period + T::one();
     let thrust_allowed = check.thrust_tolerance * max_thrust + slot.swing[0] * lead;
     let angle_allowed = check.angle_tolerance + slot.swing[1] * lead;
-    if t - reading.thrust() > thrust_allowed {
-        // `t > thrust_allowed > 0`: the efficiency is in `[0, 1)`.
-        return Some(loss_kind(T::one() - reading.thrust() / t));
+    let low = fmin(t, c.thrust);
+    if low - reading.thrust() > thrust_allowed {
+        // `low > thrust_allowed > 0`: the efficiency is in `[0, 1)`.
+        return Some(loss_kind(T::one() - reading.thrust() / low));
     }
-    let off = fmax((reading.eta_x() - x).abs(), (reading.eta_y() - y).abs());
+    // The distance of a reported angle from the interval between the model and the command.
+    let outside = |r: T, m: T, cmd: T| fmax(fmax(fmin(m, cmd) - r, r - fmax(m, cmd)), T::zero());
+    let off = fmax(
+        outside(reading.eta_x(), x, c.eta_x),
+        outside(reading.eta_y(), y, c.eta_y),
+    );
     (off > angle_allowed).then_some(FaultKind::StuckGimbal)
 }
 

@@ -140,31 +140,38 @@ fn a_silent_agent_is_a_link_loss_only_past_the_timeout() {
 
 #[test]
 fn a_changing_command_is_followed_within_the_lag_allowance() {
-    let check = ReportCheck::<f64>::recommended();
-    let mut s = ReportState::<f64, 1>::new();
-    let none = FailureMask::none();
-    // The real actuators: the same lag as the model, read 20 ms late (a history).
-    // The last three states, oldest first.
-    let mut history = [[4.0, 0.0, 0.0]; 3];
-    let mut actual = [4.0, 0.0, 0.0];
-    let closed = 1.0 - (-DT / FAULT_ACTUATOR_LAG).exp();
-    for k in 0..200 {
-        let t = k as f64 * DT;
-        // A tilt manoeuvre: thrust and angle steps, then a ramp.
-        let c = command(
-            if k < 50 { 4.0 } else { 9.0 },
-            if k < 100 { 0.0 } else { 0.4 },
-            (t * 2.0).sin() * 0.3,
-        );
-        let v = s.update(&check, &[c], &none, MAX, DT);
-        assert_eq!(v, FaultVerdict::Nominal, "period {k}");
-        actual[0] += (c.thrust - actual[0]) * closed;
-        let step = REPORT_SERVO_RATE * DT;
-        actual[1] += (c.eta_x - actual[1]).clamp(-step, step);
-        actual[2] += (c.eta_y - actual[2]).clamp(-step, step);
-        history = [history[1], history[2], actual];
-        let old = history[0];
-        s.set(0, reading(old[0], old[1], old[2], 0.02), DT);
+    // Healthy servos from the slowest stated rate to ten times faster: never named.
+    for servo in [
+        REPORT_SERVO_RATE,
+        3.0 * REPORT_SERVO_RATE,
+        10.0 * REPORT_SERVO_RATE,
+    ] {
+        let check = ReportCheck::<f64>::recommended();
+        let mut s = ReportState::<f64, 1>::new();
+        let none = FailureMask::none();
+        // The real actuators: the model's rotor lag, `servo` rad/s, read 20 ms late.
+        let mut actual = [4.0, 0.0, 0.0];
+        // The last three states, oldest first.
+        let mut history = [actual; 3];
+        let closed = 1.0 - (-DT / FAULT_ACTUATOR_LAG).exp();
+        for k in 0..200 {
+            let t = k as f64 * DT;
+            // A tilt manoeuvre: thrust and angle steps, then a sine.
+            let c = command(
+                if k < 50 { 4.0 } else { 9.0 },
+                if k < 100 { 0.0 } else { 0.4 },
+                (t * 2.0).sin() * 0.3,
+            );
+            let v = s.update(&check, &[c], &none, MAX, DT);
+            assert_eq!(v, FaultVerdict::Nominal, "servo {servo} rad/s, period {k}");
+            actual[0] += (c.thrust - actual[0]) * closed;
+            let step = servo * DT;
+            actual[1] += (c.eta_x - actual[1]).clamp(-step, step);
+            actual[2] += (c.eta_y - actual[2]).clamp(-step, step);
+            history = [history[1], history[2], actual];
+            let old = history[0];
+            s.set(0, reading(old[0], old[1], old[2], 0.02), DT);
+        }
     }
 }
 
