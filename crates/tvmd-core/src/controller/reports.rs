@@ -6,8 +6,9 @@
 
 use super::Controller;
 use crate::allocation::Allocator;
+use crate::fault::detection::FAULT_ACTUATOR_LAG;
 use crate::fault::{AgentReading, FaultKind, FaultReport, FaultSource, FaultVerdict, ReportError};
-use crate::foundation::real::Real;
+use crate::foundation::real::{lit, Real};
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Agent `agent`'s newest report: what it measured of its rotor and gimbal
@@ -86,6 +87,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             &self.failures,
             max_thrust,
             period,
+            lit(FAULT_ACTUATOR_LAG),
         );
         let lost = |k: &FaultKind<T>| matches!(k, FaultKind::Loss | FaultKind::LinkLoss);
         let replaces = match (&verdict, &report.verdict) {

@@ -6,7 +6,7 @@
 //! Per period ([`ReportState::update`]), for each working agent with a command in force
 //! `(T_c, eta_x,c, eta_y,c)`:
 //! - the model of the slowest healthy actuator: the thrust a first-order lag of the command
-//!   ([`FAULT_ACTUATOR_LAG`]), each gimbal angle moving towards its command at the slowest
+//!   (the controller's stated actuator lag, [`crate::fault_detection::FAULT_ACTUATOR_LAG`]), each gimbal angle moving towards its command at the slowest
 //!   healthy servo rate ([`ReportCheck::servo_rate`]); with the model's change over the
 //!   period, decayed by half a period, as its recent swing `s`;
 //! - a healthy actuator lies between that model and the command in force (the fastest); a new
@@ -35,8 +35,6 @@ use crate::agent::command::AgentCommand;
 use crate::agent::failure::FailureMask;
 use crate::foundation::error::{positive, ConfigError, ConfigField};
 use crate::foundation::real::{fmax, fmin, lit, Real};
-
-use super::detection::FAULT_ACTUATOR_LAG;
 
 /// [`ReportCheck::thrust_tolerance`] of [`ReportCheck::recommended`]: a tenth of the maximum
 /// thrust (an ESC's speed reading is good to a few percent; the rotor model's `k` to ten).
@@ -270,7 +268,7 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     }
 
     /// One period of length `period` whose commands in force were `commands`: advances the
-    /// models, checks the new reports, ages every report by `period` and returns the verdict
+    /// models (the thrust's a first-order lag of time constant `rotor_lag` s), checks the new reports, ages every report by `period` and returns the verdict
     /// (the first confirmed agent, else the suspected one with the most disagreeing reports,
     /// else [`FaultVerdict::Nominal`]). Agents `failures` masks are skipped and their counts
     /// forgotten. `max_thrust` (N) scales the thrust tolerance.
@@ -281,8 +279,9 @@ impl<T: Real, const N: usize> ReportState<T, N> {
         failures: &FailureMask<N>,
         max_thrust: T,
         period: T,
+        rotor_lag: T,
     ) -> FaultVerdict<T> {
-        let closed = T::one() - (-(period / lit(FAULT_ACTUATOR_LAG))).exp();
+        let closed = T::one() - (-(period / rotor_lag)).exp();
         let step = check.servo_rate * period;
         let half = lit::<T>(0.5);
         let started = self.started != 0;

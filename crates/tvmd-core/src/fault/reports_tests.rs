@@ -1,5 +1,8 @@
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
 use super::*;
+use crate::fault_detection::FAULT_ACTUATOR_LAG;
+
+const LAG: f64 = FAULT_ACTUATOR_LAG;
 
 const DT: f64 = 0.01;
 const MAX: f64 = 12.0;
@@ -37,7 +40,7 @@ fn fly<const P: usize>(
                 s.set(i, reading(t, x, y, 0.02), DT);
             }
         }
-        s.update(&check, &commands, failures, MAX, DT)
+        s.update(&check, &commands, failures, MAX, DT, LAG)
     })
 }
 
@@ -104,7 +107,7 @@ fn a_silent_agent_is_a_link_loss_only_past_the_timeout() {
     // No report arrives again: ages 0.025, 0.035, ... Past 0.1 s (the ninth period) a link loss.
     let mut named = None;
     for k in 0..12 {
-        let v = s.update(&check, &commands, &none, MAX, DT);
+        let v = s.update(&check, &commands, &none, MAX, DT, LAG);
         if v != FaultVerdict::Nominal {
             named.get_or_insert((k, v));
         }
@@ -123,7 +126,7 @@ fn a_silent_agent_is_a_link_loss_only_past_the_timeout() {
     let verdicts: [_; 4] = core::array::from_fn(|k| {
         // The same report, measured once, 20 ms old at the first period.
         s.set(1, reading(0.0, 0.0, 0.0, 0.02 + DT * k as f64), DT);
-        s.update(&check, &commands, &none, MAX, DT)
+        s.update(&check, &commands, &none, MAX, DT, LAG)
     });
     assert!(
         verdicts.iter().all(|v| matches!(
@@ -162,7 +165,7 @@ fn a_changing_command_is_followed_within_the_lag_allowance() {
                 if k < 100 { 0.0 } else { 0.4 },
                 (t * 2.0).sin() * 0.3,
             );
-            let v = s.update(&check, &[c], &none, MAX, DT);
+            let v = s.update(&check, &[c], &none, MAX, DT, LAG);
             assert_eq!(v, FaultVerdict::Nominal, "servo {servo} rad/s, period {k}");
             actual[0] += (c.thrust - actual[0]) * closed;
             let step = servo * DT;
