@@ -6,24 +6,31 @@
 //! Per period ([`ReportState::update`]), for each working agent with a command in force
 //! `(T_c, eta_x,c, eta_y,c)`:
 //! - the model of the slowest healthy actuator: the thrust a first-order lag of the command
-//!   (the controller's stated actuator lag, [`crate::fault_detection::FAULT_ACTUATOR_LAG`]), each gimbal angle moving towards its command at the slowest
-//!   healthy servo rate ([`ReportCheck::servo_rate`]); with the model's change over the
-//!   period, decayed by half a period, as its recent swing `s`;
-//! - a healthy actuator lies between that model and the command in force (the fastest); a new
-//!   report of age `a` is compared with that interval now, allowing the stated tolerance plus
-//!   the swing over the report's age and the command's stated delay (`s ((a + d) / dt + 1)`,
-//!   the model extrapolated back to when the report was measured): a thrust short of the
-//!   interval by more is a thrust fault of efficiency `T_reported / min(T_model, T_c)`
-//!   (a [`FaultKind::Loss`] at `<= 0.2`, else [`FaultKind::PartialLoss`]), an angle off by
-//!   more a [`FaultKind::StuckGimbal`]. A thrust above the model names nothing (no kind is
-//!   a runaway rotor; the residual sees it as unexplained);
+//!   (the controller's stated actuator lag, [`crate::fault_detection::FAULT_ACTUATOR_LAG`]),
+//!   each gimbal angle a first-order lag of its command ([`ReportCheck::servo_lag`]) turning at
+//!   most at the slowest healthy servo rate ([`ReportCheck::servo_rate`]), both from rest (zero
+//!   thrust, gimbal centred) when the check starts;
+//! - a healthy actuator lies between that model and the command (the fastest actuator), but a
+//!   report shows it as it was `a` (the report's age) plus `d` (the command link's stated
+//!   delay) ago, and a fast rotor follows a chattering command (the allocation at the
+//!   attainable set's boundary) within a period. So the check keeps envelopes of both: the
+//!   lowest thrust and the lowest and highest angles, each the running minimum (maximum) of
+//!   the model and the command that forgets at a stated rate `r`
+//!   ([`ReportCheck::thrust_forget`], [`ReportCheck::angle_forget`]): `low_k = min(model_k,
+//!   c_k, low_(k-1) + r dt)`. A new report is compared with the envelope widened by the
+//!   tolerance and by what it forgot since the report was measured, `r (a + d + dt)`: a thrust
+//!   short of it is a thrust fault of efficiency `T_reported / min(T_model, T_c)` (a
+//!   [`FaultKind::Loss`] at `<= 0.2`, else [`FaultKind::PartialLoss`]), an angle outside it a
+//!   [`FaultKind::StuckGimbal`]. A thrust above names nothing (no kind is a runaway rotor; the
+//!   residual sees it as unexplained);
 //! - a report older than the link timeout is a [`FaultKind::LinkLoss`], confirmed at once
 //!   (the timeout is its persistence); a report only older than usual is checked with the
 //!   larger allowance its age gives, and is no fault by itself.
 //!
-//! Proven (by the construction): a report within the tolerance of an actuator that follows the
-//! model or the command exactly is never named, whatever the command does; a report that does not arrive is
-//! named only after the link timeout. Measured, not proven: how fast real faults are named and
+//! Proven (by the construction): a report, within the tolerance, of an actuator that was at
+//! that moment between the model and any command sent within the report's age and the stated
+//! delay (plus a period) is never named, whatever the commands did; a report that does not
+//! arrive is named only after the link timeout. Measured, not proven: how fast real faults are named and
 //! that the model's allowance covers the real actuators' lag and the command link's jitter
 //! (the simulator's fault study, `docs/fault-detection.md`). What the reports cannot see: a
 //! damaged propeller at full speed (the ESC measures speed, not thrust), a report that lies;
@@ -46,6 +53,16 @@ pub const REPORT_ANGLE_TOLERANCE: f64 = 0.05;
 /// healthy gimbal servo turns at (the simulator's Monte Carlo servos are rate-limited at 6
 /// rad/s; a hobby servo's 60 degrees in 0.1 s is 10 rad/s).
 pub const REPORT_SERVO_RATE: f64 = 6.0;
+/// [`ReportCheck::servo_lag`] of [`ReportCheck::recommended`] (s): the time constant of the
+/// slowest healthy servo below its rate limit (the simulator's Monte Carlo servos, second order
+/// at 40 rad/s and damping 0.8, settle like a first-order lag of `2 zeta / w_n` = 0.04 s).
+pub const REPORT_SERVO_LAG: f64 = 0.05;
+/// [`ReportCheck::thrust_forget`] of [`ReportCheck::recommended`] (share of the maximum thrust
+/// per second): over a report's usual 40 ms (20 ms latency, 10 ms of delay, a period) the
+/// thrust envelope forgets a tenth of the maximum thrust, as much as its tolerance.
+pub const REPORT_THRUST_FORGET: f64 = 2.5;
+/// [`ReportCheck::angle_forget`] of [`ReportCheck::recommended`] (rad/s): 0.1 rad over 40 ms.
+pub const REPORT_ANGLE_FORGET: f64 = 2.5;
 /// [`ReportCheck::command_delay`] of [`ReportCheck::recommended`] (s): the command link's
 /// latency and jitter the allowance covers.
 pub const REPORT_COMMAND_DELAY: f64 = 0.01;
@@ -62,23 +79,29 @@ pub struct ReportCheck<T: Real> {
     thrust_tolerance: T,
     angle_tolerance: T,
     servo_rate: T,
+    servo_lag: T,
     command_delay: T,
     link_timeout: T,
     persistence: u8,
+    thrust_forget: T,
+    angle_forget: T,
 }
 
 impl<T: Real> ReportCheck<T> {
     /// `thrust_tolerance` (share of the maximum thrust), `angle_tolerance` (rad), `servo_rate`
-    /// (rad/s), `command_delay` (s), `link_timeout` (s), `persistence` (reports in a row).
+    /// (rad/s) and `servo_lag` (s) of the slowest healthy servo, `command_delay` (s),
+    /// `link_timeout` (s), `persistence` (reports in a row).
     ///
     /// Errors: [`ConfigError::NonFinite`] or [`ConfigError::Parameter`] naming
-    /// [`ConfigField::ReportTolerance`], [`ConfigField::ReportServoRate`],
+    /// [`ConfigField::ReportTolerance`], [`ConfigField::ReportServoRate`] (also for the
+    /// servo lag),
     /// [`ConfigField::ReportLinkTimeout`] (also for the command delay) or
     /// [`ConfigField::ReportPersistence`].
     pub fn new(
         thrust_tolerance: T,
         angle_tolerance: T,
         servo_rate: T,
+        servo_lag: T,
         command_delay: T,
         link_timeout: T,
         persistence: u8,
@@ -99,23 +122,51 @@ impl<T: Real> ReportCheck<T> {
             thrust_tolerance: positive(thrust_tolerance, ConfigField::ReportTolerance)?,
             angle_tolerance: positive(angle_tolerance, ConfigField::ReportTolerance)?,
             servo_rate: positive(servo_rate, ConfigField::ReportServoRate)?,
+            servo_lag: positive(servo_lag, ConfigField::ReportServoRate)?,
             command_delay,
             link_timeout: positive(link_timeout, field)?,
             persistence,
+            thrust_forget: lit(REPORT_THRUST_FORGET),
+            angle_forget: lit(REPORT_ANGLE_FORGET),
         })
     }
 
+    /// The same check whose envelopes forget at `thrust` (share of the maximum thrust per
+    /// second) and `angle` (rad/s) ([`REPORT_THRUST_FORGET`], [`REPORT_ANGLE_FORGET`] unless
+    /// set). Errors: [`ConfigError::NonFinite`] or [`ConfigError::Parameter`] naming
+    /// [`ConfigField::ReportTolerance`] unless both are finite and positive.
+    pub fn with_forgetting(self, thrust: T, angle: T) -> Result<Self, ConfigError> {
+        Ok(Self {
+            thrust_forget: positive(thrust, ConfigField::ReportTolerance)?,
+            angle_forget: positive(angle, ConfigField::ReportTolerance)?,
+            ..self
+        })
+    }
+
+    /// The thrust envelope's forgetting rate (share of the maximum thrust per second).
+    pub fn thrust_forget(&self) -> T {
+        self.thrust_forget
+    }
+
+    /// The angle envelopes' forgetting rate (rad/s).
+    pub fn angle_forget(&self) -> T {
+        self.angle_forget
+    }
+
     /// The recommended values ([`REPORT_THRUST_TOLERANCE`], [`REPORT_ANGLE_TOLERANCE`],
-    /// [`REPORT_SERVO_RATE`], [`REPORT_COMMAND_DELAY`], [`REPORT_LINK_TIMEOUT`],
+    /// [`REPORT_SERVO_RATE`], [`REPORT_SERVO_LAG`], [`REPORT_COMMAND_DELAY`], [`REPORT_LINK_TIMEOUT`],
     /// [`REPORT_PERSISTENCE`]).
     pub fn recommended() -> Self {
         Self {
             thrust_tolerance: lit(REPORT_THRUST_TOLERANCE),
             angle_tolerance: lit(REPORT_ANGLE_TOLERANCE),
             servo_rate: lit(REPORT_SERVO_RATE),
+            servo_lag: lit(REPORT_SERVO_LAG),
             command_delay: lit(REPORT_COMMAND_DELAY),
             link_timeout: lit(REPORT_LINK_TIMEOUT),
             persistence: REPORT_PERSISTENCE,
+            thrust_forget: lit(REPORT_THRUST_FORGET),
+            angle_forget: lit(REPORT_ANGLE_FORGET),
         }
     }
 
@@ -132,6 +183,11 @@ impl<T: Real> ReportCheck<T> {
     /// The slowest healthy servo rate (rad/s) the model turns at.
     pub fn servo_rate(&self) -> T {
         self.servo_rate
+    }
+
+    /// The slowest healthy servo's time constant (s) below its rate limit.
+    pub fn servo_lag(&self) -> T {
+        self.servo_lag
     }
 
     /// The command link's stated delay (s).
@@ -161,8 +217,9 @@ struct Slot<T: Real> {
     fresh: u8,
     /// The modelled thrust and angles now.
     model: [T; 3],
-    /// The model's recent change per period: thrust, angle.
-    swing: [T; 2],
+    /// The envelopes of the model and the commands: the lowest thrust, the lowest and the
+    /// highest `eta_x` and `eta_y`.
+    envelope: [T; 5],
     /// Disagreeing reports in a row.
     strikes: u8,
     /// The last disagreement's kind: 1 a thrust short by `1 - efficiency`, 2 an angle off,
@@ -177,7 +234,7 @@ impl<T: Real> Slot<T> {
             reading: [T::zero(), T::zero(), T::zero(), lit(f64::NAN)],
             fresh: 0,
             model: [T::zero(); 3],
-            swing: [T::zero(); 2],
+            envelope: [T::zero(); 5],
             strikes: 0,
             kind: 0,
             efficiency: T::zero(),
@@ -203,8 +260,6 @@ impl<T: Real> Slot<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReportState<T: Real, const N: usize> {
     slots: [Slot<T>; N],
-    /// The model starts at the first command in force (non-zero: started).
-    started: u8,
 }
 
 impl<T: Real, const N: usize> Default for ReportState<T, N> {
@@ -218,7 +273,6 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     pub fn new() -> Self {
         Self {
             slots: [Slot::new(); N],
-            started: 0,
         }
     }
 
@@ -259,7 +313,6 @@ impl<T: Real, const N: usize> ReportState<T, N> {
                 ..Slot::new()
             };
         }
-        self.started = 0;
     }
 
     /// Forgets the reports too.
@@ -282,34 +335,32 @@ impl<T: Real, const N: usize> ReportState<T, N> {
         rotor_lag: T,
     ) -> FaultVerdict<T> {
         let closed = T::one() - (-(period / rotor_lag)).exp();
+        let servo_closed = T::one() - (-(period / check.servo_lag)).exp();
         let step = check.servo_rate * period;
-        let half = lit::<T>(0.5);
-        let started = self.started != 0;
-        self.started = 1;
+        let (forget_t, forget_a) = (
+            check.thrust_forget * max_thrust * period,
+            check.angle_forget * period,
+        );
         let mut verdict = FaultVerdict::Nominal;
         let mut most = 0_u8;
         for (i, (slot, c)) in self.slots.iter_mut().zip(commands).enumerate() {
-            // The model starts at the command: no swing from nothing to it.
-            let before = if started {
-                slot.model
-            } else {
-                [c.thrust, c.eta_x, c.eta_y]
-            };
-            slot.model = if started {
-                let toward = |m: T, target: T| m + fmin(fmax(target - m, -step), step);
-                [
-                    before[0] + (c.thrust - before[0]) * closed,
-                    toward(before[1], c.eta_x),
-                    toward(before[2], c.eta_y),
-                ]
-            } else {
-                [c.thrust, c.eta_x, c.eta_y]
-            };
+            // From rest at the start (the model is zero then): between rest and the command a
+            // healthy actuator of any speed is never named while the model catches up.
+            let before = slot.model;
+            let toward = |m: T, target: T| m + fmin(fmax((target - m) * servo_closed, -step), step);
+            slot.model = [
+                before[0] + (c.thrust - before[0]) * closed,
+                toward(before[1], c.eta_x),
+                toward(before[2], c.eta_y),
+            ];
             let [t, x, y] = slot.model;
-            let angle_change = fmax((x - before[1]).abs(), (y - before[2]).abs());
-            slot.swing = [
-                fmax((t - before[0]).abs(), slot.swing[0] * half),
-                fmax(angle_change, slot.swing[1] * half),
+            let [low, x_low, x_high, y_low, y_high] = slot.envelope;
+            slot.envelope = [
+                fmin(fmin(t, c.thrust), low + forget_t),
+                fmin(fmin(x, c.eta_x), x_low + forget_a),
+                fmax(fmax(x, c.eta_x), x_high - forget_a),
+                fmin(fmin(y, c.eta_y), y_low + forget_a),
+                fmax(fmax(y, c.eta_y), y_high - forget_a),
             ];
             let Some(reading) = slot.reading() else {
                 continue;
@@ -335,7 +386,8 @@ impl<T: Real, const N: usize> ReportState<T, N> {
                 let kind = disagreement(check, slot, c, &reading, max_thrust, period);
                 (slot.kind, slot.efficiency) = match kind {
                     Some(FaultKind::StuckGimbal) => (2, T::zero()),
-                    Some(_) => (1, reading.thrust() / t),
+                    Some(FaultKind::PartialLoss { efficiency }) => (1, efficiency),
+                    Some(_) => (1, T::zero()),
                     None => (0, T::zero()),
                 };
                 slot.strikes = match kind {
@@ -363,9 +415,8 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     }
 }
 
-/// What a new report says against the model and the command `c` in force: `None` when it
-/// agrees within the allowance. A healthy actuator lies between the model (the slowest
-/// healthy one) and the command (the fastest), each quantity apart.
+/// What a new report says against the envelopes (`c`: the command in force): `None` when it
+/// agrees within the allowance.
 fn disagreement<T: Real>(
     check: &ReportCheck<T>,
     slot: &Slot<T>,
@@ -374,21 +425,20 @@ fn disagreement<T: Real>(
     max_thrust: T,
     period: T,
 ) -> Option<FaultKind<T>> {
-    let [t, x, y] = slot.model;
-    // Periods the model is extrapolated back over: the report's age and the command's delay.
-    let lead = (reading.age() + check.command_delay) / period + T::one();
-    let thrust_allowed = check.thrust_tolerance * max_thrust + slot.swing[0] * lead;
-    let angle_allowed = check.angle_tolerance + slot.swing[1] * lead;
-    let low = fmin(t, c.thrust);
+    let [low, x_low, x_high, y_low, y_high] = slot.envelope;
+    // What the envelopes forgot since the report was measured (and the command's delay).
+    let since = reading.age() + check.command_delay + period;
+    let thrust_allowed = (check.thrust_tolerance + check.thrust_forget * since) * max_thrust;
+    let angle_allowed = check.angle_tolerance + check.angle_forget * since;
     if low - reading.thrust() > thrust_allowed {
-        // `low > thrust_allowed > 0`: the efficiency is in `[0, 1)`.
-        return Some(loss_kind(T::one() - reading.thrust() / low));
+        // `min(T_model, T_c) >= low > thrust_allowed > 0`: the efficiency is in `[0, 1)`.
+        let expected = fmin(slot.model[0], c.thrust);
+        return Some(loss_kind(T::one() - reading.thrust() / expected));
     }
-    // The distance of a reported angle from the interval between the model and the command.
-    let outside = |r: T, m: T, cmd: T| fmax(fmax(fmin(m, cmd) - r, r - fmax(m, cmd)), T::zero());
+    let outside = |r: T, lo: T, hi: T| fmax(fmax(lo - r, r - hi), T::zero());
     let off = fmax(
-        outside(reading.eta_x(), x, c.eta_x),
-        outside(reading.eta_y(), y, c.eta_y),
+        outside(reading.eta_x(), x_low, x_high),
+        outside(reading.eta_y(), y_low, y_high),
     );
     (off > angle_allowed).then_some(FaultKind::StuckGimbal)
 }
