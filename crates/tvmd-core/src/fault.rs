@@ -48,7 +48,7 @@ pub mod reports;
 mod verdict;
 use fit::{fit, none, share, unsquare, Fit, WeightedResidual};
 pub use reading::{AgentReading, ReportError};
-pub use reports::{ReportCheck, ReportState};
+pub use reports::{ReportCheck, ReportGains, ReportState};
 pub use verdict::{FaultKind, FaultReport, FaultSource, FaultVerdict};
 
 /// A fault detector's settings: the residual's stated noise, the threshold in units of it, and

@@ -22,7 +22,7 @@ use crate::fault::detection::{
 };
 use crate::fault::{
     loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
-    ReportCheck, ReportState,
+    ReportCheck, ReportGains, ReportState,
 };
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::linalg::{wrench_parts, EuclideanNorm};
@@ -90,6 +90,9 @@ pub(super) struct FaultMonitor<T: Real, const N: usize> {
     /// reports).
     pub(super) reports: ReportState<T, N>,
     pub(super) check: ReportCheck<T>,
+    /// The check's per-period gains at the controller's period ([`FAULT_ACTUATOR_LAG`]) and
+    /// the team's maximum thrust.
+    pub(super) gains: ReportGains<T>,
 }
 
 impl<T: Real, const N: usize> FaultMonitor<T, N> {
@@ -132,6 +135,11 @@ impl<T: Real, const N: usize> FaultMonitor<T, N> {
             masked: None,
             reports: ReportState::new(),
             check: *detection.report_check(),
+            gains: detection.report_check().gains(
+                period,
+                lit(FAULT_ACTUATOR_LAG),
+                team.limits().max_thrust(),
+            ),
         }))
     }
 

@@ -6,9 +6,8 @@
 
 use super::Controller;
 use crate::allocation::Allocator;
-use crate::fault::detection::FAULT_ACTUATOR_LAG;
 use crate::fault::{AgentReading, FaultKind, FaultReport, FaultSource, FaultVerdict, ReportError};
-use crate::foundation::real::{lit, Real};
+use crate::foundation::real::Real;
 
 impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Agent `agent`'s newest report: what it measured of its rotor and gimbal
@@ -73,8 +72,6 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// residual confirmed one too; a suspicion replaces a verdict that names no agent. Nothing
     /// runs while no agent has reported.
     pub(super) fn check_reports(&mut self, report: &mut FaultReport<T>) {
-        let max_thrust = self.team.limits.max_thrust();
-        let period = self.settings.period;
         let Some(monitor) = self.fault.as_mut() else {
             return;
         };
@@ -83,11 +80,9 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         }
         let verdict = monitor.reports.update(
             &monitor.check,
+            &monitor.gains,
             &self.previous,
             &self.failures,
-            max_thrust,
-            period,
-            lit(FAULT_ACTUATOR_LAG),
         );
         let lost = |k: &FaultKind<T>| matches!(k, FaultKind::Loss | FaultKind::LinkLoss);
         let replaces = match (&verdict, &report.verdict) {

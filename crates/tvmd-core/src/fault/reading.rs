@@ -141,19 +141,6 @@ impl<T: Real> AgentReading<T> {
     pub fn age(&self) -> T {
         self.age
     }
-
-    /// The same report `dt` older (saturating at the largest finite `T`).
-    pub(crate) fn aged(self, dt: T) -> Self {
-        let age = self.age + dt;
-        Self {
-            age: if age.is_finite() {
-                age
-            } else {
-                T::max_value().unwrap_or(self.age)
-            },
-            ..self
-        }
-    }
 }
 
 #[cfg(test)]
@@ -198,10 +185,5 @@ mod tests {
             })
         );
         assert!(AgentReading::from_speed(f64::NAN, 0.0, 0.0, 0.0, &limits).is_err());
-        // Ageing never overflows into infinity.
-        let old = AgentReading::new(1.0f32, 0.0, 0.0, f32::MAX)
-            .unwrap()
-            .aged(f32::MAX);
-        assert!(old.age().is_finite());
     }
 }

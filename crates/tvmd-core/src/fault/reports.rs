@@ -41,7 +41,7 @@ use super::{loss_kind, FaultKind, FaultVerdict};
 use crate::agent::command::AgentCommand;
 use crate::agent::failure::FailureMask;
 use crate::foundation::error::{positive, ConfigError, ConfigField};
-use crate::foundation::real::{fmax, fmin, lit, Real};
+use crate::foundation::real::{lit, Real};
 
 /// [`ReportCheck::thrust_tolerance`] of [`ReportCheck::recommended`]: a tenth of the maximum
 /// thrust (an ESC's speed reading is good to a few percent; the rotor model's `k` to ten).
@@ -206,6 +206,71 @@ impl<T: Real> ReportCheck<T> {
     }
 }
 
+/// What one period of `period` s does to the models: computed once per controller
+/// ([`ReportCheck::gains`]), so that no period pays an `exp`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReportGains<T: Real> {
+    period: T,
+    /// The share of the gap the rotor and the servo models close in a period.
+    rotor: T,
+    servo: T,
+    /// The servo model's largest step (rad).
+    step: T,
+    /// What the envelopes forget in a period (N, rad).
+    forget_thrust: T,
+    forget_angle: T,
+    /// The allowances of a report of age `a`: `base + rate a` (N, rad): the tolerance and
+    /// what the envelope forgets over the report's age, the command's delay and a period.
+    thrust_base: T,
+    thrust_rate: T,
+    angle_base: T,
+    angle_rate: T,
+}
+
+impl<T: Real> ReportCheck<T> {
+    /// The per-period gains of this check at the control period `period` (s), the rotor lag
+    /// `rotor_lag` (s, the controller's stated actuator lag) and the team's `max_thrust` (N);
+    /// all positive.
+    pub fn gains(&self, period: T, rotor_lag: T, max_thrust: T) -> ReportGains<T> {
+        let closed = |tau: T| T::one() - (-(period / tau)).exp();
+        let thrust_rate = self.thrust_forget * max_thrust;
+        let since = self.command_delay + period;
+        ReportGains {
+            period,
+            rotor: closed(rotor_lag),
+            servo: closed(self.servo_lag),
+            step: self.servo_rate * period,
+            forget_thrust: thrust_rate * period,
+            forget_angle: self.angle_forget * period,
+            thrust_base: self.thrust_tolerance * max_thrust + thrust_rate * since,
+            thrust_rate,
+            angle_base: self.angle_tolerance + self.angle_forget * since,
+            angle_rate: self.angle_forget,
+        }
+    }
+}
+
+/// The smaller of two finite numbers (a comparison: `f32::min` is a `libm` call on a
+/// Cortex-M4F).
+#[inline(always)]
+fn lower<T: Real>(a: T, b: T) -> T {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The larger of two finite numbers.
+#[inline(always)]
+fn upper<T: Real>(a: T, b: T) -> T {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// One agent's report, model and count: plain numbers only (every bit pattern is a value, so
 /// a controller in memory a stray write changed, [`crate::Controller::storage_intact`], holds
 /// no invalid tag here; a wrong number is a wrong reading, never undefined behaviour).
@@ -260,6 +325,8 @@ impl<T: Real> Slot<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReportState<T: Real, const N: usize> {
     slots: [Slot<T>; N],
+    /// Some agent reported since the last clear (non-zero): the check runs.
+    reported: u8,
 }
 
 impl<T: Real, const N: usize> Default for ReportState<T, N> {
@@ -273,12 +340,13 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     pub fn new() -> Self {
         Self {
             slots: [Slot::new(); N],
+            reported: 0,
         }
     }
 
     /// Whether any agent has reported.
     pub fn any(&self) -> bool {
-        self.slots.iter().any(|s| s.reading[3].is_finite())
+        self.reported != 0
     }
 
     /// Agent `agent`'s newest report, aged to now.
@@ -297,6 +365,7 @@ impl<T: Real, const N: usize> ReportState<T, N> {
         if !held.is_finite() || reading.age() < held - period * lit(0.5) {
             slot.fresh = 1;
         }
+        self.reported = 1;
         slot.reading = [
             reading.thrust(),
             reading.eta_x(),
@@ -320,59 +389,57 @@ impl<T: Real, const N: usize> ReportState<T, N> {
         *self = Self::new();
     }
 
-    /// One period of length `period` whose commands in force were `commands`: advances the
-    /// models (the thrust's a first-order lag of time constant `rotor_lag` s), checks the new reports, ages every report by `period` and returns the verdict
-    /// (the first confirmed agent, else the suspected one with the most disagreeing reports,
-    /// else [`FaultVerdict::Nominal`]). Agents `failures` masks are skipped and their counts
-    /// forgotten. `max_thrust` (N) scales the thrust tolerance.
+    /// One period (`gains`: of the check at the controller's period) whose commands in force
+    /// were `commands`: advances the models of the agents that report, checks the new reports,
+    /// ages every report by the period and returns the verdict (the first confirmed agent,
+    /// else the suspected one with the most disagreeing reports, else
+    /// [`FaultVerdict::Nominal`]). Agents `failures` masks are skipped and their counts
+    /// forgotten. An agent that
+    /// has not reported is skipped: its model starts from rest at its first report (from rest
+    /// to the command, a healthy actuator of any speed is never named while the model catches
+    /// up).
     pub fn update(
         &mut self,
         check: &ReportCheck<T>,
+        gains: &ReportGains<T>,
         commands: &[AgentCommand<T>; N],
         failures: &FailureMask<N>,
-        max_thrust: T,
-        period: T,
-        rotor_lag: T,
     ) -> FaultVerdict<T> {
-        let closed = T::one() - (-(period / rotor_lag)).exp();
-        let servo_closed = T::one() - (-(period / check.servo_lag)).exp();
-        let step = check.servo_rate * period;
-        let (forget_t, forget_a) = (
-            check.thrust_forget * max_thrust * period,
-            check.angle_forget * period,
-        );
+        let g = gains;
+        let (forget_t, forget_a) = (g.forget_thrust, g.forget_angle);
+        let neg_step = -g.step;
         let mut verdict = FaultVerdict::Nominal;
         let mut most = 0_u8;
         for (i, (slot, c)) in self.slots.iter_mut().zip(commands).enumerate() {
-            // From rest at the start (the model is zero then): between rest and the command a
-            // healthy actuator of any speed is never named while the model catches up.
+            let age = slot.reading[3];
+            if !age.is_finite() {
+                continue;
+            }
             let before = slot.model;
-            let toward = |m: T, target: T| m + fmin(fmax((target - m) * servo_closed, -step), step);
-            slot.model = [
-                before[0] + (c.thrust - before[0]) * closed,
+            let toward =
+                |m: T, target: T| m + lower(upper((target - m) * g.servo, neg_step), g.step);
+            let (t, x, y) = (
+                before[0] + (c.thrust - before[0]) * g.rotor,
                 toward(before[1], c.eta_x),
                 toward(before[2], c.eta_y),
-            ];
-            let [t, x, y] = slot.model;
+            );
+            slot.model = [t, x, y];
             let [low, x_low, x_high, y_low, y_high] = slot.envelope;
             slot.envelope = [
-                fmin(fmin(t, c.thrust), low + forget_t),
-                fmin(fmin(x, c.eta_x), x_low + forget_a),
-                fmax(fmax(x, c.eta_x), x_high - forget_a),
-                fmin(fmin(y, c.eta_y), y_low + forget_a),
-                fmax(fmax(y, c.eta_y), y_high - forget_a),
+                lower(lower(t, c.thrust), low + forget_t),
+                lower(lower(x, c.eta_x), x_low + forget_a),
+                upper(upper(x, c.eta_x), x_high - forget_a),
+                lower(lower(y, c.eta_y), y_low + forget_a),
+                upper(upper(y, c.eta_y), y_high - forget_a),
             ];
-            let Some(reading) = slot.reading() else {
-                continue;
-            };
-            slot.reading[3] = reading.aged(period).age();
             let fresh = core::mem::take(&mut slot.fresh) != 0;
             if failures.is_failed(i) {
                 slot.strikes = 0;
                 continue;
             }
             let confirmed = matches!(verdict, FaultVerdict::Confirmed { .. });
-            if reading.age() > check.link_timeout {
+            if age > check.link_timeout {
+                // No longer aged: past the timeout its age says all (and stays finite).
                 slot.strikes = 0;
                 if !confirmed {
                     verdict = FaultVerdict::Confirmed {
@@ -382,20 +449,20 @@ impl<T: Real, const N: usize> ReportState<T, N> {
                 }
                 continue;
             }
+            slot.reading[3] = age + g.period;
             if fresh {
-                let kind = disagreement(check, slot, c, &reading, max_thrust, period);
-                (slot.kind, slot.efficiency) = match kind {
-                    Some(FaultKind::StuckGimbal) => (2, T::zero()),
-                    Some(FaultKind::PartialLoss { efficiency }) => (1, efficiency),
-                    Some(_) => (1, T::zero()),
-                    None => (0, T::zero()),
-                };
-                slot.strikes = match kind {
-                    Some(_) => slot.strikes.saturating_add(1),
-                    None => 0,
+                let (kind, efficiency) = disagreement(g, slot, c, age);
+                (slot.kind, slot.efficiency) = (kind, efficiency);
+                slot.strikes = if kind == 0 {
+                    0
+                } else {
+                    slot.strikes.saturating_add(1)
                 };
             }
-            let (Some(kind), true) = (slot.kind(), slot.strikes > 0) else {
+            if slot.strikes == 0 {
+                continue;
+            }
+            let Some(kind) = slot.kind() else {
                 continue;
             };
             if slot.strikes >= check.persistence {
@@ -415,32 +482,31 @@ impl<T: Real, const N: usize> ReportState<T, N> {
     }
 }
 
-/// What a new report says against the envelopes (`c`: the command in force): `None` when it
-/// agrees within the allowance.
+/// What a new report of age `age` says against the envelopes (`c`: the command in force), as
+/// [`Slot::kind`]'s code and efficiency: 0 when it agrees within the allowance.
+#[inline(always)]
 fn disagreement<T: Real>(
-    check: &ReportCheck<T>,
+    g: &ReportGains<T>,
     slot: &Slot<T>,
     c: &AgentCommand<T>,
-    reading: &AgentReading<T>,
-    max_thrust: T,
-    period: T,
-) -> Option<FaultKind<T>> {
+    age: T,
+) -> (u8, T) {
+    let [thrust, eta_x, eta_y, _] = slot.reading;
     let [low, x_low, x_high, y_low, y_high] = slot.envelope;
-    // What the envelopes forgot since the report was measured (and the command's delay).
-    let since = reading.age() + check.command_delay + period;
-    let thrust_allowed = (check.thrust_tolerance + check.thrust_forget * since) * max_thrust;
-    let angle_allowed = check.angle_tolerance + check.angle_forget * since;
-    if low - reading.thrust() > thrust_allowed {
-        // `min(T_model, T_c) >= low > thrust_allowed > 0`: the efficiency is in `[0, 1)`.
-        let expected = fmin(slot.model[0], c.thrust);
-        return Some(loss_kind(T::one() - reading.thrust() / expected));
+    if low - thrust > g.thrust_base + g.thrust_rate * age {
+        // `min(T_model, T_c) >= low > allowance > 0`: the efficiency is in `[0, 1)`.
+        return (1, thrust / lower(slot.model[0], c.thrust));
     }
-    let outside = |r: T, lo: T, hi: T| fmax(fmax(lo - r, r - hi), T::zero());
-    let off = fmax(
-        outside(reading.eta_x(), x_low, x_high),
-        outside(reading.eta_y(), y_low, y_high),
-    );
-    (off > angle_allowed).then_some(FaultKind::StuckGimbal)
+    let allowed = g.angle_base + g.angle_rate * age;
+    let off = x_low - eta_x > allowed
+        || eta_x - x_high > allowed
+        || y_low - eta_y > allowed
+        || eta_y - y_high > allowed;
+    if off {
+        (2, T::zero())
+    } else {
+        (0, T::zero())
+    }
 }
 
 #[cfg(test)]

@@ -28,7 +28,12 @@ fn warm<const K: usize>(commands: &[AgentCommand<f64>; K]) -> ReportState<f64, K
         for (i, c) in commands.iter().enumerate() {
             s.set(i, reading(c.thrust, c.eta_x, c.eta_y, 0.02), DT);
         }
-        let v = s.update(&check, commands, &FailureMask::none(), MAX, DT, LAG);
+        let v = s.update(
+            &check,
+            &check.gains(DT, LAG, MAX),
+            commands,
+            &FailureMask::none(),
+        );
         assert_eq!(v, FaultVerdict::Nominal);
     }
     s
@@ -54,7 +59,7 @@ fn fly<const P: usize>(
                 s.set(i, reading(t, x, y, 0.02), DT);
             }
         }
-        s.update(&check, &commands, failures, MAX, DT, LAG)
+        s.update(&check, &check.gains(DT, LAG, MAX), &commands, failures)
     })
 }
 
@@ -121,7 +126,7 @@ fn a_silent_agent_is_a_link_loss_only_past_the_timeout() {
     // No report arrives again: ages 0.025, 0.035, ... Past 0.1 s (the ninth period) a link loss.
     let mut named = None;
     for k in 0..12 {
-        let v = s.update(&check, &commands, &none, MAX, DT, LAG);
+        let v = s.update(&check, &check.gains(DT, LAG, MAX), &commands, &none);
         if v != FaultVerdict::Nominal {
             named.get_or_insert((k, v));
         }
@@ -140,7 +145,7 @@ fn a_silent_agent_is_a_link_loss_only_past_the_timeout() {
     let verdicts: [_; 4] = core::array::from_fn(|k| {
         // The same report, measured once, 20 ms old at the first period.
         s.set(1, reading(0.0, 0.0, 0.0, 0.02 + DT * k as f64), DT);
-        s.update(&check, &commands, &none, MAX, DT, LAG)
+        s.update(&check, &check.gains(DT, LAG, MAX), &commands, &none)
     });
     assert!(
         verdicts.iter().all(|v| matches!(
@@ -218,7 +223,7 @@ fn a_changing_command_is_followed_within_the_lag_allowance() {
                 },
                 (t * 2.0).sin() * 0.3,
             );
-            let v = s.update(&check, &[c], &none, MAX, DT, LAG);
+            let v = s.update(&check, &check.gains(DT, LAG, MAX), &[c], &none);
             assert_eq!(v, FaultVerdict::Nominal, "servo {rate} rad/s, period {k}");
             thrust += (c.thrust - thrust) * closed;
             servos[0].step(c.eta_x);
