@@ -412,7 +412,8 @@ pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecordin
     let (core, n) = core_of_scenario::<f32>(&scenario)?;
     let mut controller: TvmdController<f32, Recorder<CoreController<f32>>> =
         TvmdController::new(Recorder::new(core, n), n)
-            .with_failure_response(scenario.failure_response);
+            .with_failure_response(scenario.failure_response)
+            .with_reports_of(&scenario);
     let mut sim = Simulation::with_options(&scenario, SimOptions::default())?;
     sim.run(&mut controller, None)?;
     let recorder = controller.engine();

@@ -96,6 +96,8 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     detected: Vec<bool>,
     /// The agent of the last self-masking seen ([`tvmd_core::FaultMasking::agent`]).
     masking_seen: Option<usize>,
+    /// The agents' reports go to the core ([`Self::with_reports_of`]).
+    pass_reports: bool,
     /// The core has no fault detection to read the agents' reports.
     reports_unread: bool,
 }
@@ -107,7 +109,9 @@ impl<T: CoreFloat> TvmdController<T> {
     /// field the core rejected.
     pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
         let (inner, n) = core_of_scenario(scenario)?;
-        Ok(Self::new(inner, n).with_failure_response(scenario.failure_response))
+        Ok(Self::new(inner, n)
+            .with_failure_response(scenario.failure_response)
+            .with_reports_of(scenario))
     }
 
     /// The wrapped core controller.
@@ -117,6 +121,14 @@ impl<T: CoreFloat> TvmdController<T> {
 }
 
 impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
+    /// The same controller passing the agents' reports to the core when `scenario` has
+    /// `[reports]` and `[fault_detection]` (an engine that does not carry them then ends the
+    /// run with an error); otherwise reports are not passed.
+    pub fn with_reports_of(mut self, scenario: &Scenario) -> Self {
+        self.pass_reports = scenario.reports.is_some() && scenario.fault_detection.is_some();
+        self
+    }
+
     /// The same controller with another response to a hover-capability loss.
     pub fn with_failure_response(mut self, response: FailureResponse) -> Self {
         self.response = response;
@@ -144,6 +156,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             landed: false,
             detected: vec![false; n],
             masking_seen: None,
+            pass_reports: false,
             reports_unread: false,
         }
     }
@@ -232,11 +245,11 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         });
     }
 
-    /// The agents' reports of this tick to the core's fault detection (`[reports]`): each
-    /// agent's newest. A core without fault detection does not read them: they are not passed
+    /// The agents' reports of this tick to the core's fault detection (`[reports]` with
+    /// `[fault_detection]`, [`Self::with_reports_of`]): each agent's newest. A core without fault detection does not read them: they are not passed
     /// again ([`tvmd_core::ReportError::DetectionOff`]); any other refusal ends the run.
     fn pass_reports(&mut self, reports: &[Option<AgentReport>]) -> Result<(), BoxedError> {
-        if self.reports_unread {
+        if !self.pass_reports || self.reports_unread {
             return Ok(());
         }
         for (agent, r) in reports.iter().enumerate().take(self.n) {
@@ -400,7 +413,9 @@ impl AnyTvmdController {
         let wire = config::wire_config(scenario)?;
         let core = pil::PilCore::start(target, &wire)?;
         Ok(Self::Pil(
-            TvmdController::new(core, wire.n).with_failure_response(scenario.failure_response),
+            TvmdController::new(core, wire.n)
+                .with_failure_response(scenario.failure_response)
+                .with_reports_of(scenario),
         ))
     }
 
