@@ -44,11 +44,13 @@ use crate::foundation::real::{lit, sqrt, Real};
 pub mod detection;
 mod fit;
 pub mod reading;
+pub mod report_check;
 pub mod reports;
 mod verdict;
 use fit::{fit, none, share, unsquare, Fit, WeightedResidual};
 pub use reading::{AgentReading, ReportError};
-pub use reports::{ReportCheck, ReportGains, ReportState};
+pub use report_check::{ReportCheck, ReportGains};
+pub use reports::ReportState;
 pub use verdict::{FaultKind, FaultReport, FaultSource, FaultVerdict};
 
 /// A fault detector's settings: the residual's stated noise, the threshold in units of it, and

@@ -96,7 +96,7 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     detected: Vec<bool>,
     /// The agent of the last self-masking seen ([`tvmd_core::FaultMasking::agent`]).
     masking_seen: Option<usize>,
-    /// The agents' reports go to the core ([`Self::with_reports_of`]).
+    /// The agents' reports go to the core ([`Self::for_scenario`]).
     pass_reports: bool,
     /// The core has no fault detection to read the agents' reports.
     reports_unread: bool,
@@ -109,9 +109,7 @@ impl<T: CoreFloat> TvmdController<T> {
     /// field the core rejected.
     pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
         let (inner, n) = core_of_scenario(scenario)?;
-        Ok(Self::new(inner, n)
-            .with_failure_response(scenario.failure_response)
-            .with_reports_of(scenario))
+        Ok(Self::new(inner, n).for_scenario(scenario))
     }
 
     /// The wrapped core controller.
@@ -121,12 +119,13 @@ impl<T: CoreFloat> TvmdController<T> {
 }
 
 impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
-    /// The same controller passing the agents' reports to the core when `scenario` has
-    /// `[reports]` and `[fault_detection]` (an engine that does not carry them then ends the
-    /// run with an error); otherwise reports are not passed.
-    pub fn with_reports_of(mut self, scenario: &Scenario) -> Self {
+    /// The same controller with `scenario`'s response to a hover-capability loss, passing the
+    /// agents' reports to the core when it has `[reports]` and `[fault_detection]` (an engine
+    /// that does not carry them then ends the run with an error; otherwise they are not
+    /// passed).
+    pub fn for_scenario(mut self, scenario: &Scenario) -> Self {
         self.pass_reports = scenario.reports.is_some() && scenario.fault_detection.is_some();
-        self
+        self.with_failure_response(scenario.failure_response)
     }
 
     /// The same controller with another response to a hover-capability loss.
@@ -246,7 +245,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
     }
 
     /// The agents' reports of this tick to the core's fault detection (`[reports]` with
-    /// `[fault_detection]`, [`Self::with_reports_of`]): each agent's newest. A core without fault detection does not read them: they are not passed
+    /// `[fault_detection]`, [`Self::for_scenario`]): each agent's newest. A core without fault detection does not read them: they are not passed
     /// again ([`tvmd_core::ReportError::DetectionOff`]); any other refusal ends the run.
     fn pass_reports(&mut self, reports: &[Option<AgentReport>]) -> Result<(), BoxedError> {
         if !self.pass_reports || self.reports_unread {
@@ -413,9 +412,7 @@ impl AnyTvmdController {
         let wire = config::wire_config(scenario)?;
         let core = pil::PilCore::start(target, &wire)?;
         Ok(Self::Pil(
-            TvmdController::new(core, wire.n)
-                .with_failure_response(scenario.failure_response)
-                .with_reports_of(scenario),
+            TvmdController::new(core, wire.n).for_scenario(scenario),
         ))
     }
 
