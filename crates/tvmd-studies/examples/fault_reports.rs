@@ -1,6 +1,6 @@
-//! The agents' own reports in the controller's fault detection (issue 60, `docs/fault-detection.md`,
-//! "The agents' reports"): delays per team, fault and flight phase with reports at 100 Hz and
-//! 20 ms latency; `a6-agent-failure` not informed against informed; false alarms over nominal
+//! The agents' own reports in the controller's fault detection (issue 60,
+//! `docs/fault-detection.md`, "The agents' reports"): delays per team, fault and flight phase
+//! with reports at 100 Hz and 20 ms latency; `a6-agent-failure` not informed against informed; false alarms over nominal
 //! flights with 10% of the reports lost and a jittering command link; a report that lies.
 //!
 //! ```text

@@ -117,8 +117,8 @@ impl<T: Real> ReportCheck<T> {
     }
 
     /// The recommended values ([`REPORT_THRUST_TOLERANCE`], [`REPORT_ANGLE_TOLERANCE`],
-    /// [`REPORT_SERVO_RATE`], [`REPORT_SERVO_LAG`], [`REPORT_COMMAND_DELAY`], [`REPORT_LINK_TIMEOUT`],
-    /// [`REPORT_PERSISTENCE`]).
+    /// [`REPORT_SERVO_RATE`], [`REPORT_SERVO_LAG`], [`REPORT_COMMAND_DELAY`],
+    /// [`REPORT_LINK_TIMEOUT`], [`REPORT_PERSISTENCE`]).
     pub fn recommended() -> Self {
         Self {
             thrust_tolerance: lit(REPORT_THRUST_TOLERANCE),

@@ -27,12 +27,13 @@
 //!   (the timeout is its persistence); a report only older than usual is checked with the
 //!   larger allowance its age gives, and is no fault by itself.
 //!
-//! Proven (by the construction): a report, within the tolerance, of an actuator that was at
-//! that moment between the model and any command sent within the report's age and the stated
-//! delay (plus a period) is never named, whatever the commands did; a report that does not
-//! arrive is named only after the link timeout. Measured, not proven: how fast real faults are named and
-//! that the model's allowance covers the real actuators' lag and the command link's jitter
-//! (the simulator's fault study, `docs/fault-detection.md`). What the reports cannot see: a
+//! Proven (by the construction: `low_k <= min(model_j, c_j) + r (k - j) dt` for every earlier
+//! period `j`): a report, within the tolerance, of an actuator that was when measured between
+//! the model and any command sent within the report's age and the stated delay (plus a period)
+//! is never named, whatever the commands did; a report that does not arrive is named only
+//! after the link timeout. Measured, not proven: how fast real faults are named and that the
+//! model and the allowances cover the real actuators' lag and the command link's jitter (the
+//! simulator's fault study, `docs/fault-detection.md`). What the reports cannot see: a
 //! damaged propeller at full speed (the ESC measures speed, not thrust), a report that lies;
 //! the residual ([`crate::fault::FaultState`]) keeps running for those.
 
@@ -69,7 +70,8 @@ fn upper<T: Real>(a: T, b: T) -> T {
 /// no invalid tag here; a wrong number is a wrong reading, never undefined behaviour).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Slot<T: Real> {
-    /// Thrust, `eta_x`, `eta_y`, age of the newest report; no report while the age is not finite (NaN).
+    /// Thrust, `eta_x`, `eta_y`, age of the newest report; no report while the age is not
+    /// finite (NaN).
     reading: [T; 4],
     /// A report not yet checked (non-zero).
     fresh: u8,

@@ -1,8 +1,8 @@
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
 use super::*;
 use crate::fault::report_check::*;
-use crate::foundation::error::ConfigField;
 use crate::fault_detection::FAULT_ACTUATOR_LAG;
+use crate::foundation::error::ConfigField;
 
 const LAG: f64 = FAULT_ACTUATOR_LAG;
 
