@@ -277,3 +277,29 @@ fn settings_are_validated() {
     assert_eq!(r.persistence(), REPORT_PERSISTENCE);
     assert!(r.link_timeout() > 0.0 && r.thrust_tolerance() > 0.0);
 }
+
+#[test]
+fn a_fast_rotor_following_a_chattering_command_is_not_named_but_a_dead_one_is() {
+    // The allocation at the attainable set's boundary: 7 N, a dip to 2 N, back (measured in
+    // the simulator's tilt). A rotor that follows each command at once, read 20 ms late.
+    let check = ReportCheck::<f64>::recommended();
+    let gains = check.gains(DT, LAG, MAX);
+    let none = FailureMask::none();
+    let mut s = warm(&[command(7.0, 0.0, 0.0)]);
+    let thrust = |k: usize| if k % 7 == 3 { 2.0 } else { 7.0 };
+    for k in 2..300 {
+        s.set(0, reading(thrust(k - 2), 0.0, 0.0, 0.02), DT);
+        let v = s.update(&check, &gains, &[command(thrust(k), 0.0, 0.0)], &none);
+        assert_eq!(v, FaultVerdict::Nominal, "period {k}");
+    }
+    // The same rotor dead: named within two reports.
+    let mut named = None;
+    for k in 300..305 {
+        s.set(0, reading(0.0, 0.0, 0.0, 0.02), DT);
+        let v = s.update(&check, &gains, &[command(thrust(k), 0.0, 0.0)], &none);
+        if matches!(v, FaultVerdict::Confirmed { .. }) {
+            named.get_or_insert(k);
+        }
+    }
+    assert!(named.is_some_and(|k| k <= 302), "{named:?}");
+}
