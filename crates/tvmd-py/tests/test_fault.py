@@ -114,3 +114,12 @@ def test_reports_rows_of_nan_are_no_report_and_bad_ones_name_their_row():
         c.set_reports([[nan, 0.0, 0.0, 0.0]] + [[nan] * 4] * 3)
     with pytest.raises(ValueError, match="fault detection"):
         tvmd.Controller(team()).set_reports([[1.0, 0.0, 0.0, 0.0]] * 4)
+
+
+def test_the_simulator_passes_its_agents_reports_to_the_controller():
+    text = (ROOT / "scenarios/faults/loss-hover.toml").read_text()
+    result = tvmd.sim.run(toml=text + '\n[reports]\ndead_esc = "zero"\n', team="a6-inc")
+    masked = result.summary["fault"]["masked"]
+    # 100 Hz reports, 20 ms late: named from the reports, two reports after the first zero.
+    assert (masked["agent"], masked["kind"], masked["source"]) == (0, "loss", "reports")
+    assert 4.0 < masked["time"] <= 4.05
