@@ -24,34 +24,12 @@ use tvmd_scenario::{
 };
 use tvmd_sim::diagnostics::FaultSourceName;
 use tvmd_sim::{run_scenario, FaultEvent, FaultSummary, RunResult};
-use tvmd_studies::montecarlo::{Conditions, Distributions, Draw};
+use tvmd_studies::montecarlo::Conditions;
 
-const TEAMS: [&str; 3] = ["a4-inc", "a6-inc", "a8-inc"];
+mod fault_common;
+use fault_common::{map, quantiles, Phase, TEAMS};
+
 const SEED: u64 = 60;
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Phase {
-    Hover,
-    Wind,
-    Tilt,
-}
-
-impl Phase {
-    fn name(self) -> &'static str {
-        match self {
-            Self::Hover => "hover",
-            Self::Wind => "wind",
-            Self::Tilt => "tilt",
-        }
-    }
-
-    fn fault_time(self) -> f64 {
-        match self {
-            Self::Hover | Self::Wind => 4.0,
-            Self::Tilt => 7.0,
-        }
-    }
-}
 
 /// A fault of the study: the plant's failure and what the failed agent's reports say.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,30 +87,17 @@ fn flight(
     reports: AgentReports,
     links: Option<CommandLinks>,
 ) -> Result<Scenario, Box<dyn std::error::Error>> {
-    let mut s = match phase {
-        Phase::Hover => Scenario::builtin("hover")?,
-        Phase::Wind => Scenario::builtin("wind")?,
-        Phase::Tilt => Scenario::default(),
-    };
-    s.team.preset = Some(team.into());
-    s.team.agents = None;
-    s.law = LawConfig::default();
-    s.fault_detection = Some(FaultDetectionConfig::with_response(
-        FaultResponseConfig::Mask,
-    ));
-    s.reports = Some(AgentReports {
-        seed: SEED.wrapping_mul(1_000_003).wrapping_add(index),
-        ..reports
-    });
-    let n = s.team_body()?.len();
-    let mut s = Draw::new(&Distributions::default(), SEED, index, n).apply(&s)?;
+    let detection = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
     let conditions = Conditions {
         links,
         ..Conditions::default()
     };
-    conditions.apply(&mut s, SEED, index);
-    s.validate()?;
-    Ok(s)
+    fault_common::flight(team, phase, (SEED, index), detection, &conditions, |s| {
+        s.reports = Some(AgentReports {
+            seed: SEED.wrapping_mul(1_000_003).wrapping_add(index),
+            ..reports
+        });
+    })
 }
 
 struct FaultRun {
@@ -201,14 +166,6 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
     })
 }
 
-fn quantiles(mut v: Vec<f64>) -> String {
-    if v.is_empty() {
-        return "-".into();
-    }
-    v.sort_by(f64::total_cmp);
-    format!("{:.3} / {:.3}", v[v.len() / 2], v[v.len() - 1])
-}
-
 fn source(e: &Option<FaultEvent>) -> &'static str {
     match e.and_then(|e| e.source) {
         Some(FaultSourceName::Reports) => "reports",
@@ -237,7 +194,7 @@ fn fault_table(runs: &[FaultRun]) {
                             Err(()) => wrong += 1,
                         }
                     }
-                    (delays.len(), quantiles(delays))
+                    (delays.len(), quantiles(delays, 3))
                 };
                 let (ns, ds) = column(&|r| r.summary.first_suspected);
                 let (nc, dc) = column(&|r| r.summary.first_confirmed);
@@ -362,19 +319,6 @@ fn false_alarms(flights: usize, jobs: usize) {
             );
         }
     }
-}
-
-/// `f(k, item)` on `jobs` threads, the results in order (failed flights dropped).
-fn map<T: Sync, R: Send>(
-    items: &[T],
-    jobs: usize,
-    f: impl Fn(usize, &T) -> Option<R> + Sync,
-) -> Vec<R> {
-    tvmd_sim::pool::map_in_order(items, jobs, f)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .collect()
 }
 
 /// A trace of one nominal flight (`TVMD_STUDY_TRACE=team,phase,index,agent`): per tick the
