@@ -47,9 +47,11 @@
 /*
  The ABI version; raised on every incompatible change of a struct or function (2: the `law`
  of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
- the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`).
+ the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`;
+ 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source` and the
+ 9,216-byte handle at 16 agents).
  */
-#define TVMD_ABI_VERSION 4
+#define TVMD_ABI_VERSION 5
 
 /*
  `map.motor_curve`: `omega / sigma_omega` (eq. 5), the default.
@@ -139,14 +141,35 @@
  */
 #define TVMD_FAULT_KIND_STUCK_GIMBAL 3
 
+/*
+ `TvmdFaultReport.kind`: the agent's reports (`tvmd_set_agent_report`) stopped for longer
+ than the link timeout: its command link is taken as gone.
+ */
+#define TVMD_FAULT_KIND_LINK_LOSS 4
+
+/*
+ `TvmdFaultReport.source`: no agent named.
+ */
+#define TVMD_FAULT_SOURCE_NONE 0
+
+/*
+ `TvmdFaultReport.source`: the wrench residual (the vehicle's motion) named the agent.
+ */
+#define TVMD_FAULT_SOURCE_RESIDUAL 1
+
+/*
+ `TvmdFaultReport.source`: the agents' own reports named it.
+ */
+#define TVMD_FAULT_SOURCE_REPORTS 2
+
 #if !defined(TVMD_CAPACITY_4)
 /*
  Bytes of a [`TvmdController`]: at least the controller's size on every supported target
- (checked at compile time), with room for the core to grow within one ABI version. 8,192 at
+ (checked at compile time), with room for the core to grow within one ABI version. 9,216 at
  the 16-agent capacity (the controller keeps its allocator's working set, so no entry point
- holds it on the stack), 4,096 at the 4-agent one.
+ holds it on the stack, and the agents' reports), 4,096 at the 4-agent one.
  */
-#define TVMD_CONTROLLER_SIZE 8192
+#define TVMD_CONTROLLER_SIZE 9216
 #endif
 
 #if defined(TVMD_CAPACITY_4)
@@ -407,6 +430,42 @@ typedef struct TvmdActuatorOutputs {
    */
   float servos[TVMD_OUTPUT_CHANNELS];
 } TvmdActuatorOutputs;
+
+/*
+ One agent's report.
+ */
+typedef struct TvmdAgentReport {
+  /*
+   `sizeof(TvmdAgentReport)`, set by the caller.
+   */
+  uint32_t size;
+  /*
+   The agent (`0 .. n_agents`).
+   */
+  uint32_t agent;
+  /*
+   The rotor's measured speed (rpm, as `esc_status.esc[i].esc_rpm`), at least 0.
+   */
+  float rpm;
+  /*
+   The rpm at the maximum thrust, for a configuration whose limits carry no rotor
+   constants (speeds normalized to 1 at the maximum thrust: the speed is `rpm / max_rpm`);
+   0 when they carry them (the speed is `rpm * 2 pi / 60` rad/s). Finite, at least 0.
+   */
+  float max_rpm;
+  /*
+   The measured inner gimbal angle `eta_x` (rad, servo feedback).
+   */
+  float eta_x;
+  /*
+   The measured outer gimbal angle `eta_y` (rad, servo feedback).
+   */
+  float eta_y;
+  /*
+   How long ago it was measured (s): now minus the message's timestamp, at least 0.
+   */
+  float age;
+} TvmdAgentReport;
 
 /*
  The offset-free compensation as it stands: the wrench the offset-free state adds to the
@@ -747,6 +806,10 @@ typedef struct TvmdFaultReport {
    classification `tvmd_set_failures` returns); zero otherwise.
    */
   uint32_t masked_hover_capable;
+  /*
+   One of `TVMD_FAULT_SOURCE_*`: the check that named `agent`.
+   */
+  uint32_t source;
 } TvmdFaultReport;
 
 /*
@@ -1261,6 +1324,17 @@ typedef struct TvmdPlanOutput {
  */
 #define TVMD_ERR_ACTUATOR_VALUE 54
 
+/*
+ `tvmd_set_agent_report`: the report's agent is not in the team.
+ */
+#define TVMD_ERR_REPORT_AGENT 60
+
+/*
+ `tvmd_set_agent_report`: the controller was created without fault detection
+ (`fault.mode = TVMD_FAULT_OFF`): nothing would read the report.
+ */
+#define TVMD_ERR_REPORT_DETECTION_OFF 61
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1331,6 +1405,26 @@ TvmdStatus tvmd_actuator_commands(const struct TvmdController *handle,
                                   const struct TvmdActuatorOutputs *outputs,
                                   struct TvmdAgentCommand *commands,
                                   size_t count);
+
+/*
+ Gives the controller agent `report->agent`'s newest report, checked at the next
+ `tvmd_step` against the commands it answers; the controller ages it by its period at each
+ step until the next report replaces it, and names a `TVMD_FAULT_KIND_LINK_LOSS` when it
+ grows older than the link timeout (0.1 s). Call it whenever a new `esc_status` (or servo
+ feedback) arrives, or every period with the newest one and its age: the same report given
+ again is not counted twice. Agents never reported are checked by the residual only.
+
+ Statuses: `TVMD_ERR_INPUT_NON_FINITE` (a NaN or infinite value),
+ `TVMD_ERR_INPUT_OUT_OF_RANGE` (a negative rpm, `max_rpm` or age),
+ `TVMD_ERR_REPORT_AGENT`, `TVMD_ERR_REPORT_DETECTION_OFF`; the agent's previous report is
+ kept.
+
+ # Safety
+ `handle` is null or points to a `TvmdController`; `report` is null or points to a
+ `TvmdAgentReport`.
+ */
+TvmdStatus tvmd_set_agent_report(struct TvmdController *handle,
+                                 const struct TvmdAgentReport *report);
 
 /*
  Fills `out` (its `size` set by the caller) with the offset-free compensation as it stands.

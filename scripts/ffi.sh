@@ -24,7 +24,7 @@ require cc gcc
 require c++ g++
 
 step "include/tvmd.h compiles as C99 and as C++11 (-Wall -Wextra -Werror -pedantic)"
-printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 4 ? 0 : 1; }\n' >"$out/header.c"
+printf '#include "tvmd.h"\nint main(void) { return TVMD_ABI_VERSION == 5 ? 0 : 1; }\n' >"$out/header.c"
 cp "$out/header.c" "$out/header.cpp"
 cc -std=c99 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.c" -o "$out/header_c.o"
 c++ -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude -c "$out/header.cpp" -o "$out/header_cpp.o"

@@ -11,6 +11,7 @@ mod cycle;
 mod detection;
 mod guard;
 mod reconfigure;
+mod reports;
 mod settings;
 mod storage;
 
@@ -187,7 +188,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
 
     /// Forgets the previous command (rate limits restart from a centred gimbal), whatever the
     /// allocator kept from earlier periods ([`Allocator::reset`]), the offset-free state (zero
-    /// estimate or integral), the fault detector's candidate and report (a mask it set stays)
+    /// estimate or integral), the fault detector's candidate, report and the agents' reports
+    /// ([`Self::set_report`]; a mask it set stays)
     /// and the planned-rate filter (at rest). The landed flag
     /// ([`Self::set_landed`]) is the caller's input and is kept.
     pub fn reset(&mut self) {
@@ -197,6 +199,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.pending = None;
         if let Some(fault) = &mut self.fault {
             fault.reset();
+            fault.reports.clear();
         }
         if let Some(rates) = &mut self.attitude_rate {
             rates.reset();

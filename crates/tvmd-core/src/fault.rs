@@ -43,9 +43,15 @@ use crate::foundation::real::{lit, sqrt, Real};
 
 pub mod detection;
 mod fit;
+pub mod reading;
+pub mod report_check;
+pub mod reports;
 mod verdict;
 use fit::{fit, none, share, unsquare, Fit, WeightedResidual};
-pub use verdict::{FaultKind, FaultReport, FaultVerdict};
+pub use reading::{AgentReading, ReportError};
+pub use report_check::{ReportCheck, ReportGains};
+pub use reports::ReportState;
+pub use verdict::{FaultKind, FaultReport, FaultSource, FaultVerdict};
 
 /// A fault detector's settings: the residual's stated noise, the threshold in units of it, and
 /// the persistence. Validated: each finite and positive (`persistence >= 1`).
@@ -171,6 +177,7 @@ impl FaultState {
         let statistic = sqrt(rr);
         let mut report = FaultReport {
             verdict: FaultVerdict::Nominal,
+            source: FaultSource::Residual,
             statistic,
             threshold: detector.threshold,
             best_misfit: none(),

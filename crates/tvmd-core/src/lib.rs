@@ -86,7 +86,10 @@ pub use disturbance::DisturbanceObserver;
 pub use effectiveness::Effectiveness;
 pub use error::{ConfigError, ConfigField, InputError};
 pub use failure::FailureMask;
-pub use fault::{FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict};
+pub use fault::{
+    AgentReading, FaultDetector, FaultKind, FaultReport, FaultSource, FaultState, FaultVerdict,
+    ReportCheck, ReportError,
+};
 pub use gain_schedule::GainSchedule;
 pub use gimbal::GimbalCommand;
 pub use hover::{HoverCapability, HoverLimit};

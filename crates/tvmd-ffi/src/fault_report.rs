@@ -1,7 +1,7 @@
 //! The fault detector's latest report through the C interface ([`tvmd_fault_report`]), with
 //! the controller's own mask (see [`crate::fault`] for the configuration).
 
-use tvmd_core::{FaultKind, FaultVerdict};
+use tvmd_core::{FaultKind, FaultSource, FaultVerdict};
 
 use crate::handle::{checked_size, inner, TvmdController};
 use crate::status::{TvmdStatus, TVMD_ERR_NULL_POINTER, TVMD_OK};
@@ -26,6 +26,16 @@ pub const TVMD_FAULT_KIND_LOSS: u32 = 1;
 pub const TVMD_FAULT_KIND_PARTIAL_LOSS: u32 = 2;
 /// `TvmdFaultReport.kind`: the agent's force turned away from its command (a stuck gimbal).
 pub const TVMD_FAULT_KIND_STUCK_GIMBAL: u32 = 3;
+/// `TvmdFaultReport.kind`: the agent's reports (`tvmd_set_agent_report`) stopped for longer
+/// than the link timeout: its command link is taken as gone.
+pub const TVMD_FAULT_KIND_LINK_LOSS: u32 = 4;
+
+/// `TvmdFaultReport.source`: no agent named.
+pub const TVMD_FAULT_SOURCE_NONE: u32 = 0;
+/// `TvmdFaultReport.source`: the wrench residual (the vehicle's motion) named the agent.
+pub const TVMD_FAULT_SOURCE_RESIDUAL: u32 = 1;
+/// `TvmdFaultReport.source`: the agents' own reports named it.
+pub const TVMD_FAULT_SOURCE_REPORTS: u32 = 2;
 
 /// The detector's latest report and the controller's own mask.
 #[repr(C)]
@@ -52,6 +62,8 @@ pub struct TvmdFaultReport {
     /// Non-zero when that mask was accepted and the remaining team can hold hover (the
     /// classification `tvmd_set_failures` returns); zero otherwise.
     pub masked_hover_capable: u32,
+    /// One of `TVMD_FAULT_SOURCE_*`: the check that named `agent`.
+    pub source: u32,
 }
 
 /// Fills `report` (whose `size` the caller sets) with the detector's latest report: after a
@@ -88,6 +100,7 @@ pub unsafe extern "C" fn tvmd_fault_report(
     if let Some(r) = controller.fault_report() {
         out.statistic = r.statistic;
         out.threshold = r.threshold;
+        let source = r.source;
         let named = |agent: usize, kind: &FaultKind<f32>, out: &mut TvmdFaultReport| {
             out.agent = i32::try_from(agent).unwrap_or(-1);
             match *kind {
@@ -97,7 +110,12 @@ pub unsafe extern "C" fn tvmd_fault_report(
                     out.efficiency = efficiency;
                 }
                 FaultKind::StuckGimbal => out.kind = TVMD_FAULT_KIND_STUCK_GIMBAL,
+                FaultKind::LinkLoss => out.kind = TVMD_FAULT_KIND_LINK_LOSS,
             }
+            out.source = match source {
+                FaultSource::Residual => TVMD_FAULT_SOURCE_RESIDUAL,
+                FaultSource::Reports => TVMD_FAULT_SOURCE_REPORTS,
+            };
         };
         match &r.verdict {
             FaultVerdict::Nominal => out.verdict = TVMD_FAULT_VERDICT_NOMINAL,

@@ -20,11 +20,11 @@ pub(crate) type FfiController =
     Controller<f32, TVMD_MAX_AGENTS, AnyAllocator<f32, TVMD_MAX_AGENTS>>;
 
 /// Bytes of a [`TvmdController`]: at least the controller's size on every supported target
-/// (checked at compile time), with room for the core to grow within one ABI version. 8,192 at
+/// (checked at compile time), with room for the core to grow within one ABI version. 9,216 at
 /// the 16-agent capacity (the controller keeps its allocator's working set, so no entry point
-/// holds it on the stack), 4,096 at the 4-agent one.
+/// holds it on the stack, and the agents' reports), 4,096 at the 4-agent one.
 #[cfg(not(feature = "capacity-4"))]
-pub const TVMD_CONTROLLER_SIZE: usize = 8192;
+pub const TVMD_CONTROLLER_SIZE: usize = 9216;
 
 /// Bytes of a [`TvmdController`] at the 4-agent capacity (feature `capacity-4`).
 #[cfg(feature = "capacity-4")]

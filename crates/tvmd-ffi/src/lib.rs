@@ -40,6 +40,7 @@
 extern crate std;
 
 pub mod actuator;
+pub mod agent_report;
 mod blueprint;
 pub mod compensation;
 pub mod config;
@@ -66,8 +67,10 @@ pub const TVMD_MAX_AGENTS: usize = 4;
 
 /// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 /// of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
-/// the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`).
-pub const TVMD_ABI_VERSION: u32 = 4;
+/// the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`;
+/// 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source` and the
+/// 9,216-byte handle at 16 agents).
+pub const TVMD_ABI_VERSION: u32 = 5;
 
 /// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).
 #[no_mangle]

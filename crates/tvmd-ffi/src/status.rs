@@ -102,6 +102,12 @@ pub const TVMD_ERR_MAP_SERVO: TvmdStatus = 53;
 /// motor channels differ.
 pub const TVMD_ERR_ACTUATOR_VALUE: TvmdStatus = 54;
 
+/// `tvmd_set_agent_report`: the report's agent is not in the team.
+pub const TVMD_ERR_REPORT_AGENT: TvmdStatus = 60;
+/// `tvmd_set_agent_report`: the controller was created without fault detection
+/// (`fault.mode = TVMD_FAULT_OFF`): nothing would read the report.
+pub const TVMD_ERR_REPORT_DETECTION_OFF: TvmdStatus = 61;
+
 /// The code of a core input error.
 pub fn input_status(error: &InputError) -> TvmdStatus {
     match error {
@@ -209,6 +215,8 @@ pub extern "C" fn tvmd_status_name(status: TvmdStatus) -> *const core::ffi::c_ch
         TVMD_ERR_MAP_DUPLICATE_CHANNEL => "TVMD_ERR_MAP_DUPLICATE_CHANNEL\0",
         TVMD_ERR_MAP_SERVO => "TVMD_ERR_MAP_SERVO\0",
         TVMD_ERR_ACTUATOR_VALUE => "TVMD_ERR_ACTUATOR_VALUE\0",
+        TVMD_ERR_REPORT_AGENT => "TVMD_ERR_REPORT_AGENT\0",
+        TVMD_ERR_REPORT_DETECTION_OFF => "TVMD_ERR_REPORT_DETECTION_OFF\0",
         _ => "TVMD_UNKNOWN_STATUS\0",
     };
     name.as_ptr().cast()

@@ -158,6 +158,18 @@ pub enum FaultKindName {
     PartialLoss,
     /// Its force turned away from the command.
     StuckGimbal,
+    /// Its reports stopped past the link timeout (named from the agents' reports only).
+    LinkLoss,
+}
+
+/// Which check named the agent (`tvmd_core::FaultSource`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FaultSourceName {
+    /// The wrench residual (the vehicle's motion).
+    Residual,
+    /// The agents' own reports checked against their commands.
+    Reports,
 }
 
 /// The fault detector's report of one period (logged on `/fault`), when the controller runs
@@ -185,6 +197,9 @@ pub struct FaultDiagnostics {
     /// The agent the controller masked itself this period (`response = "mask"`).
     #[serde(default)]
     pub masked: Option<usize>,
+    /// The check that named `agent` (none when no agent is named).
+    #[serde(default)]
+    pub source: Option<FaultSourceName>,
 }
 
 /// Optional diagnostics returned by a controller; every present part is logged and recorded.

@@ -393,7 +393,7 @@ proto_messages! {
         verdict: String => (string, tag = 4);
         /// The isolated agent, if any.
         agent: Option<u32> => (uint32, optional, tag = 5);
-        /// `loss`, `partial-loss`, `stuck-gimbal`, or empty.
+        /// `loss`, `partial-loss`, `stuck-gimbal`, `link-loss`, or empty.
         kind: String => (string, tag = 6);
         /// The fraction delivered, for a partial loss.
         efficiency: Option<f64> => (double, optional, tag = 7);
@@ -401,6 +401,8 @@ proto_messages! {
         masked: Option<u32> => (uint32, optional, tag = 8);
         /// Consecutive periods the agent has been the candidate (suspected).
         periods: u32 => (uint32, tag = 9);
+        /// The check that named the agent: `residual`, `reports`, or empty.
+        source: String => (string, tag = 10);
     }
 }
 

@@ -3,8 +3,8 @@
 //! cycle recorder (module `recording`). The simulator's `TvmdController` drives any of them alike.
 
 use tvmd_core::{
-    AgentCommand, AnyAllocator, FailureMask, FaultMasking, FaultReport, HoverCapability, Real,
-    Reference, RigidState,
+    AgentCommand, AgentReading, AnyAllocator, FailureMask, FaultMasking, FaultReport,
+    HoverCapability, Real, Reference, ReportError, RigidState,
 };
 
 /// Agent capacity of the controller the simulator runs (the core's const generic `N`).
@@ -69,6 +69,19 @@ pub trait CoreEngine<T: Real> {
     fn fault_masking(&self) -> Option<FaultMasking<T>> {
         None
     }
+
+    /// [`tvmd_core::Controller::set_report`]: agent `agent`'s own report for the next cycle;
+    /// the inner `Result` is the core's answer. By default an engine that does not carry the
+    /// agents' reports (the processor-in-the-loop link, the cycle recorder): an error that
+    /// ends the run, never a report dropped in silence.
+    fn set_report(
+        &mut self,
+        agent: usize,
+        reading: AgentReading<T>,
+    ) -> Result<Result<(), ReportError>, BoxedError> {
+        let _ = (agent, reading);
+        Err("this engine does not carry the agents' reports ([reports])".into())
+    }
 }
 
 impl<T: Real> CoreEngine<T> for CoreController<T> {
@@ -107,5 +120,13 @@ impl<T: Real> CoreEngine<T> for CoreController<T> {
 
     fn fault_masking(&self) -> Option<FaultMasking<T>> {
         tvmd_core::Controller::fault_masking(self)
+    }
+
+    fn set_report(
+        &mut self,
+        agent: usize,
+        reading: AgentReading<T>,
+    ) -> Result<Result<(), ReportError>, BoxedError> {
+        Ok(tvmd_core::Controller::set_report(self, agent, reading))
     }
 }

@@ -13,7 +13,7 @@ use crate::afs::PyAfs;
 use crate::allocation::{make_allocator, rate_limits_arg, AllocationData};
 use crate::controller_args::{argument_error, deep_copy, period_arg};
 use crate::convert::{class_arg, commands_array, finite, iteration_cap, law_arg, matrix};
-use crate::convert::{fault_detection_arg, record_to_py, round_cap_arg};
+use crate::convert::{fault_detection_arg, record_to_py, reports_arg, round_cap_arg, set_reports};
 use crate::convert::{relaxation_arg, Int, CAPACITY};
 use crate::errors::{cycle_error, OrRaise};
 use crate::law::{gains_arg, reference_arg, state_arg, PyGains};
@@ -225,6 +225,12 @@ impl PyController {
         let mut diagnostics = tvmd_sim::control::fault_diagnostics(report);
         diagnostics.masked = this.inner.fault_masking().map(|m| m.agent);
         record_to_py(slf.py(), &diagnostics).map(Some)
+    }
+
+    #[doc = include_str!("../docstrings/tvmd.Controller.set_reports.txt")]
+    fn set_reports(slf: &Bound<'_, Self>, reports: &Bound<'_, PyAny>) -> PyResult<()> {
+        let readings = reports_arg(reports, borrow(slf)?.inner.team().len())?;
+        set_reports(&mut borrow_mut(slf)?.inner, &readings)
     }
 
     #[doc = include_str!("../docstrings/tvmd.Controller.set_failures.txt")]

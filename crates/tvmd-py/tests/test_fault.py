@@ -71,3 +71,55 @@ def test_an_uninformed_loss_is_found_and_masked_in_the_simulator():
     assert 4.0 < fault["masked"]["time"] < 4.5
     assert fault["first_loss"]["agent"] == 0
     assert fault["max_statistic"] > fault["threshold"]
+
+
+def reports_of(output, dead=()):
+    """Each agent's report of the commands of `output` (10 ms old); agents in `dead` report a
+    stopped rotor."""
+    rows = []
+    for i, (eta_x, eta_y, thrust, _omega) in enumerate(output.commands):
+        rows.append([0.0 if i in dead else thrust, eta_x, eta_y, 0.01])
+    return rows
+
+
+def test_agents_reports_name_a_stopped_rotor_and_agreeing_ones_change_nothing():
+    c = tvmd.Controller(team(), fault_detection="mask")
+    plain = tvmd.Controller(team(), fault_detection="mask")
+    state = {"position": [0.0, 0.0, 1.5]}
+    out = c.step(state, state)
+    plain.step(state, state)
+    for _ in range(10):
+        c.set_reports(reports_of(out))
+        out = c.step(state, state)
+        assert (out.commands == plain.step(state, state).commands).all()
+    assert c.fault_report()["source"] is None
+    # Agent 1's rotor reported stopped: two reports confirm the loss and the mask follows.
+    for _ in range(2):
+        c.set_reports(reports_of(out, dead=(1,)))
+        out = c.step(state, state)
+    r = c.fault_report()
+    assert (r["verdict"], r["agent"], r["kind"], r["source"]) == ("confirmed", 1, "loss", "reports")
+    assert r["masked"] == 1 and out.commands[1][2] == 0.0
+
+
+def test_reports_rows_of_nan_are_no_report_and_bad_ones_name_their_row():
+    c = tvmd.Controller(team(), fault_detection="report")
+    nan = float("nan")
+    c.set_reports([[nan] * 4] * 4)
+    with pytest.raises(ValueError, match="reports"):
+        c.set_reports([[1.0, 0.0, 0.0, 0.0]] * 3)
+    with pytest.raises(ValueError, match="row 2: .*age"):
+        c.set_reports([[1.0, 0.0, 0.0, 0.0]] * 2 + [[1.0, 0.0, 0.0, -1.0], [nan] * 4])
+    with pytest.raises(ValueError, match="row 0"):
+        c.set_reports([[nan, 0.0, 0.0, 0.0]] + [[nan] * 4] * 3)
+    with pytest.raises(ValueError, match="fault detection"):
+        tvmd.Controller(team()).set_reports([[1.0, 0.0, 0.0, 0.0]] * 4)
+
+
+def test_the_simulator_passes_its_agents_reports_to_the_controller():
+    text = (ROOT / "scenarios/faults/loss-hover.toml").read_text()
+    result = tvmd.sim.run(toml=text + '\n[reports]\ndead_esc = "zero"\n', team="a6-inc")
+    masked = result.summary["fault"]["masked"]
+    # 100 Hz reports, 20 ms late: named from the reports, two reports after the first zero.
+    assert (masked["agent"], masked["kind"], masked["source"]) == (0, "loss", "reports")
+    assert 4.0 < masked["time"] <= 4.05

@@ -2,6 +2,8 @@
 //! [`FlightOutput`] (commands and [`Diagnostics`]). The loop (module `sim`) calls it; the tvmd
 //! adapter (module `control`) and test controllers implement it.
 
+use serde::Serialize;
+
 use crate::diagnostics::Diagnostics;
 use crate::error::BoxedError;
 use tvmd_plant::actuators::ActuatorCommand;
@@ -22,6 +24,20 @@ pub struct FlightOutput {
     pub diagnostics: Diagnostics,
 }
 
+/// The newest report of one agent at a tick (`[reports]`: the simulator's agents' own
+/// reports).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AgentReport {
+    /// Rotor speed as the thrust `k omega^2` it makes with an intact propeller (N).
+    pub thrust: f64,
+    /// Inner gimbal angle `eta_x` (rad).
+    pub eta_x: f64,
+    /// Outer gimbal angle `eta_y` (rad).
+    pub eta_y: f64,
+    /// How long ago it was measured (s).
+    pub age: f64,
+}
+
 /// What a flight controller is given at one controller tick `t_k`: the one definition of a
 /// step's inputs, shared by every controller and by the loop.
 #[derive(Clone, Copy, Debug)]
@@ -34,6 +50,9 @@ pub struct FlightInput<'a> {
     pub reference: &'a ReferenceSample,
     /// `failed[i]`: agent `i` failed and the controller is told so.
     pub failed: &'a [bool],
+    /// Per agent, its newest report arrived by `t_k` (`None`: none yet); empty without
+    /// `[reports]`.
+    pub reports: &'a [Option<AgentReport>],
 }
 
 impl<'a> FlightInput<'a> {
@@ -49,7 +68,13 @@ impl<'a> FlightInput<'a> {
             state,
             reference,
             failed,
+            reports: &[],
         }
+    }
+
+    /// The same inputs with the agents' reports.
+    pub fn with_reports(self, reports: &'a [Option<AgentReport>]) -> Self {
+        Self { reports, ..self }
     }
 }
 

@@ -191,6 +191,11 @@ fn fault(f: &proto::Fault) -> Result<FaultDiagnostics, SimError> {
         efficiency: f.efficiency,
         periods: f.periods,
         masked: f.masked.map(|i| i as usize),
+        source: if f.source.is_empty() {
+            None
+        } else {
+            Some(named(f.t, "source", &f.source)?)
+        },
     })
 }
 

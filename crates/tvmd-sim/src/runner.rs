@@ -411,8 +411,7 @@ pub fn record_cycles(scenario: &Scenario, cycles: usize) -> Result<CycleRecordin
     let config = wire_config(&scenario)?;
     let (core, n) = core_of_scenario::<f32>(&scenario)?;
     let mut controller: TvmdController<f32, Recorder<CoreController<f32>>> =
-        TvmdController::new(Recorder::new(core, n), n)
-            .with_failure_response(scenario.failure_response);
+        TvmdController::new(Recorder::new(core, n), n).for_scenario(&scenario);
     let mut sim = Simulation::with_options(&scenario, SimOptions::default())?;
     sim.run(&mut controller, None)?;
     let recorder = controller.engine();

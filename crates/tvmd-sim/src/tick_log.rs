@@ -214,6 +214,7 @@ fn fault(t: f64, f: &FaultDiagnostics) -> proto::Fault {
         efficiency: f.efficiency,
         masked: f.masked.and_then(|i| u32::try_from(i).ok()),
         periods: f.periods,
+        source: f.source.as_ref().map(kebab).unwrap_or_default(),
     }
 }
 

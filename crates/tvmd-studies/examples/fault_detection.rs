@@ -21,9 +21,11 @@ use tvmd_scenario::{
     Failure, FaultDetectionConfig, FaultResponseConfig, LawConfig, OnHoverLoss, Scenario,
 };
 use tvmd_sim::{run_scenario, FaultSummary, RunResult};
-use tvmd_studies::montecarlo::{Conditions, Distributions, Draw};
+use tvmd_studies::montecarlo::Conditions;
 
-const TEAMS: [&str; 3] = ["a4-inc", "a6-inc", "a8-inc"];
+mod fault_common;
+use fault_common::{map, quantiles, Phase, TEAMS};
+
 const SEED: u64 = 47;
 
 /// The detector of every flight: the recommended one with `"mask"`, or another stated model
@@ -36,49 +38,11 @@ fn detection() -> FaultDetectionConfig {
     d
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Phase {
-    Hover,
-    Wind,
-    Tilt,
-}
-
-impl Phase {
-    fn name(self) -> &'static str {
-        match self {
-            Self::Hover => "hover",
-            Self::Wind => "wind",
-            Self::Tilt => "tilt",
-        }
-    }
-
-    /// When a fault strikes in this phase.
-    fn fault_time(self) -> f64 {
-        match self {
-            Self::Hover | Self::Wind => 4.0,
-            // Mid-tilt: the reference rolls over 4-10 s.
-            Self::Tilt => 7.0,
-        }
-    }
-}
-
 /// The flight of `team` in `phase` with the offset-free law and detection (`"mask"`), a Monte
 /// Carlo draw `index` and the default conditions.
 fn flight(team: &str, phase: Phase, index: u64) -> Result<Scenario, Box<dyn std::error::Error>> {
-    let mut s = match phase {
-        Phase::Hover => Scenario::builtin("hover")?,
-        Phase::Wind => Scenario::builtin("wind")?,
-        Phase::Tilt => Scenario::default(),
-    };
-    s.team.preset = Some(team.into());
-    s.team.agents = None;
-    s.law = LawConfig::default();
-    s.fault_detection = Some(detection());
-    let n = s.team_body()?.len();
-    let mut s = Draw::new(&Distributions::default(), SEED, index, n).apply(&s)?;
-    Conditions::default().apply(&mut s, SEED, index);
-    s.validate()?;
-    Ok(s)
+    let conditions = Conditions::default();
+    fault_common::flight(team, phase, (SEED, index), detection(), &conditions, |_| {})
 }
 
 fn kind_name(k: FailureKind) -> &'static str {
@@ -165,15 +129,6 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
     })
 }
 
-fn quantiles(mut v: Vec<f64>) -> String {
-    if v.is_empty() {
-        return "-".into();
-    }
-    v.sort_by(f64::total_cmp);
-    let median = v[v.len() / 2];
-    format!("{:.2} / {:.2}", median, v[v.len() - 1])
-}
-
 fn fault_table(runs: &[FaultRun]) {
     println!("| team | fault | phase | flights | suspected (right agent) | delay median / worst (s) | confirmed (right agent) | delay median / worst (s) | loss confirmed, masked | delay median / worst (s) | wrong agent | largest statistic / k in the first second: smallest / median / largest |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
@@ -198,7 +153,7 @@ fn fault_table(runs: &[FaultRun]) {
                             Err(()) => wrong += 1,
                         }
                     }
-                    (delays.len(), quantiles(delays))
+                    (delays.len(), quantiles(delays, 2))
                 };
                 let (ns, ds) = column(&|r| r.fault.first_suspected);
                 let (nc, dc) = column(&|r| r.fault.first_confirmed);
@@ -368,19 +323,6 @@ fn informed_late() -> Result<(), Box<dyn std::error::Error>> {
         println!();
     }
     Ok(())
-}
-
-/// `f(k, item)` on `jobs` threads, the results in order (failed flights dropped).
-fn map<T: Sync, R: Send>(
-    items: &[T],
-    jobs: usize,
-    f: impl Fn(usize, &T) -> Option<R> + Sync,
-) -> Vec<R> {
-    tvmd_sim::pool::map_in_order(items, jobs, f)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .collect()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -4,7 +4,8 @@
 //! the host does.
 
 use tvmd_core::{
-    FailureMask, FaultDetection, FaultKind, FaultMasking, FaultReport, FaultResponse, FaultVerdict,
+    FailureMask, FaultDetection, FaultKind, FaultMasking, FaultReport, FaultResponse, FaultSource,
+    FaultVerdict,
 };
 
 use crate::{get_hover, mask_bits, mask_of, put_hover, Reader, Writer, AGENTS, HOVER_WORDS};
@@ -12,8 +13,8 @@ use crate::{get_hover, mask_bits, mask_of, put_hover, Reader, Writer, AGENTS, HO
 /// Words of [`put_fault_detection`]: flag, `epsilon`, `k`, persistence, response.
 pub const FAULT_DETECTION_WORDS: usize = 5;
 
-/// Words of [`put_fault_answer`]: the report (flag, verdict 5, statistic, threshold, the two
-/// misfits), the masking (flag, agent, hover flag, [`HOVER_WORDS`]) and the mask in force.
+/// Words of [`put_fault_answer`]: the report (flag, verdict 5 with the source in the kind
+/// word's second byte, statistic, threshold, the two misfits), the masking (flag, agent, hover flag, [`HOVER_WORDS`]) and the mask in force.
 pub const FAULT_ANSWER_WORDS: usize = 1 + 5 + 4 + 3 + HOVER_WORDS + 1;
 
 /// Appends the fault detection settings (all zero when off).
@@ -69,7 +70,7 @@ pub fn put_fault_answer(w: &mut Writer<'_>, answer: &FaultAnswer) -> Option<()> 
         None => w.f32s(&[0.0; 10])?,
         Some(report) => {
             w.u32(1)?;
-            put_verdict(w, &report.verdict)?;
+            put_verdict(w, &report.verdict, report.source)?;
             w.f32s(&[
                 report.statistic,
                 report.threshold,
@@ -103,10 +104,11 @@ pub fn get_fault_answer(r: &mut Reader<'_>) -> Option<FaultAnswer> {
             None
         }
         _ => {
-            let verdict = get_verdict(r)?;
+            let (verdict, source) = get_verdict(r)?;
             let [statistic, threshold, best_misfit, runner_up_misfit] = r.array()?;
             Some(FaultReport {
                 verdict,
+                source,
                 statistic,
                 threshold,
                 best_misfit,
@@ -131,8 +133,9 @@ pub fn get_fault_answer(r: &mut Reader<'_>) -> Option<FaultAnswer> {
     })
 }
 
-/// Verdict tag, agent, kind tag, efficiency, periods.
-fn put_verdict(w: &mut Writer<'_>, v: &FaultVerdict<f32>) -> Option<()> {
+/// Verdict tag, agent, kind tag (the source, 0 residual or 1 reports, in its second byte),
+/// efficiency, periods.
+fn put_verdict(w: &mut Writer<'_>, v: &FaultVerdict<f32>, source: FaultSource) -> Option<()> {
     let (tag, agent, kind, periods) = match *v {
         FaultVerdict::Nominal => (0, 0, None, 0),
         FaultVerdict::Unexplained => (1, 0, None, 0),
@@ -149,23 +152,35 @@ fn put_verdict(w: &mut Writer<'_>, v: &FaultVerdict<f32>) -> Option<()> {
         None | Some(FaultKind::Loss) => (0, 0.0),
         Some(FaultKind::PartialLoss { efficiency }) => (1, efficiency),
         Some(FaultKind::StuckGimbal) => (2, 0.0),
+        Some(FaultKind::LinkLoss) => (3, 0.0),
     };
-    w.u32(kind)?;
+    let source = match source {
+        FaultSource::Residual => 0,
+        FaultSource::Reports => 1 << 8,
+    };
+    w.u32(kind | source)?;
     w.f32(efficiency)?;
     w.u32(periods)
 }
 
-fn get_verdict(r: &mut Reader<'_>) -> Option<FaultVerdict<f32>> {
+fn get_verdict(r: &mut Reader<'_>) -> Option<(FaultVerdict<f32>, FaultSource)> {
     let tag = r.u32()?;
     let agent = r.u32()? as usize;
-    let kind = match (r.u32()?, r.f32()?) {
+    let word = r.u32()?;
+    let source = match word >> 8 {
+        0 => FaultSource::Residual,
+        1 => FaultSource::Reports,
+        _ => return None,
+    };
+    let kind = match (word & 0xff, r.f32()?) {
         (0, _) => FaultKind::Loss,
         (1, efficiency) => FaultKind::PartialLoss { efficiency },
         (2, _) => FaultKind::StuckGimbal,
+        (3, _) => FaultKind::LinkLoss,
         _ => return None,
     };
     let periods = r.u32()?;
-    Some(match tag {
+    let verdict = match tag {
         0 => FaultVerdict::Nominal,
         1 => FaultVerdict::Unexplained,
         2 => FaultVerdict::Suspected {
@@ -175,7 +190,8 @@ fn get_verdict(r: &mut Reader<'_>) -> Option<FaultVerdict<f32>> {
         },
         3 => FaultVerdict::Confirmed { agent, kind },
         _ => return None,
-    })
+    };
+    Some((verdict, source))
 }
 
 #[cfg(test)]
@@ -205,6 +221,7 @@ mod tests {
         };
         let report = |verdict| FaultReport {
             verdict,
+            source: FaultSource::Residual,
             statistic: 7.5,
             threshold: 5.0,
             best_misfit: 0.5,
@@ -234,6 +251,17 @@ mod tests {
                     agent: 2,
                     hover: Some(hover),
                 }),
+                failures,
+            },
+            FaultAnswer {
+                report: Some(FaultReport {
+                    source: FaultSource::Reports,
+                    ..report(FaultVerdict::Confirmed {
+                        agent: 1,
+                        kind: FaultKind::LinkLoss,
+                    })
+                }),
+                masking: None,
                 failures,
             },
             FaultAnswer {

@@ -22,6 +22,7 @@ use crate::fault::detection::{
 };
 use crate::fault::{
     loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
+    ReportCheck, ReportGains, ReportState,
 };
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::linalg::{wrench_parts, EuclideanNorm};
@@ -85,6 +86,13 @@ pub(super) struct FaultMonitor<T: Real, const N: usize> {
     undelivered: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
+    /// The agents' reports and their check ([`crate::fault::reports`]; idle while no agent
+    /// reports).
+    pub(super) reports: ReportState<T, N>,
+    pub(super) check: ReportCheck<T>,
+    /// The check's per-period gains at the controller's period ([`FAULT_ACTUATOR_LAG`]) and
+    /// the team's maximum thrust.
+    pub(super) gains: ReportGains<T>,
 }
 
 impl<T: Real, const N: usize> FaultMonitor<T, N> {
@@ -125,12 +133,21 @@ impl<T: Real, const N: usize> FaultMonitor<T, N> {
             undelivered: lit::<T>(FAULT_ACTUATOR_LAG) / period * closed,
             report: None,
             masked: None,
+            reports: ReportState::new(),
+            check: *detection.report_check(),
+            gains: detection.report_check().gains(
+                period,
+                lit(FAULT_ACTUATOR_LAG),
+                team.limits().max_thrust(),
+            ),
         }))
     }
 
-    /// Forgets the candidate, the residual and the report (a controller reset).
+    /// Forgets the candidate, the residual, the report and the report check's models (a
+    /// controller reset, a landing; the agents' reports stay).
     pub(super) fn reset(&mut self) {
         self.state.reset();
+        self.reports.forget();
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
         self.wrench = Vector6::zeros();
@@ -260,6 +277,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             // half of them above) average under 1 and read as a partial loss.
             *kind = loss_kind(monitor.raw_share.max(T::zero()).min(T::one()));
         }
+        self.check_reports(&mut report);
+        let Some(monitor) = self.fault.as_mut() else {
+            return;
+        };
         monitor.report = Some(report);
         // The baseline follows the slow model error, not a fault: held above half the threshold.
         if report.statistic <= report.threshold * lit(0.5) {
@@ -269,7 +290,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         }
         let FaultVerdict::Confirmed {
             agent,
-            kind: FaultKind::Loss,
+            kind: FaultKind::Loss | FaultKind::LinkLoss,
         } = report.verdict
         else {
             return;

@@ -8,7 +8,7 @@
 //! the largest agent distance `||p_i||`, so one setting fits every team (a loss of one of `n`
 //! agents at hover is about `1 / (n epsilon)` noise units in force alone).
 
-use crate::fault::FaultDetector;
+use crate::fault::{FaultDetector, ReportCheck};
 use crate::foundation::error::ConfigError;
 use crate::foundation::real::{lit, Real};
 
@@ -41,13 +41,16 @@ pub enum FaultResponse {
     #[default]
     Report,
     /// Mask the agent ([`crate::Controller::set_failures`]) and report it with the hover-capability
-    /// certificate ([`crate::Controller::fault_masking`]). Partial losses and stuck gimbals are
-    /// reported only.
+    /// certificate ([`crate::Controller::fault_masking`]): a confirmed loss from either source
+    /// (the residual or the agent's reports) and a confirmed link loss. Partial losses and
+    /// stuck gimbals are reported only.
     Mask,
 }
 
 /// The controller's fault detection: the stated relative model error, the threshold in its
-/// units, the persistence and the response. Validated: each finite and positive
+/// units, the persistence and the response, and the check of the agents' own reports (used
+/// only for agents that report, [`crate::Controller::set_report`]: recommended values unless
+/// [`Self::with_report_check`] states others). Validated: each finite and positive
 /// (`persistence >= 1`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaultDetection<T: Real> {
@@ -55,6 +58,7 @@ pub struct FaultDetection<T: Real> {
     threshold: T,
     persistence: u32,
     response: FaultResponse,
+    reports: ReportCheck<T>,
 }
 
 impl<T: Real> FaultDetection<T> {
@@ -76,6 +80,7 @@ impl<T: Real> FaultDetection<T> {
             threshold,
             persistence,
             response,
+            reports: ReportCheck::recommended(),
         })
     }
 
@@ -86,6 +91,7 @@ impl<T: Real> FaultDetection<T> {
             threshold: lit(FAULT_THRESHOLD),
             persistence: FAULT_PERSISTENCE,
             response,
+            reports: ReportCheck::recommended(),
         }
     }
 
@@ -112,6 +118,16 @@ impl<T: Real> FaultDetection<T> {
     /// The same detection with another response.
     pub fn with_response(self, response: FaultResponse) -> Self {
         Self { response, ..self }
+    }
+
+    /// The check of the agents' reports ([`ReportCheck::recommended`] unless set).
+    pub fn report_check(&self) -> &ReportCheck<T> {
+        &self.reports
+    }
+
+    /// The same detection with another report check.
+    pub fn with_report_check(self, reports: ReportCheck<T>) -> Self {
+        Self { reports, ..self }
     }
 
     /// The detector for a team of weight `m_C g` (N) whose farthest agent is `arm` (m) from

@@ -14,6 +14,30 @@ pub enum FaultKind<T: Real> {
     },
     /// The agent's force turned away from its command: a stuck or slipping gimbal.
     StuckGimbal,
+    /// The agent's reports stopped for longer than the stated link timeout
+    /// ([`crate::fault::ReportCheck::link_timeout`]): its command link is taken as gone (named
+    /// by the report check only; the residual names what the agent then does).
+    LinkLoss,
+}
+
+/// Which check named the verdict's agent.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FaultSource {
+    /// The wrench residual: the vehicle's motion ([`crate::fault::FaultState`]).
+    #[default]
+    Residual,
+    /// The agents' own reports checked against their commands ([`crate::fault::ReportState`]).
+    Reports,
+}
+
+impl FaultSource {
+    /// `"residual"` or `"reports"`.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Residual => "residual",
+            Self::Reports => "reports",
+        }
+    }
 }
 
 /// The detector's verdict this period.
@@ -43,11 +67,14 @@ pub enum FaultVerdict<T: Real> {
 
 /// One period's report: the verdict, the statistic and the threshold it was compared with, and
 /// the isolation's best and runner-up misfits (in noise units; the largest finite `T` when no
-/// agent was fitted).
+/// agent was fitted), and the check that named the verdict's agent.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaultReport<T: Real> {
     /// The verdict.
     pub verdict: FaultVerdict<T>,
+    /// The check that named the verdict's agent ([`FaultSource::Residual`] for a verdict that
+    /// names none).
+    pub source: FaultSource,
     /// `||r||_Sigma`.
     pub statistic: T,
     /// `k`.

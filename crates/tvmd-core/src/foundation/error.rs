@@ -122,6 +122,14 @@ pub enum ConfigField {
     /// Fault detection without the residual it reads (it needs the disturbance observer,
     /// [`crate::OffsetFree::Observer`]).
     FaultResidual,
+    /// A tolerance of [`crate::fault::ReportCheck`] (thrust or gimbal angle).
+    ReportTolerance,
+    /// The servo rate of [`crate::fault::ReportCheck`].
+    ReportServoRate,
+    /// The link timeout of [`crate::fault::ReportCheck`].
+    ReportLinkTimeout,
+    /// The persistence of [`crate::fault::ReportCheck`].
+    ReportPersistence,
 }
 
 impl ConfigField {
@@ -173,6 +181,10 @@ impl ConfigField {
             Self::FaultThreshold => "fault.threshold",
             Self::FaultPersistence => "fault.persistence",
             Self::FaultResidual => "fault.residual",
+            Self::ReportTolerance => "fault.report_tolerance",
+            Self::ReportServoRate => "fault.report_servo_rate",
+            Self::ReportLinkTimeout => "fault.report_link_timeout",
+            Self::ReportPersistence => "fault.report_persistence",
         }
     }
 }

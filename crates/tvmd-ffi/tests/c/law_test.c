@@ -86,7 +86,7 @@ static float distance_to_minus(const float compensation[3], const float d[3]) {
 
 static void test_configs(void) {
   TvmdConfig def = filled(tvmd_config_default), paper = filled(tvmd_config_paper), bad;
-  CHECK(TVMD_ABI_VERSION == 4 && tvmd_abi_version() == 4);
+  CHECK(TVMD_ABI_VERSION == 5 && tvmd_abi_version() == 5);
   CHECK_STATUS(tvmd_config_default(NULL), TVMD_ERR_NULL_POINTER);
   bad = def;
   bad.size = sizeof bad - 4;

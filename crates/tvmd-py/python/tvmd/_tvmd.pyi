@@ -1019,10 +1019,29 @@ class Controller:
             dict: ``statistic`` (the residual in noise units) and the ``threshold`` it was
             compared with; ``verdict`` (``"nominal"``, ``"unexplained"``, ``"suspected"`` or
             ``"confirmed"``); ``agent`` (the isolated agent, or None), ``kind`` (``"loss"``,
-            ``"partial-loss"``, ``"stuck-gimbal"`` or None) and ``efficiency`` (the fraction
-            delivered, for a partial loss); ``periods`` (consecutive periods of a suspicion);
-            ``masked`` (the agent the controller masked itself, with ``fault_detection="mask"``,
-            or None).
+            ``"partial-loss"``, ``"stuck-gimbal"``, ``"link-loss"`` or None) and ``efficiency``
+            (the fraction delivered, for a partial loss); ``periods`` (consecutive periods of a
+            suspicion); ``masked`` (the agent the controller masked itself, with
+            ``fault_detection="mask"``, or None); ``source`` (``"residual"`` or ``"reports"``:
+            the check that named ``agent``, ``set_reports``; None when no agent is named).
+        """
+    def set_reports(self, reports: ArrayLike) -> None:
+        """Gives the fault detection each agent's newest own report (issue 60): what it measured of its
+        rotor and gimbal, checked at the next ``step`` against the commands it answers. The
+        controller ages each report by its period at every step until a newer one replaces it; the same
+        report given again (its age grown) is not counted twice, and an agent whose report grows older
+        than the link timeout (0.1 s) is named with ``kind="link-loss"``. ``fault_report()["source"]``
+        says whether the reports or the residual named an agent.
+
+        Args:
+            reports: (n, 4) rows ``(thrust, eta_x, eta_y, age)``: the rotor speed as the thrust it
+                makes (N), the gimbal angles (rad) and the report's age (s), as
+                ``tvmd.sim.Observation.reports``; a row all NaN is an agent with no report (kept as
+                before).
+
+        Raises:
+            ValueError: another shape, a row with a NaN or infinite value among finite ones, a negative
+                thrust or age (the message names the row), or a controller without fault detection.
         """
     def set_failures(self, failed: _Failed = None) -> "HoverCapability":
         """Marks agents failed (None or [] for none). A failed agent leaves ``n``, ``n_x``/``n_y`` and ``M``

@@ -5,11 +5,12 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::flight::AgentReport;
 use tvmd_plant::actuators::ActuatorCommand;
 use tvmd_plant::physics::PlantState;
 use tvmd_plant::reference::ReferenceSample;
 pub use tvmd_scenario::core_float::CoreFloat;
-use tvmd_scenario::core_float::{matrix_to_core, vector_to_core};
+use tvmd_scenario::core_float::{matrix_to_core, to_core, vector_to_core};
 
 /// `x` in f64 (exact).
 pub fn to_sim<T: CoreFloat>(x: T) -> f64 {
@@ -51,6 +52,20 @@ pub fn core_reference<T: CoreFloat>(r: &ReferenceSample) -> tvmd_core::Reference
         angular_velocity: vector_to_core(&r.omega),
         angular_acceleration: vector_to_core(&r.omega_dot),
     }
+}
+
+/// The core's reading of a simulated report. The simulator's Gaussian noise can take a stopped
+/// rotor's thrust below zero, which no speed sensor reports (an ESC's rpm is at least 0): that
+/// thrust is read as 0. Errors: a non-finite value ([`tvmd_core::ReportError`]).
+pub fn core_reading<T: CoreFloat>(
+    r: &AgentReport,
+) -> Result<tvmd_core::AgentReading<T>, tvmd_core::ReportError> {
+    tvmd_core::AgentReading::new(
+        to_core(if r.thrust < 0.0 { 0.0 } else { r.thrust }),
+        to_core(r.eta_x),
+        to_core(r.eta_y),
+        to_core(r.age),
+    )
 }
 
 /// The simulator's actuator command of a core command.

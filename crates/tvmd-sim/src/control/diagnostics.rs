@@ -7,9 +7,10 @@ use super::convert::{array_to_sim, matrix_to_sim, to_sim, vector_to_sim, CoreFlo
 use super::CoreOutput;
 use crate::diagnostics::{
     AllocationDiagnostics, ControlDiagnostics, Diagnostics, FaultDiagnostics, FaultKindName,
-    FaultVerdictName, LyapunovDiagnostics, NullSpaceDiagnostics, PlannerDiagnostics,
+    FaultSourceName, FaultVerdictName, LyapunovDiagnostics, NullSpaceDiagnostics,
+    PlannerDiagnostics,
 };
-use tvmd_core::{FaultKind, FaultReport, FaultVerdict, PlannerStatus};
+use tvmd_core::{FaultKind, FaultReport, FaultSource, FaultVerdict, PlannerStatus};
 use tvmd_plant::math::{planned_roll, to_rows};
 
 /// The diagnostics of `out` for a team of `n` agents, with the controller's failure note.
@@ -107,7 +108,12 @@ pub fn fault_diagnostics<T: CoreFloat>(report: &FaultReport<T>) -> FaultDiagnost
             (Some(FaultKindName::PartialLoss), Some(to_sim(efficiency)))
         }
         Some(FaultKind::StuckGimbal) => (Some(FaultKindName::StuckGimbal), None),
+        Some(FaultKind::LinkLoss) => (Some(FaultKindName::LinkLoss), None),
     };
+    let source = agent.map(|_| match report.source {
+        FaultSource::Residual => FaultSourceName::Residual,
+        FaultSource::Reports => FaultSourceName::Reports,
+    });
     FaultDiagnostics {
         statistic: to_sim(report.statistic),
         threshold: to_sim(report.threshold),
@@ -117,5 +123,6 @@ pub fn fault_diagnostics<T: CoreFloat>(report: &FaultReport<T>) -> FaultDiagnost
         efficiency,
         periods,
         masked: None,
+        source,
     }
 }

@@ -31,7 +31,7 @@ use tvmd_core::FailureMask;
 
 use crate::diagnostics::{Diagnostics, FaultDiagnostics, HoverDiagnostics};
 use crate::error::BoxedError;
-use crate::flight::{FlightController, FlightInput, FlightOutput};
+use crate::flight::{AgentReport, FlightController, FlightInput, FlightOutput};
 use crate::SimError;
 use tvmd_plant::physics::PlantState;
 use tvmd_scenario::{FailureResponse, OnHoverLoss, Precision, Scenario};
@@ -96,6 +96,10 @@ pub struct TvmdController<T: CoreFloat, E: CoreEngine<T> = CoreController<T>> {
     detected: Vec<bool>,
     /// The agent of the last self-masking seen ([`tvmd_core::FaultMasking::agent`]).
     masking_seen: Option<usize>,
+    /// The agents' reports go to the core ([`Self::for_scenario`]).
+    pass_reports: bool,
+    /// The core has no fault detection to read the agents' reports.
+    reports_unread: bool,
 }
 
 impl<T: CoreFloat> TvmdController<T> {
@@ -105,7 +109,7 @@ impl<T: CoreFloat> TvmdController<T> {
     /// field the core rejected.
     pub fn from_scenario(scenario: &Scenario) -> Result<Self, SimError> {
         let (inner, n) = core_of_scenario(scenario)?;
-        Ok(Self::new(inner, n).with_failure_response(scenario.failure_response))
+        Ok(Self::new(inner, n).for_scenario(scenario))
     }
 
     /// The wrapped core controller.
@@ -115,6 +119,15 @@ impl<T: CoreFloat> TvmdController<T> {
 }
 
 impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
+    /// The same controller with `scenario`'s response to a hover-capability loss, passing the
+    /// agents' reports to the core when it has `[reports]` and `[fault_detection]` (an engine
+    /// that does not carry them then ends the run with an error; otherwise they are not
+    /// passed).
+    pub fn for_scenario(mut self, scenario: &Scenario) -> Self {
+        self.pass_reports = scenario.reports.is_some() && scenario.fault_detection.is_some();
+        self.with_failure_response(scenario.failure_response)
+    }
+
     /// The same controller with another response to a hover-capability loss.
     pub fn with_failure_response(mut self, response: FailureResponse) -> Self {
         self.response = response;
@@ -142,6 +155,8 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
             landed: false,
             detected: vec![false; n],
             masking_seen: None,
+            pass_reports: false,
+            reports_unread: false,
         }
     }
 
@@ -229,6 +244,29 @@ impl<T: CoreFloat, E: CoreEngine<T>> TvmdController<T, E> {
         });
     }
 
+    /// The agents' reports of this tick to the core's fault detection (`[reports]` with
+    /// `[fault_detection]`, [`Self::for_scenario`]): each agent's newest. A core without fault detection does not read them: they are not passed
+    /// again ([`tvmd_core::ReportError::DetectionOff`]); any other refusal ends the run.
+    fn pass_reports(&mut self, reports: &[Option<AgentReport>]) -> Result<(), BoxedError> {
+        if !self.pass_reports || self.reports_unread {
+            return Ok(());
+        }
+        for (agent, r) in reports.iter().enumerate().take(self.n) {
+            let Some(r) = r else {
+                continue;
+            };
+            match self.inner.set_report(agent, convert::core_reading(r)?)? {
+                Ok(()) => {}
+                Err(tvmd_core::ReportError::DetectionOff) => {
+                    self.reports_unread = true;
+                    return Ok(());
+                }
+                Err(e) => return Err(e.into()),
+            }
+        }
+        Ok(())
+    }
+
     /// The detector's report of the cycle just run, and a mask the core set itself in it:
     /// taken as the simulator's own (kept in later masks, classified, landing on a
     /// hover-capability loss as for an informed failure).
@@ -270,6 +308,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
             state,
             reference,
             failed,
+            reports,
         } = *input;
         let landed = state.position.z <= landing::LANDED_HEIGHT;
         if landed != self.landed {
@@ -277,6 +316,7 @@ impl<T: CoreFloat, E: CoreEngine<T>> FlightController for TvmdController<T, E> {
             self.landed = landed;
         }
         self.update_failures(t, state, failed)?;
+        self.pass_reports(reports)?;
         let n = self.n;
         let landing_reference = self.landing.as_ref().map(|l| l.reference(t));
         let reference = landing_reference.as_ref().unwrap_or(reference);
@@ -372,7 +412,7 @@ impl AnyTvmdController {
         let wire = config::wire_config(scenario)?;
         let core = pil::PilCore::start(target, &wire)?;
         Ok(Self::Pil(
-            TvmdController::new(core, wire.n).with_failure_response(scenario.failure_response),
+            TvmdController::new(core, wire.n).for_scenario(scenario),
         ))
     }
 

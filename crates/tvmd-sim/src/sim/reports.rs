@@ -5,25 +5,13 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use serde::Serialize;
 use tvmd_plant::actuators::{ActuatorBank, ActuatorCommand};
 use tvmd_scenario::{AgentReports, DeadEsc};
 
+pub use crate::flight::AgentReport;
+
 /// Times closer than this are the same instant.
 const SAME_TIME: f64 = 1e-12;
-
-/// The newest report of one agent at a tick.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct AgentReport {
-    /// Rotor speed as the thrust `k omega^2` it makes with an intact propeller (N).
-    pub thrust: f64,
-    /// Inner gimbal angle `eta_x` (rad).
-    pub eta_x: f64,
-    /// Outer gimbal angle `eta_y` (rad).
-    pub eta_y: f64,
-    /// How long ago it was measured (s).
-    pub age: f64,
-}
 
 /// A report on its way: when it arrives, whose, when measured, what it says.
 #[derive(Clone, Copy, Debug)]

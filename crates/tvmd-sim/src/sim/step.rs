@@ -54,6 +54,7 @@ impl Observation {
     /// The observation as a flight controller's input.
     pub fn input(&self) -> FlightInput<'_> {
         FlightInput::new(self.t, &self.state, &self.reference, &self.failed)
+            .with_reports(&self.reports)
     }
 }
 

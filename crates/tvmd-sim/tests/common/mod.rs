@@ -59,6 +59,7 @@ impl FlightController for PdHover {
             state: s,
             reference: r,
             failed,
+            ..
         } = *input;
         let n = self.alloc.nrows();
         if self.cut_at.is_some_and(|c| t >= c) {

@@ -7,6 +7,7 @@ mod common;
 mod closed_loop;
 mod coarse_step;
 mod fault_detection;
+mod fault_reports;
 mod flight_metrics;
 mod hover_failure;
 mod links;

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::diagnostics::{FaultDiagnostics, FaultKindName, FaultVerdictName};
+use crate::diagnostics::{FaultDiagnostics, FaultKindName, FaultSourceName, FaultVerdictName};
 
 /// One event of the detector: its time, the agent and the kind it reported.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -13,8 +13,11 @@ pub struct FaultEvent {
     pub time: f64,
     /// The agent.
     pub agent: usize,
-    /// What its residual looked like then.
+    /// What its residual (or its reports) looked like then.
     pub kind: Option<FaultKindName>,
+    /// The check that named it (`None` in summaries written before the agents' reports).
+    #[serde(default)]
+    pub source: Option<FaultSourceName>,
 }
 
 /// What the fault detector reported over a run (present when the controller runs one).
@@ -49,6 +52,7 @@ impl FaultSummary {
             time: t,
             agent,
             kind: f.kind,
+            source: f.source,
         });
         if f.verdict != FaultVerdictName::Nominal && self.first_alarm.is_none() {
             self.first_alarm = Some(t);
@@ -66,10 +70,12 @@ impl FaultSummary {
             }
         }
         if let (None, Some(agent)) = (self.masked, f.masked) {
+            // The response masks a loss or a link loss, named this tick.
             self.masked = Some(FaultEvent {
                 time: t,
                 agent,
-                kind: Some(FaultKindName::Loss),
+                kind: f.kind.or(Some(FaultKindName::Loss)),
+                source: f.source,
             });
         }
     }
