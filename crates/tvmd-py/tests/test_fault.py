@@ -180,3 +180,15 @@ def test_the_simulator_passes_its_agents_reports_to_the_controller():
     # 100 Hz reports, 20 ms late: named from the reports, two reports after the first zero.
     assert (masked["agent"], masked["kind"], masked["source"]) == (0, "loss", "reports")
     assert 4.0 < masked["time"] <= 4.05
+
+
+def test_the_scenarios_report_check_reaches_the_simulators_controller():
+    """``[fault_detection.report_check]`` in a scenario: six reports to confirm instead of two
+    mask the dead agent four reports (40 ms at 100 Hz) later, still from its reports."""
+    text = (ROOT / "scenarios/faults/loss-hover.toml").read_text() + '\n[reports]\ndead_esc = "zero"\n'
+    times = []
+    for extra in ("", "\n[fault_detection.report_check]\npersistence = 6\n"):
+        masked = tvmd.sim.run(toml=text + extra, team="a6-inc").summary["fault"]["masked"]
+        assert (masked["agent"], masked["source"]) == (0, "reports")
+        times.append(masked["time"])
+    assert 0.03 < times[1] - times[0] < 0.05, times
