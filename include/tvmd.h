@@ -48,8 +48,8 @@
  The ABI version; raised on every incompatible change of a struct or function (2: the `law`
  of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
  the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`;
- 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source` and the
- 9,216-byte handle at 16 agents).
+ 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source`, the report
+ check's settings `TvmdFaultDetection.reports` and the 9,216-byte handle at 16 agents).
  */
 #define TVMD_ABI_VERSION 5
 
@@ -575,6 +575,54 @@ typedef struct TvmdGains {
 } TvmdGains;
 
 /*
+ The check of the agents' own reports (`tvmd_set_agent_report`; docs/fault-detection.md,
+ "The agents' reports"). Both library configurations set the recommended values. Every
+ number finite and positive but `command_delay` (finite, `>= 0`); otherwise `tvmd_create`
+ (or `tvmd_reconfigure`) refuses it with `TVMD_ERR_CONFIG_NON_FINITE` or
+ `TVMD_ERR_CONFIG_PARAMETER` when the mode is on.
+ */
+typedef struct TvmdReportCheck {
+  /*
+   A report's thrust tolerance, as a share of the maximum thrust (recommended 0.1).
+   */
+  float thrust_tolerance;
+  /*
+   A report's gimbal angle tolerance (rad, recommended 0.05).
+   */
+  float angle_tolerance;
+  /*
+   The slowest healthy gimbal servo's rate (rad/s, recommended 6).
+   */
+  float servo_rate;
+  /*
+   The slowest healthy servo's time constant below its rate limit (s, recommended 0.05).
+   */
+  float servo_lag;
+  /*
+   The command link's latency and jitter the allowance covers (s, `>= 0`, recommended
+   0.01).
+   */
+  float command_delay;
+  /*
+   A report older than this (s) says the agent's link is gone (recommended 0.1).
+   */
+  float link_timeout;
+  /*
+   Reports in a row that confirm a fault, 1 to 255 (recommended 2).
+   */
+  uint32_t persistence;
+  /*
+   What the thrust envelope forgets, as a share of the maximum thrust per second
+   (recommended 2.5).
+   */
+  float thrust_forget;
+  /*
+   What the angle envelopes forget (rad/s, recommended 2.5).
+   */
+  float angle_forget;
+} TvmdReportCheck;
+
+/*
  Fault detection settings. `tvmd_config_default` and `tvmd_config_paper` set the mode off and
  the recommended numbers, so switching the mode on uses them.
  */
@@ -597,6 +645,10 @@ typedef struct TvmdFaultDetection {
    Periods a verdict must hold to be confirmed, `>= 1` (recommended 5).
    */
   uint32_t persistence;
+  /*
+   The check of the agents' reports (read only for agents that report).
+   */
+  struct TvmdReportCheck reports;
 } TvmdFaultDetection;
 
 /*

@@ -68,8 +68,8 @@ pub const TVMD_MAX_AGENTS: usize = 4;
 /// The ABI version; raised on every incompatible change of a struct or function (2: the `law`
 /// of `TvmdConfig` and the compensation of `TvmdOutput`; 3: the stages, the reconfiguration and
 /// the tail guard; 4: the 8,192-byte handle and the actuator outputs' `TVMD_OUTPUT_CHANNELS`;
-/// 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source` and the
-/// 9,216-byte handle at 16 agents).
+/// 5: the agents' reports, `tvmd_set_agent_report`, `TvmdFaultReport.source`, the report
+/// check's settings `TvmdFaultDetection.reports` and the 9,216-byte handle at 16 agents).
 pub const TVMD_ABI_VERSION: u32 = 5;
 
 /// The ABI version of the library (compare with the header's `TVMD_ABI_VERSION`).

@@ -23,12 +23,14 @@ use crate::errors::{sim_error, OrRaise, READ};
 
 mod commands;
 mod law;
+mod links;
 mod reports;
 mod round_cap;
 
 pub(crate) use commands::{batch_commands_arg, batch_wrench_arg, commands_arg, wrench_arg};
 
 pub(crate) use law::{fault_detection_arg, law_arg};
+pub(crate) use links::link_stats_to_py;
 pub(crate) use reports::{reports_arg, set_reports};
 pub(crate) use round_cap::round_cap_arg;
 

@@ -17,7 +17,7 @@ use tvmd_sim::sim::{Observation, SimOptions, Simulation, Verdict};
 use tvmd_sim::{AnyTvmdController, FlightController, FlightOutput};
 
 use crate::convert::{commands_arg, matrix, record_to_py, shaped};
-use crate::convert::{finite, wrench_arg, Int};
+use crate::convert::{finite, link_stats_to_py, wrench_arg, Int};
 use crate::errors::value_error;
 use crate::law::{PyReference, PyState};
 use crate::record::record;
@@ -320,6 +320,15 @@ impl PySimulation {
     #[getter]
     fn done(&self) -> bool {
         self.sim.is_finished()
+    }
+
+    /// The command links' counts per agent so far: a dict of (n,) int arrays `sent`, `lost`,
+    /// `stale` (arrived after a newer one), `failsafes`; None without the scenario's `[links]`.
+    fn link_stats<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.sim
+            .link_stats()
+            .map(|s| link_stats_to_py(py, &s))
+            .transpose()
     }
 
     /// Number of agents `n`.

@@ -63,6 +63,63 @@ def test_bad_settings_name_their_field(bad, error, words):
         tvmd.Controller(team(), fault_detection=bad)
 
 
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("thrust_tolerance", 0.0),
+        ("angle_tolerance", float("nan")),
+        ("servo_rate", -1.0),
+        ("servo_lag", float("inf")),
+        ("command_delay", -0.01),
+        ("link_timeout", 0.0),
+        ("persistence", 0),
+        ("persistence", 256),
+        ("thrust_forget", 0.0),
+        ("angle_forget", -2.0),
+        ("lag", 1.0),
+    ],
+)
+def test_bad_report_check_settings_name_their_key(key, value):
+    with pytest.raises(ValueError, match=f"report_check.{key}"):
+        tvmd.Controller(team(), fault_detection={"report_check": {key: value}})
+
+
+def test_the_report_checks_persistence_is_a_setting():
+    """Agent 1's rotor reported stopped (after ten agreeing reports): the recommended check
+    confirms it after two reports,
+    one set to four reports waits for four; a long link timeout keeps old reports a check."""
+    for persistence in (2, 4):
+        c = tvmd.Controller(
+            team(),
+            fault_detection={
+                "response": "report",
+                "report_check": {"persistence": persistence, "link_timeout": 0.5},
+            },
+        )
+        state = {"position": [0.0, 0.0, 1.5]}
+        out = c.step(state, state)
+        for _ in range(10):  # agreeing reports while the check's rotor model spins up
+            c.set_reports(reports_of(out))
+            out = c.step(state, state)
+        verdicts = []
+        for _ in range(4):
+            c.set_reports(reports_of(out, dead=(1,)))
+            out = c.step(state, state)
+            r = c.fault_report()
+            verdicts.append((r["verdict"], r["agent"], r["source"]))
+        first = next(i for i, v in enumerate(verdicts) if v == ("confirmed", 1, "reports"))
+        assert first == persistence - 1, verdicts
+    # A report 0.3 s old: a lost link with the recommended 0.1 s, not with 0.5 s.
+    for timeout, kind in ((None, "link-loss"), (0.5, None)):
+        check = {} if timeout is None else {"link_timeout": timeout}
+        c = tvmd.Controller(team(), fault_detection={"report_check": check})
+        out = c.step(state, state)
+        for _ in range(3):
+            c.set_reports([row[:3] + [0.3] for row in reports_of(out)])
+            out = c.step(state, state)
+        assert c.fault_report()["kind"] == kind
+
+
 def test_an_uninformed_loss_is_found_and_masked_in_the_simulator():
     result = tvmd.sim.run(str(ROOT / "scenarios/faults/loss-hover.toml"))
     fault = result.summary["fault"]
@@ -123,3 +180,15 @@ def test_the_simulator_passes_its_agents_reports_to_the_controller():
     # 100 Hz reports, 20 ms late: named from the reports, two reports after the first zero.
     assert (masked["agent"], masked["kind"], masked["source"]) == (0, "loss", "reports")
     assert 4.0 < masked["time"] <= 4.05
+
+
+def test_the_scenarios_report_check_reaches_the_simulators_controller():
+    """``[fault_detection.report_check]`` in a scenario: six reports to confirm instead of two
+    mask the dead agent four reports (40 ms at 100 Hz) later, still from its reports."""
+    text = (ROOT / "scenarios/faults/loss-hover.toml").read_text() + '\n[reports]\ndead_esc = "zero"\n'
+    times = []
+    for extra in ("", "\n[fault_detection.report_check]\npersistence = 6\n"):
+        masked = tvmd.sim.run(toml=text + extra, team="a6-inc").summary["fault"]["masked"]
+        assert (masked["agent"], masked["source"]) == (0, "reports")
+        times.append(masked["time"])
+    assert 0.03 < times[1] - times[0] < 0.05, times

@@ -249,3 +249,29 @@ def test_observations_carry_the_agents_reports_and_links_apply():
     assert sim.Simulation("hover").reset().reports is None
     with pytest.raises(ValueError, match="reports.lying"):
         sim.Simulation(toml=base + "\n[reports]\nlying = [9]\n")
+
+
+def test_link_stats_count_each_agents_commands_and_restart_on_reset():
+    """Issue 60: ``Simulation.link_stats()`` is per agent the commands sent, lost, stale and
+    the failsafes, as int arrays; None without ``[links]``."""
+    base = sim.scenario_toml("hover").replace('duration = 12.0', 'duration = 1.0')
+    s = sim.Simulation(toml=base + "\n[links]\nlatency = 0.005\njitter = 0.02\nloss = 0.3\n")
+    controller = sim.ScenarioController(toml=base)
+    obs = s.reset()
+    ticks = 0
+    while not obs.done:
+        obs = s.step(controller.step(obs))
+        ticks += 1
+    stats = s.link_stats()
+    assert set(stats) == {"sent", "lost", "stale", "failsafes"}
+    for counts in stats.values():
+        assert counts.shape == (4,) and counts.dtype == np.int64 and (counts >= 0).all()
+    # Every tick sends each agent one command; 30% loss drops some of the 100, not all.
+    assert (stats["sent"] == ticks).all() and ticks == 100
+    assert ((stats["lost"] > 5) & (stats["lost"] < 60)).all(), stats["lost"]
+    # A jitter four times the latency lets newer commands overtake older ones.
+    assert stats["stale"].sum() > 0
+    assert (stats["lost"] + stats["stale"] <= stats["sent"]).all()
+    s.reset()
+    assert (s.link_stats()["sent"] == 0).all()
+    assert sim.Simulation("hover").link_stats() is None

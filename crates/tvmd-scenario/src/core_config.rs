@@ -15,7 +15,7 @@ use crate::core_float::{matrix_to_core, to_core, vector_to_core, CoreFloat};
 use crate::error::invalid;
 use crate::{
     AttitudeRateConfig, FaultDetectionConfig, FaultResponseConfig, GainScheduleConfig, LawConfig,
-    OffsetFreeConfig, Scenario, ScenarioError,
+    OffsetFreeConfig, ReportCheckConfig, Scenario, ScenarioError,
 };
 
 /// The scenario field a core configuration error refers to.
@@ -55,6 +55,12 @@ fn config_field(e: &ConfigError) -> &'static str {
         Some(ConfigField::FaultThreshold) => "fault_detection.threshold",
         Some(ConfigField::FaultPersistence) => "fault_detection.persistence",
         Some(ConfigField::FaultResidual) => "fault_detection",
+        Some(
+            ConfigField::ReportTolerance
+            | ConfigField::ReportServoRate
+            | ConfigField::ReportLinkTimeout
+            | ConfigField::ReportPersistence,
+        ) => "fault_detection.report_check",
         Some(ConfigField::RateLimits) => "controller_rate_limits",
         Some(ConfigField::Period) => "controller_period",
         Some(ConfigField::Gravity) => "physics.gravity",
@@ -154,7 +160,9 @@ pub fn controller_settings<T: CoreFloat>(
     })
 }
 
-/// The core's fault detection of a scenario's `[fault_detection]` in `T`.
+/// The core's fault detection of a scenario's `[fault_detection]` in `T`, with its report
+/// check (`[fault_detection.report_check]`; a bad value names its field, also without the
+/// scenario's validation, as from Python).
 pub fn fault_detection<T: CoreFloat>(
     config: &FaultDetectionConfig,
 ) -> Result<FaultDetection<T>, ScenarioError> {
@@ -162,13 +170,18 @@ pub fn fault_detection<T: CoreFloat>(
         FaultResponseConfig::Report => FaultResponse::Report,
         FaultResponseConfig::Mask => FaultResponse::Mask,
     };
-    FaultDetection::new(
+    let detection = FaultDetection::new(
         to_core(config.model_error),
         to_core(config.threshold),
         config.persistence,
         response,
     )
-    .map_err(config_error)
+    .map_err(config_error)?;
+    // The recommended check as the core states it (its own constants, bit for bit).
+    if config.report_check == ReportCheckConfig::default() {
+        return Ok(detection);
+    }
+    Ok(detection.with_report_check(config.report_check.to_core()?))
 }
 
 /// The core's settings of the scenario's `[law]` in `T`: the gain schedule, the offset-free

@@ -7,6 +7,9 @@
 //! threshold = 5.0            # k, in those units
 //! persistence = 5            # controller periods that confirm an agent
 //! response = "mask"          # or "report": the controller masks a confirmed lost agent itself
+//!
+//! [fault_detection.report_check]   # the agents' reports' check, crate::ReportCheckConfig
+//! link_timeout = 0.1
 //! ```
 //!
 //! It reads the disturbance observer's measurement, so it needs `law.offset_free` to be the
@@ -16,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::checks::check_pos;
 use crate::error::invalid;
-use crate::{OffsetFreeConfig, ScenarioError};
+use crate::{OffsetFreeConfig, ReportCheckConfig, ScenarioError};
 
 /// The core's recommended values (`tvmd_core::FaultDetection::recommended`).
 pub use tvmd_core::controller::{FAULT_MODEL_ERROR, FAULT_PERSISTENCE, FAULT_THRESHOLD};
@@ -45,6 +48,9 @@ pub struct FaultDetectionConfig {
     pub persistence: u32,
     /// `"report"` (default) or `"mask"`.
     pub response: FaultResponseConfig,
+    /// The check of the agents' reports (`[fault_detection.report_check]`, read with
+    /// `[reports]`); the core's recommended values by default.
+    pub report_check: ReportCheckConfig,
 }
 
 impl Default for FaultDetectionConfig {
@@ -54,6 +60,7 @@ impl Default for FaultDetectionConfig {
             threshold: FAULT_THRESHOLD,
             persistence: FAULT_PERSISTENCE,
             response: FaultResponseConfig::Report,
+            report_check: ReportCheckConfig::default(),
         }
     }
 }
@@ -74,6 +81,7 @@ impl FaultDetectionConfig {
         if self.persistence == 0 {
             return Err(invalid("fault_detection.persistence", "must be at least 1"));
         }
+        self.report_check.validate()?;
         if !matches!(offset_free, OffsetFreeConfig::Observer { .. }) {
             return Err(invalid(
                 "fault_detection",

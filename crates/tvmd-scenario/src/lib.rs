@@ -114,6 +114,7 @@ mod name_or;
 mod null_space;
 mod overrides;
 mod plant;
+mod report_check;
 mod reports;
 mod scenario;
 mod success;
@@ -142,6 +143,7 @@ pub use null_space::{
 };
 pub use overrides::Overrides;
 pub use plant::{Payload, PlantError};
+pub use report_check::ReportCheckConfig;
 pub use reports::{AgentReports, DeadEsc};
 pub use scenario::{Scenario, MAX_SCENARIO_BYTES};
 pub use success::SuccessBounds;

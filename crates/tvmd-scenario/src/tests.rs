@@ -151,6 +151,75 @@ fn fault_detection_parses_defaults_and_needs_the_observer() {
 }
 
 #[test]
+fn report_check_defaults_to_the_core_and_names_a_bad_field() {
+    use tvmd_core::ReportCheck;
+    let s = Scenario::from_toml_str("[fault_detection]\n").unwrap();
+    let d = s.fault_detection.unwrap();
+    assert_eq!(d.report_check, ReportCheckConfig::default());
+    assert_eq!(
+        *core_config::fault_detection::<f32>(&d)
+            .unwrap()
+            .report_check(),
+        ReportCheck::<f32>::recommended()
+    );
+    let s = Scenario::from_toml_str(
+        "[fault_detection.report_check]\nlink_timeout = 0.25\npersistence = 3\n\
+         thrust_forget = 1.5\ncommand_delay = 0.0\n",
+    )
+    .unwrap();
+    let d = s.fault_detection.unwrap();
+    assert_eq!(d.report_check.servo_rate, 6.0);
+    let core = core_config::fault_detection::<f64>(&d).unwrap();
+    let check = core.report_check();
+    assert_eq!(
+        (
+            check.link_timeout(),
+            check.persistence(),
+            check.thrust_forget()
+        ),
+        (0.25, 3, 1.5)
+    );
+    assert_eq!(check.command_delay(), 0.0);
+    assert_eq!(check.angle_tolerance(), 0.05);
+    let back = Scenario::from_toml_str(&toml::to_string(&s).unwrap()).unwrap();
+    assert_eq!(back.fault_detection, s.fault_detection);
+    for (key, value) in [
+        ("thrust_tolerance", "0.0"),
+        ("angle_tolerance", "-0.1"),
+        ("servo_rate", "inf"),
+        ("servo_lag", "nan"),
+        ("command_delay", "-0.01"),
+        ("link_timeout", "0.0"),
+        ("persistence", "0"),
+        ("persistence", "256"),
+        ("thrust_forget", "0.0"),
+        ("angle_forget", "-1.0"),
+    ] {
+        let text = format!("[fault_detection.report_check]\n{key} = {value}\n");
+        let e = Scenario::from_toml_str(&text).unwrap_err();
+        let field = format!("fault_detection.report_check.{key}");
+        assert!(
+            matches!(&e, ScenarioError::InvalidScenario { field: f, .. } if *f == field),
+            "{text}: {e}"
+        );
+        // The core's conversion refuses it too, without the scenario's validation.
+        let mut d = FaultDetectionConfig::default();
+        let parsed: toml::Table = toml::from_str(&format!("{key} = {value}")).unwrap();
+        d.report_check = toml::Value::Table(parsed).try_into().unwrap();
+        assert!(core_config::fault_detection::<f32>(&d).is_err(), "{text}");
+    }
+    // A value f32 cannot hold is refused by the f32 controller, not rounded to zero.
+    let mut d = FaultDetectionConfig::default();
+    d.report_check.servo_lag = 1e-60;
+    assert!(core_config::fault_detection::<f64>(&d).is_ok());
+    assert!(matches!(
+        core_config::fault_detection::<f32>(&d),
+        Err(ScenarioError::InvalidScenario { field, .. }) if field == "fault_detection.report_check"
+    ));
+    assert!(Scenario::from_toml_str("[fault_detection.report_check]\nlag = 1.0\n").is_err());
+}
+
+#[test]
 fn load_takes_a_builtin_name_or_a_file() {
     assert_eq!(
         Scenario::load("a4-con").unwrap(),

@@ -49,6 +49,7 @@ pub use flight::{FlightController, FlightInput, FlightOutput};
 pub use load::{load_run, LoadedRun};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};
+pub use sim::links::LinkStats;
 pub use sim::{
     FaultEvent, FaultSummary, FlightDifference, Observation, PaperMetrics, RunResult, RunSummary,
     Sample, SampleRetention, SimOptions, Simulation, Stepped, Verdict,

@@ -81,13 +81,23 @@ impl<T: Real> ReportCheck<T> {
         if command_delay < T::zero() {
             return Err(ConfigError::Parameter { field });
         }
+        // One loop, not five inlined checks: the C interface's flash build counts its bytes.
+        for (value, field) in [
+            (thrust_tolerance, ConfigField::ReportTolerance),
+            (angle_tolerance, ConfigField::ReportTolerance),
+            (servo_rate, ConfigField::ReportServoRate),
+            (servo_lag, ConfigField::ReportServoRate),
+            (link_timeout, field),
+        ] {
+            positive(value, field)?;
+        }
         Ok(Self {
-            thrust_tolerance: positive(thrust_tolerance, ConfigField::ReportTolerance)?,
-            angle_tolerance: positive(angle_tolerance, ConfigField::ReportTolerance)?,
-            servo_rate: positive(servo_rate, ConfigField::ReportServoRate)?,
-            servo_lag: positive(servo_lag, ConfigField::ReportServoRate)?,
+            thrust_tolerance,
+            angle_tolerance,
+            servo_rate,
+            servo_lag,
             command_delay,
-            link_timeout: positive(link_timeout, field)?,
+            link_timeout,
             persistence,
             thrust_forget: lit(REPORT_THRUST_FORGET),
             angle_forget: lit(REPORT_ANGLE_FORGET),

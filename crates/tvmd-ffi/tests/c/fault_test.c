@@ -1,7 +1,7 @@
 /* The C test of agent fault detection (run from tvmd_test.c's main): off in both library
  * configurations (the report says no verdict); on with the default (observer) law it reports
  * a nominal hover below its threshold; it needs the observer; bad numbers and modes give their
- * status. The loss scenarios themselves are flown by the simulator's tests (full dynamics). */
+ * status, those of the agents' reports' check (`fault.reports`) too. The loss scenarios themselves are flown by the simulator's tests (full dynamics). */
 #include <math.h>
 #include <string.h>
 
@@ -67,6 +67,24 @@ static void test_agent_reports(TvmdConfig config) {
   CHECK(rep.verdict == TVMD_FAULT_VERDICT_CONFIRMED && rep.agent == 1);
   CHECK(rep.kind == TVMD_FAULT_KIND_LOSS && rep.source == TVMD_FAULT_SOURCE_REPORTS);
   CHECK(o.commands[1].thrust == 0.0f);
+  /* With a persistence of four reports the same loss is confirmed two reports later. */
+  config.fault.reports.persistence = 4u;
+  CHECK_STATUS(tvmd_create(&plain_storage, sizeof plain_storage, &config), TVMD_OK);
+  for (k = 0; k < 20; ++k) { /* agreeing reports while the check's rotor model spins up */
+    if (k > 0)
+      for (i = 0; i < plain.agent_count; ++i)
+        CHECK_STATUS(report_agent(&plain_storage, &config, i, plain.commands[i], 0, 0.01f), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&plain_storage, &s, &r, &plain), TVMD_OK);
+  }
+  for (k = 0; k < 5; ++k) {
+    for (i = 0; i < plain.agent_count; ++i)
+      CHECK_STATUS(report_agent(&plain_storage, &config, i, plain.commands[i], i == 1u, 0.01f), TVMD_OK);
+    CHECK_STATUS(tvmd_step(&plain_storage, &s, &r, &plain), TVMD_OK);
+    rep = report_of(&plain_storage);
+    if (rep.masked_agent == 1) break;
+  }
+  CHECK(k == 3 && rep.source == TVMD_FAULT_SOURCE_REPORTS);
+  config.fault.reports.persistence = 2u;
   /* Bad reports. */
   memset(&bad, 0, sizeof bad);
   CHECK_STATUS(tvmd_set_agent_report(&fault_storage, NULL), TVMD_ERR_NULL_POINTER);
@@ -146,6 +164,37 @@ void test_fault(void) {
   CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_NON_FINITE);
   bad = config; bad.fault.persistence = 0u;
   CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  /* The report check's settings: recommended in both configurations, refused when bad. */
+  CHECK(config.fault.reports.thrust_tolerance == 0.1f && config.fault.reports.persistence == 2u);
+  CHECK(config.fault.reports.link_timeout == 0.1f && config.fault.reports.command_delay == 0.01f);
+  CHECK(config.fault.reports.servo_rate == 6.0f && config.fault.reports.servo_lag == 0.05f);
+  CHECK(config.fault.reports.angle_tolerance == 0.05f);
+  CHECK(config.fault.reports.thrust_forget == 2.5f && config.fault.reports.angle_forget == 2.5f);
+  CHECK_STATUS(tvmd_config_paper(&bad), TVMD_OK);
+  CHECK(memcmp(&bad.fault.reports, &config.fault.reports, sizeof bad.fault.reports) == 0);
+  bad = config; bad.fault.reports.thrust_tolerance = 0.0f;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.angle_tolerance = NAN;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_NON_FINITE);
+  bad = config; bad.fault.reports.servo_rate = -6.0f;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.servo_lag = INFINITY;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_NON_FINITE);
+  bad = config; bad.fault.reports.command_delay = -0.01f;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.link_timeout = 0.0f;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.persistence = 0u;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.persistence = 256u;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.thrust_forget = 0.0f;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_PARAMETER);
+  bad = config; bad.fault.reports.angle_forget = NAN;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_ERR_CONFIG_NON_FINITE);
+  /* Off, the report check is not read. */
+  bad.fault.mode = TVMD_FAULT_OFF;
+  CHECK_STATUS(tvmd_create(&fault_storage, sizeof fault_storage, &bad), TVMD_OK);
 
   /* The report's own checks. */
   memset(&rep, 0, sizeof rep);

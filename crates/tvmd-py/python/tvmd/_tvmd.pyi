@@ -971,8 +971,16 @@ class Controller:
             persistence 5 periods; with ``"mask"`` the controller masks an agent whose loss is
             confirmed, as ``set_failures`` would), or a dict with the keys of a scenario's TOML
             ``[fault_detection]`` table (``model_error``, ``threshold``, ``persistence``,
-            ``response``). It reads the disturbance observer's residual, so it needs the
-            offset-free law's observer. ``fault_report()`` gives each period's verdict.
+            ``response``, and ``report_check``: a dict of the check of the agents' reports,
+            ``set_reports``, with the keys ``thrust_tolerance`` (share of the maximum thrust,
+            0.1), ``angle_tolerance`` (rad, 0.05), ``servo_rate`` (rad/s, 6), ``servo_lag`` (s,
+            0.05), ``command_delay`` (s, >= 0, 0.01), ``link_timeout`` (s, 0.1), ``persistence``
+            (reports, 1 to 255, 2), ``thrust_forget`` (share of the maximum thrust per second,
+            2.5), ``angle_forget`` (rad/s, 2.5); each optional, its recommended value given
+            after its unit; every number but ``command_delay`` finite and > 0). It reads the
+            disturbance observer's residual, so it needs the offset-free law's observer.
+            ``fault_report()`` gives each period's verdict. A bad value raises ``ValueError``
+            naming its key.
         max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
             (keyword only; see ``tvmd.allocate``): bounds its worst-case cost, the flight option
             of docs/allocation-benchmark.md; "uncapped" for the walk's own ``2 n + 4``. Default

@@ -449,6 +449,15 @@ class Simulation:
         allocation cannot serve (zero thrust for a non-zero force) holds the previous commands."""
     def result(self) -> SimResult:
         """The flight so far as a ``SimResult`` (the samples copied; the simulation goes on)."""
+    def link_stats(self) -> Optional[dict[str, NDArray[np.int64]]]:
+        """The command links' counts per agent since the last reset (scenario ``[links]``).
+
+        Returns:
+            A dict of (n,) int64 arrays in the agents' order: ``sent`` (commands sent),
+            ``lost`` (on their own, in bursts, or to a silent link), ``stale`` (arrived after a
+            newer one and dropped), ``failsafes`` (times the agent failed safe after ``hold``
+            seconds without a command); None when the scenario has no ``[links]``.
+        """
     @property
     def state(self) -> State:
         """The true state now."""
@@ -687,7 +696,8 @@ def run(
             ``SimResult.law`` says which flew. Not with ``pil`` unless ``"paper"``.
         fault_detection: turn on agent fault detection in the controller (scenario table
             ``[fault_detection]``), as ``tvmd.Controller``'s ``fault_detection``: ``"report"``,
-            ``"mask"`` or a dict of the table's keys; it needs the offset-free law's observer.
+            ``"mask"`` or a dict of the table's keys (``report_check`` a dict of the
+            ``[fault_detection.report_check]`` keys); it needs the offset-free law's observer.
             ``summary["fault"]`` reports what it found. Default None: the scenario's own.
         max_rounds: the "exact-boundary-redistribution" allocator's round cap per period
             (scenario field ``allocator_max_rounds``; bounds its worst-case cost): an int >= 0
