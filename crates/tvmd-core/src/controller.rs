@@ -36,6 +36,7 @@ use crate::agent::admissible::{admissible_sets, AdmissibleSet};
 use crate::agent::command::AgentCommand;
 use crate::agent::effectiveness::Effectiveness;
 use crate::allocation::{Allocation, Allocator, NullSpaceReport};
+use crate::fault::ReportState;
 use crate::foundation::error::{ConfigError, InputError};
 use crate::foundation::real::Real;
 use crate::law::attitude_rate::{AttitudeRateState, PlannedRates};
@@ -105,6 +106,8 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     attitude_rate: Option<AttitudeRateState<T>>,
     /// The fault detector (`None` when `settings.fault_detection` is).
     fault: Option<detection::FaultMonitor<T, N>>,
+    /// The agents' reports ([`Self::set_report`]; taken only while `fault` runs).
+    reports: ReportState<T, N>,
     /// What the offset-free state records once the law stage's wrench is allocated.
     pending: Option<(RigidState<T>, cycle::PendingRecord<T>)>,
     plant: Plant<T>,
@@ -199,8 +202,8 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.pending = None;
         if let Some(fault) = &mut self.fault {
             fault.reset();
-            fault.reports.clear();
         }
+        self.reports.clear();
         if let Some(rates) = &mut self.attitude_rate {
             rates.reset();
         }

@@ -13,6 +13,7 @@ use crate::afs::{AttainableForceSpace, Relaxation};
 use crate::agent::admissible::AdmissibleSet;
 use crate::agent::command::AgentCommand;
 use crate::allocation::Allocator;
+use crate::fault::ReportState;
 use crate::foundation::error::ConfigError;
 use crate::foundation::real::Real;
 use crate::law::attitude_rate::AttitudeRateState;
@@ -252,6 +253,7 @@ unsafe fn write<T: Real, const N: usize, A: Allocator<T, N>>(
     addr_of_mut!((*this).offset_free).write(offset_free);
     addr_of_mut!((*this).attitude_rate).write(attitude_rate);
     addr_of_mut!((*this).fault).write(fault);
+    addr_of_mut!((*this).reports).write(ReportState::new());
     addr_of_mut!((*this).pending).write(None);
     addr_of_mut!((*this).plant).write(plant);
     addr_of_mut!((*this).planner).write(AttitudePlanner::new(settings.relaxation));

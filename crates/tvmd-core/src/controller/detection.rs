@@ -22,7 +22,7 @@ use crate::fault::detection::{
 };
 use crate::fault::{
     loss_kind, lost_share, FaultDetector, FaultKind, FaultReport, FaultState, FaultVerdict,
-    ReportCheck, ReportGains, ReportState,
+    ReportCheck, ReportGains,
 };
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::linalg::{wrench_parts, EuclideanNorm};
@@ -86,9 +86,8 @@ pub(super) struct FaultMonitor<T: Real, const N: usize> {
     undelivered: T,
     report: Option<FaultReport<T>>,
     masked: Option<Masked>,
-    /// The agents' reports and their check ([`crate::fault::reports`]; idle while no agent
-    /// reports).
-    pub(super) reports: ReportState<T, N>,
+    /// The agents' reports' check ([`crate::fault::reports`]; the reports themselves are the
+    /// controller's, outside the monitor, so that building a monitor on the stack stays small).
     pub(super) check: ReportCheck<T>,
     /// The check's per-period gains at the controller's period ([`FAULT_ACTUATOR_LAG`]) and
     /// the team's maximum thrust.
@@ -133,7 +132,6 @@ impl<T: Real, const N: usize> FaultMonitor<T, N> {
             undelivered: lit::<T>(FAULT_ACTUATOR_LAG) / period * closed,
             report: None,
             masked: None,
-            reports: ReportState::new(),
             check: *detection.report_check(),
             gains: detection.report_check().gains(
                 period,
@@ -143,11 +141,10 @@ impl<T: Real, const N: usize> FaultMonitor<T, N> {
         }))
     }
 
-    /// Forgets the candidate, the residual, the report and the report check's models (a
-    /// controller reset, a landing; the agents' reports stay).
+    /// Forgets the candidate, the residual and the report (a controller reset, a landing; the
+    /// caller forgets the report check's models).
     pub(super) fn reset(&mut self) {
         self.state.reset();
-        self.reports.forget();
         self.residual = Vector6::zeros();
         self.baseline = Vector6::zeros();
         self.wrench = Vector6::zeros();
@@ -197,6 +194,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         if landed {
             // On the ground: nothing to read, and nothing carried into the next flight.
             monitor.reset();
+            self.reports.forget();
             return;
         }
         // The actuators' first-order lag over the period the residual measures: the share of

@@ -32,8 +32,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             return Err(ReportError::Agent { agent, len });
         }
         let period = self.settings.period;
-        let monitor = self.fault.as_mut().ok_or(ReportError::DetectionOff)?;
-        monitor.reports.set(agent, reading, period);
+        if self.fault.is_none() {
+            return Err(ReportError::DetectionOff);
+        }
+        self.reports.set(agent, reading, period);
         Ok(())
     }
 
@@ -57,14 +59,13 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// Agent `agent`'s newest report as the controller holds it (aged to the last step), if
     /// any.
     pub fn report(&self, agent: usize) -> Option<AgentReading<T>> {
-        self.fault.as_ref()?.reports.reading(agent)
+        self.fault.as_ref()?;
+        self.reports.reading(agent)
     }
 
     /// Forgets every agent's report (the report check stops until reports come again).
     pub fn clear_reports(&mut self) {
-        if let Some(monitor) = self.fault.as_mut() {
-            monitor.reports.clear();
-        }
+        self.reports.clear();
     }
 
     /// This period's report check (after the residual's verdict `report` of the same
@@ -75,10 +76,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         let Some(monitor) = self.fault.as_mut() else {
             return;
         };
-        if !monitor.reports.any() {
+        if !self.reports.any() {
             return;
         }
-        let verdict = monitor.reports.update(
+        let verdict = self.reports.update(
             &monitor.check,
             &monitor.gains,
             &self.previous,
