@@ -70,6 +70,22 @@ type Cycle<const N: usize, A = RedistributedPseudoInverse> = Controller<f32, N, 
 
 /// The measured unit: one cycle behind a call, as callgrind's `tvmd_cycle_f32` on x86.
 #[inline(never)]
+/// The measured cycles' state and reference: at rest 0.2 m off the hover point, and either
+/// holding where it is (hover) or flying to the point with the paper's pi/3 roll reference, which
+/// the planner must truncate (searching).
+pub(crate) fn cycle_case(searching: bool) -> (RigidState<f32>, Reference<f32>) {
+    let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
+    let mut reference = Reference::hover(if searching {
+        Vector3::new(0.0, 0.0, 1.5)
+    } else {
+        state.position
+    });
+    if searching {
+        reference.attitude = roll(convert::<f64, f32>(core::f64::consts::FRAC_PI_3));
+    }
+    (state, reference)
+}
+
 fn cycle<const N: usize, A: Allocator<f32, N>>(
     c: &mut Cycle<N, A>,
     s: &RigidState<f32>,
@@ -125,15 +141,7 @@ fn measure<const N: usize, A: Allocator<f32, N> + Clone>(
         built = black_box(Controller::new(team, settings, allocator.clone()).ok());
     });
     let mut c = built?;
-    let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
-    let mut reference = Reference::hover(if searching {
-        Vector3::new(0.0, 0.0, 1.5)
-    } else {
-        state.position
-    });
-    if searching {
-        reference.attitude = roll(convert::<f64, f32>(core::f64::consts::FRAC_PI_3));
-    }
+    let (state, reference) = cycle_case(searching);
     let out = c.step(&state, &reference).ok()?;
     let (status, iterations) = (out.planner.status, out.planner.iterations);
     // Each measured cycle steps a copy of the controller as the first step left it, so every

@@ -7,14 +7,12 @@
 use core::hint::black_box;
 
 use cortex_m_semihosting::hprintln;
-use tvmd_core::controller::roll;
-use tvmd_core::nalgebra::{convert, Vector3};
 use tvmd_core::{
     AgentReading, Controller, ControllerSettings, FaultDetection, FaultResponse,
     RedistributedPseudoInverse, Reference, RigidState,
 };
 
-use crate::{clock, team, REPS};
+use crate::{clock, cycle_case, team, REPS};
 
 /// Issue 60's bound on the reports' extra instructions at n = 4.
 pub const REPORTS_EXTRA_BOUND: u32 = 800;
@@ -66,15 +64,7 @@ pub fn report<const N: usize>(per_tick: u32) -> bool {
             hprintln!("cost: n = {} reports: FAIL: controller refused", N);
             return false;
         };
-        let state = RigidState::at_rest(Vector3::new(0.2f32, 0.0, 1.5));
-        let mut reference = Reference::hover(if searching {
-            Vector3::new(0.0, 0.0, 1.5)
-        } else {
-            state.position
-        });
-        if searching {
-            reference.attitude = roll(convert::<f64, f32>(core::f64::consts::FRAC_PI_3));
-        }
+        let (state, reference) = cycle_case(searching);
         let Ok(out) = c.step(&state, &reference) else {
             hprintln!("cost: n = {} reports: FAIL: the first cycle refused", N);
             return false;
