@@ -27,14 +27,16 @@
 # asks PX4 to land (land mode within 1 s), the team lands on three agents (tilt at most 0.8 rad,
 # standing within 0.15 m of the target, disarmed). It needs
 # pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
-# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies the
-# hover of tvmd_control and of the authors' modules (their PX4 fork) on the nominal vehicle,
-# under a steady wind and off its model, and prints the table of docs/px4-module.md
-# (scripts/px4/side_by_side.py; not asserted, about a minute). --perf (not in the test
-# command: a second PX4 build, then about 4 minutes of flights) builds px4_sitl_nolockstep too
-# (PX4's SITL without lockstep: its clock, and so its perf counters, on the wall clock) and flies
-# both stacks' hover and tilt on tvmd-sim in real time (`tvmd-sim px4 --real-time`), reading
-# PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
+# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies
+# tvmd_control and the authors' modules (their PX4 fork) on the nominal vehicle, under a steady
+# wind and off its model (the hover, and the tilt: theirs in their manual mode, the throttle
+# trimmed for the model error), then an agent failure in each one's hover, and prints the tables
+# of docs/px4-side-by-side.md (scripts/px4/side_by_side.py; not asserted, 11 flights, about 3.5
+# minutes). --perf (not in the test command: a second PX4 build, then about 8 minutes of
+# flights) builds px4_sitl_nolockstep too (PX4's SITL without lockstep: its clock, and so its
+# perf counters, on the wall clock) and flies both stacks' hover and tilt on tvmd-sim in real
+# time (`tvmd-sim px4 --real-time`; each stack's again under the wind and the model error),
+# reading PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
 # (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -50,7 +52,7 @@ for arg in "$@"; do
     --fly) fly=1 ;;
     --side-by-side) side=1 ;;
     --perf) perf=1 ;;
-    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,40p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -160,7 +162,7 @@ if [ "$side" -eq 1 ]; then
   # their position mode and their tilt in their manual mode (under the model error with the
   # throttle trimmed, flight-trimmed.toml); then agent 0 lost in each stack's hover (told to
   # tvmd_control, untold to theirs: their stack has no way to be told). The tables of
-  # docs/px4-module.md. The authors' modules need their PX4 fork (airframe 4007).
+  # docs/px4-side-by-side.md. The authors' modules need their PX4 fork (airframe 4007).
   authors="$repo/scripts/px4/authors"
   fly_side() { # stack-and-flight name, airframe, scenario, flight file
     local params="$flights/params"

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The side-by-side tables of docs/px4-module.md: tvmd_control and the authors' modules on the
-same flights, measured the same way (stack_measures.py: the truth from tvmd-sim px4's reports,
+"""The side-by-side tables of docs/px4-side-by-side.md: tvmd_control and the authors' modules on
+the same flights, measured the same way (stack_measures.py: the truth from tvmd-sim px4's reports,
 the plans, the unallocated force and the saturation from the ulogs).
 
     side_by_side.py DIR
@@ -81,7 +81,8 @@ def hover_table(d, perf):
 
 
 def tilt_table(d):
-    print("| flight | stack | planned roll, largest | roll flown: mean / std / largest | unallocated force, largest "
+    print("| flight | stack | planned roll, largest | roll flown: largest; held (last 4 s): mean / std "
+          "| unallocated force, largest "
           "| position error (truth): rms / largest | height (truth) | EKF2 position error, largest "
           "| saturated periods |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
@@ -89,7 +90,7 @@ def tilt_table(d):
         for key, name in STACKS:
             w = load(d, f"{key}-{flight}" if key == "tvmd" else f"authors-tilt-{flight}", key)["tilt"]
             print(f"| {flight} | {name} | {num(w.get('planned_roll_max'), '.4f')} rad | "
-                  f"{w['roll_mean']:.3f} / {w['roll_std']:.3f} / {w['roll_max']:.3f} rad | "
+                  f"{w['roll_max']:.3f}; {w['roll_held_mean']:.3f} / {w['roll_held_std']:.3f} rad | "
                   f"{num(w.get('unallocated_force_max'), '.2f')} N | "
                   f"{num(w['hold_rms'], '.3f')} / {num(w['hold_max'], '.3f')} m | "
                   f"{num(w['height_min'], '.2f')}-{num(w['height_max'], '.2f')} m | "

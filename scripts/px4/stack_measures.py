@@ -9,10 +9,12 @@ STACK: `tvmd` (tvmd_control, airframe 4090: its status topic tvmd_control_status
 control_allocator_status). For each of the report's windows `hover` and `tilt`:
   - from the report (the plant's truth): the hold against the window's target (rms, largest),
     the roll flown (mean, standard deviation, largest), EKF2's largest position error;
+  - from PX4's ground-truth topics in the ulog: the true height's range, and the roll held
+    (mean and standard deviation over the window's last 4 s: tvmd_control's tilt window starts
+    with its stick, the authors' 2 s after theirs);
   - from the ulog: the planned roll, largest (tvmd_control's q_planned; the authors' planner's
     q_d); the unallocated force, largest (tvmd_control's e_f; the authors' allocator's asked
-    force less its allocated one, N); the true height's range (PX4's ground-truth topic); the
-    saturated periods: tvmd_control's rate-loop periods with an agent held by a limit (its
+    force less its allocated one, N); the saturated periods: tvmd_control's rate-loop periods with an agent held by a limit (its
     counter saturated_periods over the window, of 250 a second), the authors' allocation periods
     whose redistribution stopped at an agent's boundary (the first increment of
     control_allocation_meta_data below 1, one record a period), and as a cross-check the share
@@ -35,6 +37,7 @@ from pyulog import ULog
 
 EARTH_RADIUS = 6371000.0
 RATE_LOOP_HZ = 250.0  # tvmd_control's rate loop: every gyro sample in SITL
+HELD = 4.0  # s: the end of a window where the roll is held (the tilt windows' stick came 2-4 s before)
 
 
 def topic(ulog, name):
@@ -83,6 +86,7 @@ class Truth:
         self.height = gpos["alt"] - alt0
         self.t_att = seconds(att)
         self.tilt = tilt_of(quat_rows(att))
+        self.roll = roll_of(quat_rows(att))
 
     def heights(self, t0, t1):
         h = self.height[(self.t >= t0) & (self.t <= t1)]
@@ -146,6 +150,9 @@ def window_measures(stack, ulog, truth, w):
     m = {key: w.get(key) for key in ("from", "to", "hold_rms", "hold_max", "roll_mean", "roll_std", "roll_max",
                                        "ekf_position_max", "height_max")}
     m["height_min"], _ = truth.heights(w["from"], w["to"])
+    # The roll held: the window's last HELD seconds (the roll-in before them), from the truth.
+    held = (truth.t_att >= w["to"] - HELD) & (truth.t_att <= w["to"])
+    m["roll_held_mean"], m["roll_held_std"] = float(truth.roll[held].mean()), float(truth.roll[held].std())
     m["unlogged"] = unlogged(ulog, w["from"], w["to"])
     m.update((tvmd_window if stack == "tvmd" else authors_window)(ulog, w["from"], w["to"]))
     return m
