@@ -27,14 +27,16 @@
 # asks PX4 to land (land mode within 1 s), the team lands on three agents (tilt at most 0.8 rad,
 # standing within 0.15 m of the target, disarmed). It needs
 # pyulog in the Python environment. Logs, ulogs and measures go to target/px4-module-flights/;
-# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies the
-# hover of tvmd_control and of the authors' modules (their PX4 fork) on the nominal vehicle,
-# under a steady wind and off its model, and prints the table of docs/px4-module.md
-# (scripts/px4/side_by_side.py; not asserted, about a minute). --perf (not in the test
-# command: a second PX4 build, then about 4 minutes of flights) builds px4_sitl_nolockstep too
-# (PX4's SITL without lockstep: its clock, and so its perf counters, on the wall clock) and flies
-# both stacks' hover and tilt on tvmd-sim in real time (`tvmd-sim px4 --real-time`), reading
-# PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
+# PX4_INSTANCE (default 7) keeps its ports apart from other SITL runs. --side-by-side flies
+# tvmd_control and the authors' modules (their PX4 fork) on the nominal vehicle, under a steady
+# wind and off its model (the hover, and the tilt: theirs in their manual mode, the throttle
+# trimmed for the model error), then an agent failure in each one's hover, and prints the tables
+# of docs/px4-side-by-side.md (scripts/px4/side_by_side.py; not asserted, 11 flights, about 3.5
+# minutes). --perf (not in the test command: a second PX4 build, then about 8 minutes of
+# flights) builds px4_sitl_nolockstep too (PX4's SITL without lockstep: its clock, and so its
+# perf counters, on the wall clock) and flies both stacks' hover and tilt on tvmd-sim in real
+# time (`tvmd-sim px4 --real-time`; each stack's again under the wind and the model error),
+# reading PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
 # (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -50,7 +52,7 @@ for arg in "$@"; do
     --fly) fly=1 ;;
     --side-by-side) side=1 ;;
     --perf) perf=1 ;;
-    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,40p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -155,21 +157,29 @@ if [ "$perf" -eq 1 ]; then
 fi
 
 if [ "$side" -eq 1 ]; then
-  # Not in the test command (about a minute): the hover of each stack on the nominal vehicle,
-  # under a steady wind and off its model; the table of docs/px4-module.md. The authors' modules
-  # need their PX4 fork (airframe 4007).
+  # Not in the test command (about three minutes): each stack on the nominal vehicle, under a
+  # steady wind and off its model: tvmd_control's flight (hover and tilt), the authors' hover in
+  # their position mode and their tilt in their manual mode (under the model error with the
+  # throttle trimmed, flight-trimmed.toml); then agent 0 lost in each stack's hover (told to
+  # tvmd_control, untold to theirs: their stack has no way to be told). The tables of
+  # docs/px4-side-by-side.md. The authors' modules need their PX4 fork (airframe 4007).
   authors="$repo/scripts/px4/authors"
+  fly_side() { # stack-and-flight name, airframe, scenario, flight file
+    local params="$flights/params"
+    [ "$2" = 4090 ] || params="$authors/params"
+    step "side by side: $1 (airframe $2)"
+    "$sim" px4 "$3" --flight "$4" --px4-dir "$px4_dir" --px4-build "$target" --autostart "$2" \
+      --params "$params" --instance "$instance" --out "$out/$1.mcap" >/dev/null
+  }
   for flight in nominal wind model-error; do
     scenario=scenario; [ "$flight" = nominal ] || scenario="scenario-$flight"
-    step "side by side, $flight: tvmd_control (airframe 4090)"
-    "$sim" px4 "$flights/$scenario.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
-      --px4-build "$target" --autostart 4090 --params "$flights/params" --instance "$instance" \
-      --out "$out/tvmd-$flight.mcap" >/dev/null
-    step "side by side, $flight: the authors' modules (airframe 4007, their position mode)"
-    "$sim" px4 "$authors/$scenario.toml" --flight "$authors/flight-hold.toml" --px4-dir "$px4_dir" \
-      --px4-build "$target" --autostart 4007 --params "$authors/params" --instance "$instance" \
-      --out "$out/authors-$flight.mcap" >/dev/null
+    manual=flight; [ "$flight" = model-error ] && manual=flight-trimmed
+    fly_side "tvmd-$flight" 4090 "$flights/$scenario.toml" "$flights/flight.toml"
+    fly_side "authors-$flight" 4007 "$authors/$scenario.toml" "$authors/flight-hold.toml"
+    fly_side "authors-tilt-$flight" 4007 "$authors/$scenario.toml" "$authors/$manual.toml"
   done
+  fly_side tvmd-agent-failure 4090 "$flights/scenario-agent-failure.toml" "$flights/flight-agent-failure.toml"
+  fly_side authors-agent-failure 4007 "$authors/scenario-agent-failure.toml" "$authors/flight-agent-failure.toml"
   python3 "$repo/scripts/px4/side_by_side.py" "$out"
 fi
 

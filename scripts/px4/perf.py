@@ -6,7 +6,7 @@ clock is the wall clock) and the bridge in real time (`tvmd-sim px4 --real-time`
 authors' modules need their PX4 fork (airframe 4007, as scripts/px4-module.sh --side-by-side).
 
     perf.py --sim TVMD_SIM --px4-dir PX4_DIR [--build px4_sitl_nolockstep] [--instance N]
-        --out DIR
+        [--conditions nominal,wind,model-error] --out DIR
 
 In lockstep SITL, hrt is the simulated clock, which does not advance inside a cycle: every perf
 elapsed counter reads 0 there. Here each flight is started by tvmd-sim; once PX4 reports the
@@ -17,7 +17,9 @@ and windows (simulated s, which the real-time bridge keeps on the wall clock):
   tvmd        tvmd_control/flight.toml  hover 22.5-29.5 (before its parameter test), tilt 38.5-45.5
   authors     authors/flight-hold.toml  hover 28-35 (their position mode)
   authors-rc  authors/flight.toml       hover 18.5-21.5, tilt 24.5-27.5 (their manual mode)
-(in scripts/px4/). The windows' edges are found on the wall clock from PX4's console line,
+(in scripts/px4/), on the nominal vehicles (scenario.toml); with --conditions (default all
+three) `tvmd` and `authors` again under a steady wind (`-wind`, scenario-wind.toml) and off
+their models (`-model-error`, scenario-model-error.toml). The windows' edges are found on the wall clock from PX4's console line,
 within a tenth of a second. Also reads the ulogs' `perf_counter_postflight` (PX4's logger writes
 every counter at disarm: from the last `perf reset` here, the last window's start, to the
 disarm, the landing included) where a flight disarmed. Writes DIR/perf.json (side_by_side.py
@@ -48,16 +50,23 @@ STACKS = {
 }
 
 
-def flights():
+def flights(conditions):
+    """(name, stack, scenario, flight file, airframe, params, windows, condition) per flight: each
+    stack's under each condition (nominal, wind, model-error: the scenarios of the side-by-side
+    table), and the authors' manual flight on the nominal vehicle."""
     t, a = REPO / "scripts/px4/tvmd_control", REPO / "scripts/px4/authors"
-    return [
-        ("tvmd", "tvmd", t / "scenario.toml", t / "flight.toml", 4090, t / "params",
-         [("hover", 22.5, 29.5), ("tilt", 38.5, 45.5)]),
-        ("authors", "authors", a / "scenario.toml", a / "flight-hold.toml", 4007, a / "params",
-         [("hover", 28.0, 35.0)]),
-        ("authors-rc", "authors", a / "scenario.toml", a / "flight.toml", 4007, a / "params",
-         [("hover", 18.5, 21.5), ("tilt", 24.5, 27.5)]),
-    ]
+    out = []
+    for c in conditions:
+        scenario = "scenario.toml" if c == "nominal" else f"scenario-{c}.toml"
+        suffix = "" if c == "nominal" else f"-{c}"
+        out.append((f"tvmd{suffix}", "tvmd", t / scenario, t / "flight.toml", 4090, t / "params",
+                    [("hover", 22.5, 29.5), ("tilt", 38.5, 45.5)], c))
+        out.append((f"authors{suffix}", "authors", a / scenario, a / "flight-hold.toml", 4007, a / "params",
+                    [("hover", 28.0, 35.0)], c))
+        if c == "nominal":
+            out.append(("authors-rc", "authors", a / scenario, a / "flight.toml", 4007, a / "params",
+                        [("hover", 18.5, 21.5), ("tilt", 24.5, 27.5)], c))
+    return out
 
 
 def parse(lines):
@@ -148,14 +157,20 @@ def main():
     p.add_argument("--build", default="px4_sitl_nolockstep")
     p.add_argument("--instance", type=int, default=7)
     p.add_argument("--out", required=True)
+    p.add_argument("--conditions", default="nominal,wind,model-error",
+                   help="comma-separated: nominal, wind, model-error (the scenarios' conditions)")
     a = p.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     results = []
-    for name, stack, scenario, flight, autostart, params, windows in flights():
+    conditions = [c for c in a.conditions.split(",") if c]
+    unknown = set(conditions) - {"nominal", "wind", "model-error"}
+    if unknown:
+        raise SystemExit(f"error: unknown conditions {sorted(unknown)}")
+    for name, stack, scenario, flight, autostart, params, windows, condition in flights(conditions):
         print(f"==> perf: {name} (airframe {autostart}, {flight.name}, real time)", flush=True)
         r = fly(a, out, name, scenario, flight, autostart, params, windows)
-        r["stack"] = stack
+        r["stack"], r["condition"] = stack, condition
         for w in r["readings"]:
             w["per_period_us"] = per_period(stack, w["counters"])
         results.append(r)
