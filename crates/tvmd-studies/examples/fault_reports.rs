@@ -1,7 +1,10 @@
 //! The agents' own reports in the controller's fault detection (issue 60,
 //! `docs/fault-detection.md`, "The agents' reports"): delays per team, fault and flight phase
 //! with reports at 100 Hz and 20 ms latency; `a6-agent-failure` not informed against informed; false alarms over nominal
-//! flights with 10% of the reports lost and a jittering command link; a report that lies.
+//! flights with 10% of the reports lost and a jittering command link; a report that lies; and
+//! the delays from each failure's first effect on a report (`fault_effect`: the first report that
+//! differs from the one the agent would have sent had it not failed by more than 3, 1 or 10
+//! standard deviations of its noise, or that the failure stopped).
 //!
 //! ```text
 //! cargo run --profile ci -p tvmd-studies --example fault_reports -- [FLIGHTS] [JOBS]
@@ -27,7 +30,9 @@ use tvmd_sim::{run_scenario, FaultEvent, FaultSummary, RunResult};
 use tvmd_studies::montecarlo::Conditions;
 
 mod fault_common;
+mod fault_effect;
 use fault_common::{map, quantiles, Phase, TEAMS};
+use fault_effect::{EffectWatch, FirstEffect};
 
 const SEED: u64 = 60;
 
@@ -100,6 +105,32 @@ fn flight(
     })
 }
 
+/// Flies `s` with its controller, watching `agent`'s reports from `t_f` on: its fault summary
+/// and the failure's first effects on the reports.
+fn fly_watching(
+    s: &Scenario,
+    agent: usize,
+    t_f: f64,
+) -> Result<(FaultSummary, FirstEffect), Box<dyn std::error::Error>> {
+    use tvmd_sim::FlightController;
+    let options = tvmd_sim::sim::SimOptions {
+        samples: tvmd_sim::sim::SampleRetention::None,
+    };
+    let mut sim = tvmd_sim::sim::Simulation::with_options(s, options)?;
+    let mut c = tvmd_sim::AnyTvmdController::from_scenario(s)?;
+    let mut watch = EffectWatch::new(t_f, s.reports.clone().ok_or("no reports")?);
+    while !sim.is_finished() {
+        let o = sim.observe()?.clone();
+        let healthy = sim.healthy_reports();
+        watch.see(o.t, o.reports[agent], healthy[agent]);
+        let out = c.step(&o.input()).map_err(|e| e.to_string())?;
+        let sent = out.commands[agent];
+        watch.command(o.t, sent.eta_x, sent.eta_y);
+        sim.step_output(out)?;
+    }
+    Ok((sim.summary().fault.unwrap_or_default(), watch.finish()))
+}
+
 struct FaultRun {
     team: &'static str,
     fault: Fault,
@@ -107,6 +138,7 @@ struct FaultRun {
     agent: usize,
     summary: FaultSummary,
     t_f: f64,
+    effect: FirstEffect,
 }
 
 impl FaultRun {
@@ -117,6 +149,16 @@ impl FaultRun {
             Some(e) if e.agent == self.agent && e.time >= self.t_f => Ok(Some(e.time - self.t_f)),
             Some(_) => Err(()),
         }
+    }
+
+    /// The delay of the first confirmation (the right agent) after the failure's first effect
+    /// on a report past `fault_effect::EFFECT_SIGMAS[k]`.
+    fn since_effect(&self, k: usize) -> Option<f64> {
+        let e = self
+            .summary
+            .first_confirmed
+            .filter(|e| e.agent == self.agent)?;
+        Some(e.time - self.effect.at[k]?)
     }
 }
 
@@ -154,14 +196,15 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
             controller_informed: false,
             informed_after: 0.0,
         }];
-        let r = run_scenario(&s, None, None).ok()?;
+        let (summary, effect) = fly_watching(&s, agent, t_f).ok()?;
         Some(FaultRun {
             team,
             fault,
             phase,
             agent,
-            summary: r.summary.fault.unwrap_or_default(),
+            summary,
             t_f,
+            effect,
         })
     })
 }
@@ -212,6 +255,54 @@ fn fault_table(runs: &[FaultRun]) {
                     group.len(),
                     by("reports"),
                     by("residual"),
+                );
+            }
+        }
+    }
+}
+
+/// The failure's first effect on the failed agent's reports (past 3, 1 and 10 standard
+/// deviations of the report's noise, or a report missing) and the first confirmation after it.
+fn effect_table(runs: &[FaultRun]) {
+    println!("| team | fault | phase | flights | an effect (3 sigma) | first effect, s after t_f: median / worst | isolated, s after the first effect (3 sigma): median / worst | (1 sigma): median / worst | (10 sigma): median / worst | largest angle effect within 50 ms (rad), median | reports within the commands' range, median share |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for team in TEAMS {
+        for fault in Fault::ALL {
+            for phase in [Phase::Hover, Phase::Tilt] {
+                let group: Vec<&FaultRun> = runs
+                    .iter()
+                    .filter(|r| r.team == team && r.fault == fault && r.phase == phase)
+                    .collect();
+                let first: Vec<f64> = group
+                    .iter()
+                    .filter_map(|r| Some(r.effect.at[0]? - r.t_f))
+                    .collect();
+                let after = |k: usize| {
+                    quantiles(group.iter().filter_map(|r| r.since_effect(k)).collect(), 3)
+                };
+                let median = |pick: fn(&FirstEffect) -> Option<f64>, digits: usize| {
+                    let v: Vec<f64> = group.iter().filter_map(|r| pick(&r.effect)).collect();
+                    quantiles(v, digits)
+                        .split(" / ")
+                        .next()
+                        .unwrap_or("-")
+                        .to_string()
+                };
+                let (largest, inside) = if fault == Fault::StuckGimbal {
+                    (median(|e| e.largest, 3), median(|e| e.inside, 2))
+                } else {
+                    ("-".into(), "-".into())
+                };
+                println!(
+                    "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} |",
+                    fault.name(),
+                    phase.name(),
+                    group.len(),
+                    first.len(),
+                    quantiles(first, 3),
+                    after(0),
+                    after(1),
+                    after(2),
                 );
             }
         }
@@ -366,7 +457,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("## a6-agent-failure, not informed, with reports\n");
     outcome()?;
     println!("\n## Delays with reports (100 Hz, 20 ms), fault at t_f, not informed\n");
-    fault_table(&fault_runs(jobs));
+    let runs = fault_runs(jobs);
+    fault_table(&runs);
+    println!("\n## The failure's first effect on a report (the failed agent's report against the one it would have sent had it not failed, the same noise), not informed\n");
+    effect_table(&runs);
     println!("\n## False alarms over {flights} nominal flights, 10% of the reports lost, link jitter 0-10 ms\n");
     false_alarms(flights, jobs);
     Ok(())
