@@ -16,6 +16,9 @@
 //! `[reports]` at their defaults (100 Hz, 20 ms latency, 0.05 N and 5 mrad of noise). `FLIGHTS`
 //! nominal flights (default 1000) over A4-, A6-, A8-Inc and hover, wind, tilt. Prints Markdown.
 //!
+//! `TVMD_STUDY_ANGLE_CHECK=0.025,1.0` flies every flight with the report check's
+//! `angle_tolerance` and `angle_forget` set so (how their retuning was measured).
+//!
 //! `TVMD_STUDY_TRACE=a6-inc,tilt,16,2` prints instead, for nominal flight 16 (A6-Inc, tilt) and
 //! agent 2, each tick's command and newest report from 4.9 to 5.8 s (how the report check's
 //! allowances were found: the thrust command chatters at the attainable set's boundary).
@@ -92,7 +95,11 @@ fn flight(
     reports: AgentReports,
     links: Option<CommandLinks>,
 ) -> Result<Scenario, Box<dyn std::error::Error>> {
-    let detection = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
+    let mut detection = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
+    if let Some([tolerance, forget]) = angle_check() {
+        detection.report_check.angle_tolerance = tolerance;
+        detection.report_check.angle_forget = forget;
+    }
     let conditions = Conditions {
         links,
         ..Conditions::default()
@@ -103,6 +110,14 @@ fn flight(
             ..reports
         });
     })
+}
+
+/// `TVMD_STUDY_ANGLE_CHECK=tolerance,forget`: the report check's `angle_tolerance` (rad) and
+/// `angle_forget` (rad/s) for every flight, in place of the recommended ones.
+fn angle_check() -> Option<[f64; 2]> {
+    let v = std::env::var("TVMD_STUDY_ANGLE_CHECK").ok()?;
+    let (a, b) = v.split_once(',')?;
+    Some([a.trim().parse().ok()?, b.trim().parse().ok()?])
 }
 
 /// Flies `s` with its controller, watching `agent`'s reports from `t_f` on: its fault summary
@@ -264,8 +279,8 @@ fn fault_table(runs: &[FaultRun]) {
 /// The failure's first effect on the failed agent's reports (past 3, 1 and 10 standard
 /// deviations of the report's noise, or a report missing) and the first confirmation after it.
 fn effect_table(runs: &[FaultRun]) {
-    println!("| team | fault | phase | flights | an effect (3 sigma) | first effect, s after t_f: median / worst | isolated, s after the first effect (3 sigma): median / worst | (1 sigma): median / worst | (10 sigma): median / worst | largest angle effect within 50 ms (rad), median | reports within the commands' range, median share |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| team | fault | phase | flights | an effect (3 sigma) | first effect, s after t_f: median / worst | isolated, s after the first effect (3 sigma): median / worst | (1 sigma): median / worst | (10 sigma): median / worst | largest angle effect within 50 ms (rad), median | reports within the commands' range, median share | the check's servo model's largest error (rad), median: healthy / stuck reports | named by a check against that model (0.1 rad, 2 reports), s after the first effect: median / worst |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for team in TEAMS {
         for fault in Fault::ALL {
             for phase in [Phase::Hover, Phase::Tilt] {
@@ -288,13 +303,29 @@ fn effect_table(runs: &[FaultRun]) {
                         .unwrap_or("-")
                         .to_string()
                 };
-                let (largest, inside) = if fault == Fault::StuckGimbal {
-                    (median(|e| e.largest, 3), median(|e| e.inside, 2))
+                let (largest, inside, model) = if fault == Fault::StuckGimbal {
+                    (
+                        median(|e| e.largest, 3),
+                        median(|e| e.inside, 2),
+                        format!(
+                            "{} (worst {:.3}) / {} | {}",
+                            median(|e| e.model.map(|m| m[0]), 3),
+                            group
+                                .iter()
+                                .filter_map(|r| Some(r.effect.model?[0]))
+                                .fold(0.0, f64::max),
+                            median(|e| e.model.map(|m| m[1]), 3),
+                            quantiles(
+                                group.iter().filter_map(|r| r.effect.model_named).collect(),
+                                3
+                            ),
+                        ),
+                    )
                 } else {
-                    ("-".into(), "-".into())
+                    ("-".into(), "-".into(), "- | -".into())
                 };
                 println!(
-                    "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} |",
+                    "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} | {model} |",
                     fault.name(),
                     phase.name(),
                     group.len(),

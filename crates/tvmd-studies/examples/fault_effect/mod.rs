@@ -24,7 +24,20 @@ pub struct FirstEffect {
     /// within the commands sent 20 ms either side of their measurement (where a check that
     /// admits any angle between the commands cannot see the failure, whatever its tolerance).
     pub inside: Option<f64>,
+    /// The largest error (rad) of the report check's own servo model (a first-order lag of 50
+    /// ms turning at most at 6 rad/s, `ReportCheck::recommended`, stepped on the commands sent
+    /// from 0.1 s before the fault) against the reports the agent would have sent healthy,
+    /// and against the stuck ones, within 0.5 s of the first effect: how well a check that
+    /// tracked its model, rather than an envelope, could tell them apart.
+    pub model: Option<[f64; 2]>,
+    /// When a check of the reports against that model at their measurement, tolerance
+    /// [`MODEL_TOLERANCE`] and two reports in a row, would have named the stuck gimbal (s after
+    /// the first effect, the 20 ms latency included; within 0.5 s of it).
+    pub model_named: Option<f64>,
 }
+
+/// The tolerance (rad) of the hypothetical check against the model ([`FirstEffect::model_named`]).
+pub const MODEL_TOLERANCE: f64 = 0.1;
 
 /// Watches one agent's reports against the ones it would have sent had it not failed
 /// (`Simulation::healthy_reports`: the same noise, so the difference is the failure's effect).
@@ -39,6 +52,8 @@ pub struct EffectWatch {
     angles: Vec<(f64, f64, f64, f64)>,
     /// `(t, eta_x, eta_y)` of the commands sent from 0.1 s before the fault on.
     commands: Vec<(f64, f64, f64)>,
+    /// `(measured, eta_x, eta_y)` of the healthy reports from 0.1 s before the fault on.
+    healthy: Vec<(f64, f64, f64)>,
 }
 
 impl EffectWatch {
@@ -51,6 +66,7 @@ impl EffectWatch {
             effect: FirstEffect::default(),
             angles: Vec::new(),
             commands: Vec::new(),
+            healthy: Vec::new(),
         }
     }
 
@@ -86,6 +102,9 @@ impl EffectWatch {
         let angle = (r.eta_x - h.eta_x).abs().max((r.eta_y - h.eta_y).abs());
         let sigmas = ((r.thrust - h.thrust).abs() / self.spec.thrust_noise)
             .max(angle / self.spec.angle_noise);
+        if m >= self.t_f - 0.1 {
+            self.healthy.push((m, h.eta_x, h.eta_y));
+        }
         if m >= self.t_f - 1e-9 {
             mark(&mut self.effect.at, m, sigmas);
             self.angles.push((m, angle, r.eta_x, r.eta_y));
@@ -123,6 +142,53 @@ impl EffectWatch {
         if !late.is_empty() {
             self.effect.inside = Some(inside.count() as f64 / late.len() as f64);
         }
+        self.effect.model = self.model_errors(first);
         self.effect
+    }
+
+    /// The model's predictions `(t, [eta_x, eta_y])` from the first healthy report on.
+    fn predictions(&self) -> Vec<(f64, [f64; 2])> {
+        let period = 0.01;
+        let (gain, step) = (1.0 - (-period / 0.05_f64).exp(), 6.0 * period);
+        let Some(&(m0, x0, y0)) = self.healthy.first() else {
+            return Vec::new();
+        };
+        let mut model = [x0, y0];
+        let mut predicted = Vec::new();
+        for &(t, x, y) in self.commands.iter().filter(|c| c.0 >= m0 - 1e-9) {
+            for (m, c) in model.iter_mut().zip([x, y]) {
+                *m += ((c - *m) * gain).clamp(-step, step);
+            }
+            predicted.push((t + period, model));
+        }
+        predicted
+    }
+
+    /// [`FirstEffect::model`] and [`FirstEffect::model_named`].
+    fn model_errors(&mut self, first: f64) -> Option<[f64; 2]> {
+        let predicted = self.predictions();
+        let error = |m: f64, x: f64, y: f64| {
+            let p = predicted.iter().find(|p| (p.0 - m).abs() < 1e-6)?.1;
+            Some((x - p[0]).abs().max((y - p[1]).abs()))
+        };
+        let within = |m: f64| m >= first - 1e-9 && m <= first + 0.5 + 1e-9;
+        let healthy = self
+            .healthy
+            .iter()
+            .filter(|h| within(h.0))
+            .filter_map(|h| error(h.0, h.1, h.2))
+            .reduce(f64::max)?;
+        let stuck: Vec<(f64, f64)> = self
+            .angles
+            .iter()
+            .filter(|a| within(a.0))
+            .filter_map(|a| Some((a.0, error(a.0, a.2, a.3)?)))
+            .collect();
+        self.effect.model_named = stuck
+            .windows(2)
+            .find(|w| w.iter().all(|e| e.1 > MODEL_TOLERANCE))
+            .map(|w| w[1].0 + self.spec.latency - first);
+        let stuck = stuck.iter().map(|e| e.1).reduce(f64::max)?;
+        Some([healthy, stuck])
     }
 }
