@@ -71,6 +71,12 @@ pub enum Command {
         /// confirmed lost agent itself); needs the offset-free law (docs/method.md).
         #[arg(long, value_parser = ["report", "mask"])]
         detect: Option<String>,
+        /// Turn on the agents' own reports (`[reports]` at the simulator's defaults, replacing
+        /// the scenario's: 100 Hz, 20 ms latency, 0.05 N and 5 mrad of noise); the value says
+        /// what a dead ESC reports: silent (nothing, the default) or zero (zero speed). With
+        /// --detect the controller checks them (docs/fault-detection.md).
+        #[arg(long, value_name = "DEAD_ESC", num_args = 0..=1, default_missing_value = "silent", value_parser = ["silent", "zero"])]
+        reports: Option<String>,
         /// Override the scenario's controller precision: f64, or f32 (the flight
         /// configuration, `tvmd_core::Controller<f32, ..>`); the physics stays f64.
         #[arg(long, value_parser = ["f64", "f32"])]

@@ -1,8 +1,8 @@
 //! Run-time overrides of a scenario (the command line's `--relaxation` / `--allocator` /
-//! `--precision` / `--team` / `--law`, the Python keywords `relaxation=` / `allocator=` /
+//! `--precision` / `--team` / `--law` / `--detect` / `--reports`, the Python keywords `relaxation=` / `allocator=` /
 //! `precision=` / `law=`), applied with validation.
 
-use super::{FaultDetectionConfig, LawConfig, NullSpaceConfig, Precision, Scenario};
+use super::{AgentReports, FaultDetectionConfig, LawConfig, NullSpaceConfig, Precision, Scenario};
 use crate::ScenarioError;
 
 /// Fields of a scenario replaced at run time; `None` keeps the scenario's value.
@@ -24,6 +24,9 @@ pub struct Overrides {
     /// Agent fault detection (`[fault_detection]`), e.g. the recommended detector with the
     /// `"mask"` response.
     pub fault_detection: Option<FaultDetectionConfig>,
+    /// The agents' own reports (`[reports]`), e.g. the simulator's defaults with a dead ESC
+    /// that reports zero speed.
+    pub reports: Option<AgentReports>,
 }
 
 impl Overrides {
@@ -36,6 +39,7 @@ impl Overrides {
             && self.team.is_none()
             && self.law.is_none()
             && self.fault_detection.is_none()
+            && self.reports.is_none()
     }
 
     /// Applies the overrides to `scenario` and validates the result; errors name the field.
@@ -57,6 +61,9 @@ impl Overrides {
         }
         if let Some(detection) = self.fault_detection {
             scenario.fault_detection = Some(detection);
+        }
+        if let Some(reports) = &self.reports {
+            scenario.reports = Some(reports.clone());
         }
         if let Some(team) = &self.team {
             scenario.team.preset = Some(team.clone());
@@ -88,6 +95,10 @@ mod tests {
             team: Some("a6-inc".into()),
             law: Some(LawConfig::paper()),
             fault_detection: None,
+            reports: Some(AgentReports {
+                rate: 50.0,
+                ..AgentReports::default()
+            }),
         };
         assert!(!o.is_empty() && Overrides::default().is_empty());
         let s = Scenario::default().with_overrides(&o).unwrap();
@@ -96,6 +107,7 @@ mod tests {
         assert_eq!(s.controller_precision, Precision::F32);
         assert_eq!(s.team_body().unwrap().len(), 6);
         assert_eq!(s.law, LawConfig::paper());
+        assert_eq!(s.reports.as_ref().map(|r| r.rate), Some(50.0));
         assert_ne!(Scenario::default().law, LawConfig::paper());
         let bad = Overrides {
             team: Some("a99".into()),
@@ -131,5 +143,14 @@ mod tests {
             matches!(&e, ScenarioError::InvalidScenario { field, .. } if field == "allocator"),
             "{e}"
         );
+        let bad = Overrides {
+            reports: Some(AgentReports {
+                latency: -1.0,
+                ..AgentReports::default()
+            }),
+            ..Overrides::default()
+        };
+        let e = Scenario::default().with_overrides(&bad).unwrap_err();
+        assert!(e.to_string().contains("reports.latency"), "{e}");
     }
 }

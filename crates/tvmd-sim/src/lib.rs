@@ -45,7 +45,7 @@ pub use control::pil::{self, PilError, PilTarget};
 pub use control::recording::{self, CycleRecording};
 pub use control::{AnyTvmdController, TvmdController, WrenchAllocation, MAX_AGENTS};
 pub use error::{BoxedError, SimError};
-pub use flight::{FlightController, FlightInput, FlightOutput};
+pub use flight::{AgentReport, FlightController, FlightInput, FlightOutput};
 pub use load::{load_run, LoadedRun};
 pub use request::{RunRequest, ScenarioSource};
 pub use runner::{relaxation_sweep, run_many, run_scenario, RunSpec};

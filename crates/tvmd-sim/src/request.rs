@@ -8,8 +8,8 @@
 use std::path::{Path, PathBuf};
 
 use tvmd_scenario::{
-    FaultDetectionConfig, FaultResponseConfig, LawConfig, NullSpaceConfig, Overrides, Precision,
-    Scenario,
+    AgentReports, DeadEsc, FaultDetectionConfig, FaultResponseConfig, LawConfig, NullSpaceConfig,
+    Overrides, Precision, Scenario,
 };
 
 use crate::runner::RunSpec;
@@ -75,6 +75,8 @@ pub struct RunRequest {
     pub law: Option<LawConfig>,
     /// Override of the fault detection (`[fault_detection]`).
     pub fault_detection: Option<FaultDetectionConfig>,
+    /// Override of the agents' reports (`[reports]`).
+    pub reports: Option<AgentReports>,
     /// Override of the controller precision.
     pub precision: Option<Precision>,
     /// The processor-in-the-loop target, or `None` for the host.
@@ -113,6 +115,26 @@ impl RunRequest {
             }
         };
         Ok(FaultDetectionConfig::with_response(response))
+    }
+
+    /// The option `reports` (`silent`, `zero`): the agents' reports at the simulator's
+    /// defaults ([`AgentReports::default`]: 100 Hz, 20 ms latency, 0.05 N and 5 mrad of
+    /// noise), a dead ESC reporting nothing or zero speed; the error names `reports`.
+    pub fn parse_reports(text: &str) -> Result<AgentReports, SimError> {
+        let dead_esc = match text {
+            "silent" => DeadEsc::Silent,
+            "zero" => DeadEsc::Zero,
+            other => {
+                return Err(invalid(
+                    "reports",
+                    format!("unknown dead ESC `{other}` (known: silent, zero)"),
+                ))
+            }
+        };
+        Ok(AgentReports {
+            dead_esc,
+            ..AgentReports::default()
+        })
     }
 
     /// The option `pil` (`cortex-m4`, `cortex-m7`); the error names `pil`.
@@ -159,6 +181,7 @@ impl RunRequest {
             team: self.team.clone(),
             law: self.law,
             fault_detection: self.fault_detection,
+            reports: self.reports.clone(),
         }
     }
 
@@ -226,6 +249,11 @@ mod tests {
             e.contains("controller_precision") && e.contains("f16"),
             "{e}"
         );
+        let r = RunRequest::parse_reports("zero").unwrap();
+        assert_eq!(r.dead_esc, DeadEsc::Zero);
+        assert_eq!(r.rate, AgentReports::default().rate);
+        let e = RunRequest::parse_reports("loud").unwrap_err().to_string();
+        assert!(e.contains("`reports`") && e.contains("loud"), "{e}");
         let e = RunRequest::parse_pil("cortex-z9").unwrap_err().to_string();
         assert!(e.contains("`pil`"), "{e}");
         let e = RunRequest::parse_null_space("nope")

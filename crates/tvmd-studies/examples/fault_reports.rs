@@ -1,7 +1,10 @@
 //! The agents' own reports in the controller's fault detection (issue 60,
 //! `docs/fault-detection.md`, "The agents' reports"): delays per team, fault and flight phase
 //! with reports at 100 Hz and 20 ms latency; `a6-agent-failure` not informed against informed; false alarms over nominal
-//! flights with 10% of the reports lost and a jittering command link; a report that lies.
+//! flights with 10% of the reports lost and a jittering command link; a report that lies; and
+//! the delays from each failure's first effect on a report (`fault_effect`: the first report that
+//! differs from the one the agent would have sent had it not failed by more than 3, 1 or 10
+//! standard deviations of its noise, or that the failure stopped).
 //!
 //! ```text
 //! cargo run --profile ci -p tvmd-studies --example fault_reports -- [FLIGHTS] [JOBS]
@@ -12,6 +15,9 @@
 //! and the recommended detector with `response = "mask"`, as `examples/fault_detection.rs`; and
 //! `[reports]` at their defaults (100 Hz, 20 ms latency, 0.05 N and 5 mrad of noise). `FLIGHTS`
 //! nominal flights (default 1000) over A4-, A6-, A8-Inc and hover, wind, tilt. Prints Markdown.
+//!
+//! `TVMD_STUDY_ANGLE_CHECK=0.025,1.0` flies every flight with the report check's
+//! `angle_tolerance` and `angle_forget` set so (how their retuning was measured).
 //!
 //! `TVMD_STUDY_TRACE=a6-inc,tilt,16,2` prints instead, for nominal flight 16 (A6-Inc, tilt) and
 //! agent 2, each tick's command and newest report from 4.9 to 5.8 s (how the report check's
@@ -27,7 +33,9 @@ use tvmd_sim::{run_scenario, FaultEvent, FaultSummary, RunResult};
 use tvmd_studies::montecarlo::Conditions;
 
 mod fault_common;
+mod fault_effect;
 use fault_common::{map, quantiles, Phase, TEAMS};
+use fault_effect::{EffectWatch, FirstEffect};
 
 const SEED: u64 = 60;
 
@@ -87,7 +95,11 @@ fn flight(
     reports: AgentReports,
     links: Option<CommandLinks>,
 ) -> Result<Scenario, Box<dyn std::error::Error>> {
-    let detection = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
+    let mut detection = FaultDetectionConfig::with_response(FaultResponseConfig::Mask);
+    if let Some([tolerance, forget]) = angle_check() {
+        detection.report_check.angle_tolerance = tolerance;
+        detection.report_check.angle_forget = forget;
+    }
     let conditions = Conditions {
         links,
         ..Conditions::default()
@@ -100,6 +112,40 @@ fn flight(
     })
 }
 
+/// `TVMD_STUDY_ANGLE_CHECK=tolerance,forget`: the report check's `angle_tolerance` (rad) and
+/// `angle_forget` (rad/s) for every flight, in place of the recommended ones.
+fn angle_check() -> Option<[f64; 2]> {
+    let v = std::env::var("TVMD_STUDY_ANGLE_CHECK").ok()?;
+    let (a, b) = v.split_once(',')?;
+    Some([a.trim().parse().ok()?, b.trim().parse().ok()?])
+}
+
+/// Flies `s` with its controller, watching `agent`'s reports from `t_f` on: its fault summary
+/// and the failure's first effects on the reports.
+fn fly_watching(
+    s: &Scenario,
+    agent: usize,
+    t_f: f64,
+) -> Result<(FaultSummary, FirstEffect), Box<dyn std::error::Error>> {
+    use tvmd_sim::FlightController;
+    let options = tvmd_sim::sim::SimOptions {
+        samples: tvmd_sim::sim::SampleRetention::None,
+    };
+    let mut sim = tvmd_sim::sim::Simulation::with_options(s, options)?;
+    let mut c = tvmd_sim::AnyTvmdController::from_scenario(s)?;
+    let mut watch = EffectWatch::new(t_f, s.reports.clone().ok_or("no reports")?);
+    while !sim.is_finished() {
+        let o = sim.observe()?.clone();
+        let healthy = sim.healthy_reports();
+        watch.see(o.t, o.reports[agent], healthy[agent]);
+        let out = c.step(&o.input()).map_err(|e| e.to_string())?;
+        let sent = out.commands[agent];
+        watch.command(o.t, sent.eta_x, sent.eta_y);
+        sim.step_output(out)?;
+    }
+    Ok((sim.summary().fault.unwrap_or_default(), watch.finish()))
+}
+
 struct FaultRun {
     team: &'static str,
     fault: Fault,
@@ -107,6 +153,7 @@ struct FaultRun {
     agent: usize,
     summary: FaultSummary,
     t_f: f64,
+    effect: FirstEffect,
 }
 
 impl FaultRun {
@@ -117,6 +164,16 @@ impl FaultRun {
             Some(e) if e.agent == self.agent && e.time >= self.t_f => Ok(Some(e.time - self.t_f)),
             Some(_) => Err(()),
         }
+    }
+
+    /// The delay of the first confirmation (the right agent) after the failure's first effect
+    /// on a report past `fault_effect::EFFECT_SIGMAS[k]`.
+    fn since_effect(&self, k: usize) -> Option<f64> {
+        let e = self
+            .summary
+            .first_confirmed
+            .filter(|e| e.agent == self.agent)?;
+        Some(e.time - self.effect.at[k]?)
     }
 }
 
@@ -154,14 +211,15 @@ fn fault_runs(jobs: usize) -> Vec<FaultRun> {
             controller_informed: false,
             informed_after: 0.0,
         }];
-        let r = run_scenario(&s, None, None).ok()?;
+        let (summary, effect) = fly_watching(&s, agent, t_f).ok()?;
         Some(FaultRun {
             team,
             fault,
             phase,
             agent,
-            summary: r.summary.fault.unwrap_or_default(),
+            summary,
             t_f,
+            effect,
         })
     })
 }
@@ -212,6 +270,70 @@ fn fault_table(runs: &[FaultRun]) {
                     group.len(),
                     by("reports"),
                     by("residual"),
+                );
+            }
+        }
+    }
+}
+
+/// The failure's first effect on the failed agent's reports (past 3, 1 and 10 standard
+/// deviations of the report's noise, or a report missing) and the first confirmation after it.
+fn effect_table(runs: &[FaultRun]) {
+    println!("| team | fault | phase | flights | an effect (3 sigma) | first effect, s after t_f: median / worst | isolated, s after the first effect (3 sigma): median / worst | (1 sigma): median / worst | (10 sigma): median / worst | largest angle effect within 50 ms (rad), median | reports within the commands' range, median share | the check's servo model's largest error (rad), median: healthy / stuck reports | named by a check against that model (0.1 rad, 2 reports), s after the first effect: median / worst |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for team in TEAMS {
+        for fault in Fault::ALL {
+            for phase in [Phase::Hover, Phase::Tilt] {
+                let group: Vec<&FaultRun> = runs
+                    .iter()
+                    .filter(|r| r.team == team && r.fault == fault && r.phase == phase)
+                    .collect();
+                let first: Vec<f64> = group
+                    .iter()
+                    .filter_map(|r| Some(r.effect.at[0]? - r.t_f))
+                    .collect();
+                let after = |k: usize| {
+                    quantiles(group.iter().filter_map(|r| r.since_effect(k)).collect(), 3)
+                };
+                let median = |pick: fn(&FirstEffect) -> Option<f64>, digits: usize| {
+                    let v: Vec<f64> = group.iter().filter_map(|r| pick(&r.effect)).collect();
+                    quantiles(v, digits)
+                        .split(" / ")
+                        .next()
+                        .unwrap_or("-")
+                        .to_string()
+                };
+                let (largest, inside, model) = if fault == Fault::StuckGimbal {
+                    (
+                        median(|e| e.largest, 3),
+                        median(|e| e.inside, 2),
+                        format!(
+                            "{} (worst {:.3}) / {} | {}",
+                            median(|e| e.model.map(|m| m[0]), 3),
+                            group
+                                .iter()
+                                .filter_map(|r| Some(r.effect.model?[0]))
+                                .fold(0.0, f64::max),
+                            median(|e| e.model.map(|m| m[1]), 3),
+                            quantiles(
+                                group.iter().filter_map(|r| r.effect.model_named).collect(),
+                                3
+                            ),
+                        ),
+                    )
+                } else {
+                    ("-".into(), "-".into(), "- | -".into())
+                };
+                println!(
+                    "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} | {model} |",
+                    fault.name(),
+                    phase.name(),
+                    group.len(),
+                    first.len(),
+                    quantiles(first, 3),
+                    after(0),
+                    after(1),
+                    after(2),
                 );
             }
         }
@@ -366,7 +488,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("## a6-agent-failure, not informed, with reports\n");
     outcome()?;
     println!("\n## Delays with reports (100 Hz, 20 ms), fault at t_f, not informed\n");
-    fault_table(&fault_runs(jobs));
+    let runs = fault_runs(jobs);
+    fault_table(&runs);
+    println!("\n## The failure's first effect on a report (the failed agent's report against the one it would have sent had it not failed, the same noise), not informed\n");
+    effect_table(&runs);
     println!("\n## False alarms over {flights} nominal flights, 10% of the reports lost, link jitter 0-10 ms\n");
     false_alarms(flights, jobs);
     Ok(())

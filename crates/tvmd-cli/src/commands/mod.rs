@@ -45,6 +45,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             team,
             law,
             detect,
+            reports,
             precision,
             pil,
             live,
@@ -64,6 +65,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             team,
             law,
             detect,
+            reports,
             precision,
             pil,
             live: live.then_some(LiveOptions {

@@ -31,6 +31,7 @@ pub struct RunArgs {
     pub(crate) team: Option<String>,
     pub(crate) law: Option<String>,
     pub(crate) detect: Option<String>,
+    pub(crate) reports: Option<String>,
     pub(crate) precision: Option<String>,
     pub(crate) pil: Option<String>,
     pub(crate) live: Option<LiveOptions>,
@@ -68,6 +69,11 @@ pub fn cmd_run(a: RunArgs) -> Result<(), CliError> {
             .detect
             .as_deref()
             .map(RunRequest::parse_fault_detection)
+            .transpose()?,
+        reports: a
+            .reports
+            .as_deref()
+            .map(RunRequest::parse_reports)
             .transpose()?,
         samples: plot_retention(a.plots.is_some()),
         ..RunRequest::default()

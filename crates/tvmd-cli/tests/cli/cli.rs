@@ -348,6 +348,62 @@ fn detect_option_reports_the_fault_and_needs_the_observer() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Issue 60: `--reports` turns on the agents' own reports at the simulator's defaults; with
+/// `--detect` the controller names a dead ESC that reports zero speed from its reports (two
+/// reports after the first that shows it, 20 ms late), and one that falls silent too.
+#[test]
+fn reports_option_turns_on_the_agents_reports() {
+    let dir = tmp_dir("reports");
+    // A6-Inc loses agent 0 at 0.5 s in a hover the controller is not told of.
+    let path = dir.join("loss.toml");
+    std::fs::write(
+        &path,
+        "name = \"loss\"\nduration = 1.2\ninitial_position = [0.0, 0.0, 1.5]\n\
+         [team]\npreset = \"a6-inc\"\n[reference]\nkind = \"hover\"\nposition = [0.0, 0.0, 1.5]\n\
+         [[failures]]\nagent = 0\ntime = 0.5\nkind = \"no-thrust\"\ncontroller_informed = false\n",
+    )
+    .unwrap();
+    let summary = dir.join("summary.json");
+    let masked = |reports: &[&str]| {
+        ok(bin()
+            .args(["run", path.to_str().unwrap(), "--no-log"])
+            .args(["--detect", "mask"])
+            .args(reports)
+            .args(["--summary", summary.to_str().unwrap()])
+            .output()
+            .unwrap());
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        json["summary"]["fault"]["masked"].clone()
+    };
+    let zero = masked(&["--reports", "zero"]);
+    assert_eq!(zero["agent"], 0, "{zero}");
+    assert_eq!(zero["source"], "reports", "{zero}");
+    let at = zero["time"].as_f64().unwrap();
+    assert!(at > 0.5 && at < 0.55, "{zero}");
+    // Without a value: the dead ESC falls silent, and the agent is named all the same.
+    let silent = masked(&["--reports"]);
+    assert_eq!(silent["agent"], 0, "{silent}");
+    assert!(silent["time"].as_f64().unwrap() > at, "{silent} {zero}");
+    let out = bin()
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--no-log",
+            "--reports",
+            "loud",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("loud") && stderr.contains("--reports"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Issue 57: `--detect` on a scenario that flies the paper's law says which law it needs.
 #[test]
 fn detect_on_a_paper_law_scenario_names_the_law_it_needs() {

@@ -32,7 +32,10 @@ impl CommandPath {
             held: vec![ActuatorCommand::default(); agents],
             saturation: PlantSaturation::new(scenario, agents)?,
             links: spec.map(|s| Links::new(s, agents)),
-            reports: scenario.reports.as_ref().map(|r| Reports::new(r, agents)),
+            reports: scenario
+                .reports
+                .as_ref()
+                .map(|r| Reports::new(r, agents, scenario.actuators)),
         })
     }
 
@@ -71,6 +74,26 @@ impl CommandPath {
             Some(l) => r.sample(t, bank, l.applied(), |i| l.is_silent(i, t)),
             None => r.sample(t, bank, &self.held, |_| false),
         }
+    }
+
+    /// After the actuators' physics step of `dt`: the agents' healthy twin (with reports) steps
+    /// with the same applied commands.
+    pub(super) fn step_twin(&mut self, dt: f64) {
+        let applied = match self.links.as_ref() {
+            Some(l) => l.applied(),
+            None => &self.held,
+        };
+        if let Some(r) = self.reports.as_mut() {
+            r.step_twin(applied, dt);
+        }
+    }
+
+    /// Per agent, the newest report arrived by the last [`CommandPath::reports_at`] as the
+    /// agent would have sent it had it not failed, aged to `t` (empty: no reports).
+    pub(super) fn healthy_reports(&self, t: f64) -> Vec<Option<AgentReport>> {
+        self.reports
+            .as_ref()
+            .map_or_else(Vec::new, |r| r.healthy_at(t))
     }
 
     /// Per agent, the newest report arrived by `t` (empty: the scenario has no reports).

@@ -134,6 +134,15 @@ impl Simulation {
         self.commands.link_stats()
     }
 
+    /// Per agent, the newest report of the current tick's observation as the agent would have
+    /// sent it had it not failed: its actuators' healthy twin (the same model given the same
+    /// commands, never failed; a lying agent's command) measured with the same noise draws.
+    /// Against [`Observation::reports`] it is the failure's effect on the report, without
+    /// noise: zero for an agent that has not failed. Empty without `[reports]`.
+    pub fn healthy_reports(&self) -> Vec<Option<AgentReport>> {
+        self.commands.healthy_reports(self.time())
+    }
+
     /// The number of agents (the length of every step's commands).
     pub fn agents(&self) -> usize {
         self.team.len()
@@ -303,6 +312,7 @@ impl Simulation {
             let (applied, changed) = self.commands.applied(t);
             self.forces_stale |= changed;
             self.actuators.step(applied, dt);
+            self.commands.step_twin(dt);
             if self.forces_stale || !memoryless {
                 body_forces(
                     self.actuators.outputs(),

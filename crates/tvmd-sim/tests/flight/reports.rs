@@ -149,3 +149,43 @@ fn no_reports_section_means_no_reports() {
     let mut sim = Simulation::new(&s).unwrap();
     assert!(sim.observe().unwrap().reports.is_empty());
 }
+
+/// The reports a healthy agent would have sent (`Simulation::healthy_reports`): the same as
+/// the reports for an agent that has not failed, bit for bit (the same actuators, commands and
+/// noise); for a failed one they differ by the failure's effect alone.
+#[test]
+fn healthy_reports_differ_by_the_failure_alone() {
+    let zero = AgentReports {
+        dead_esc: DeadEsc::Zero,
+        ..AgentReports::default()
+    };
+    let s = hover(Some((1, FailureKind::NoThrust)), zero);
+    let mut sim = Simulation::new(&s).unwrap();
+    let mut controller = AnyTvmdController::from_scenario(&s).unwrap();
+    let mut effects = 0;
+    while !sim.is_finished() {
+        let o = sim.observe().unwrap().clone();
+        let healthy = sim.healthy_reports();
+        assert_eq!(healthy.len(), 6);
+        for (i, (r, h)) in o.reports.iter().zip(&healthy).enumerate() {
+            let (Some(r), Some(h)) = (r, h) else {
+                assert_eq!(r, h);
+                continue;
+            };
+            // Measured before the failure at 1.0 s, or another agent: the same report.
+            if i != 1 || o.t - r.age < 1.0 - 1e-9 {
+                assert_eq!(r, h, "t = {}, agent {i}", o.t);
+            } else {
+                assert!(r.thrust.abs() < 0.3 && h.thrust > 1.0, "{r:?} {h:?}");
+                assert_eq!((r.eta_x, r.eta_y, r.age), (h.eta_x, h.eta_y, h.age));
+                effects += 1;
+            }
+        }
+        let out = controller.step(&o.input()).unwrap();
+        sim.step_output(out).unwrap();
+    }
+    assert!(effects > 150, "{effects} reports after the failure");
+    let mut s = Scenario::builtin("hover").unwrap();
+    s.duration = 0.05;
+    assert!(Simulation::new(&s).unwrap().healthy_reports().is_empty());
+}
