@@ -39,11 +39,11 @@
 # time (`tvmd-sim px4 --real-time`; each stack's again under the wind and the model error),
 # reading PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
 # (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
-# --teams (not in the test command: five flights, about a minute on a built tree) flies
+# --teams (not in the test command: ten flights, about two minutes on a built tree) flies
 # flight.toml with the catalogue's other teams of at most four agents, each on its own airframe
 # (4091 a3-con, 4092 a3-inc, 4093 a4-con, 4094 a4-diamond-con, 4095 a4-diamond-inc; tvmd-sim's
-# team the same preset) and checks each as --fly does, against tvmd-sim's own flight of the
-# reference with the same team (docs/px4-teams.md).
+# team the same preset), nominal and with --fly's model error, and checks each as --fly does,
+# against tvmd-sim's own flight of the reference with the same team (docs/px4-teams.md).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
@@ -228,19 +228,28 @@ if [ "$teams" -eq 1 ]; then
   grep -v '^param set TVMD_AG' "$flights/params" >"$teams_out/params"
   for entry in 4091:a3-con 4092:a3-inc 4093:a4-con 4094:a4-diamond-con 4095:a4-diamond-inc; do
     autostart="${entry%%:*}" preset="${entry#*:}"
-    step "tvmd_control in PX4 on tvmd-sim: $preset (airframe $autostart)"
+    step "tvmd-sim's own flight of the reference with $preset"
     "$sim" run "$flights/own-tilt.toml" --team "$preset" --summary "$teams_out/own-tilt-$preset.json" \
       --out "$teams_out/own-tilt-$preset.mcap" >/dev/null
-    sed 's/^preset = "a4-inc"$/preset = "'"$preset"'"/' "$flights/scenario.toml" >"$teams_out/scenario-$preset.toml"
-    grep -q "^preset = \"$preset\"$" "$teams_out/scenario-$preset.toml"
-    start=$(date +%s)
-    "$sim" px4 "$teams_out/scenario-$preset.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
-      --px4-build "$target" --autostart "$autostart" --params "$teams_out/params" --instance "$instance" \
-      --out "$teams_out/$preset.mcap"
-    echo "flown in $(($(date +%s) - start)) s wall"
-    python3 "$repo/scripts/px4/tvmd_control.py" "$teams_out/$preset.ulg" "$teams_out/$preset.px4.json" \
-      --own "$teams_out/own-tilt-$preset.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
-      --json "$teams_out/$preset.measures.json"
+    for flight in scenario scenario-model-error; do
+      # The model error's gimbal offsets name four agents: a three-agent team drops the last
+      # (agent 3's, zero).
+      name="$preset"; [ "$flight" = scenario ] || name="$preset-model-error"
+      sed 's/^preset = "a4-inc"$/preset = "'"$preset"'"/' "$flights/$flight.toml" >"$teams_out/$name.toml"
+      case "$preset" in
+        a3-*) sed -i 's/^\(gimbal_offsets = .*\), \[0\.0, 0\.0\]\]$/\1]/' "$teams_out/$name.toml" ;;
+      esac
+      grep -q "^preset = \"$preset\"$" "$teams_out/$name.toml"
+      step "tvmd_control in PX4 on tvmd-sim: $name (airframe $autostart)"
+      start=$(date +%s)
+      "$sim" px4 "$teams_out/$name.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
+        --px4-build "$target" --autostart "$autostart" --params "$teams_out/params" --instance "$instance" \
+        --out "$teams_out/$name.mcap"
+      echo "flown in $(($(date +%s) - start)) s wall"
+      python3 "$repo/scripts/px4/tvmd_control.py" "$teams_out/$name.ulg" "$teams_out/$name.px4.json" \
+        --own "$teams_out/own-tilt-$preset.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
+        --json "$teams_out/$name.measures.json"
+    done
   done
   echo "tvmd_control flew hover and the tilt with every catalogue team of at most four agents (ulogs in $teams_out)"
 fi
