@@ -4,11 +4,12 @@
 # parameter and keeps running; with --fly, flies it on tvmd-sim in lockstep (tvmd-sim px4) and
 # checks the flights from their ulogs (docs/px4-module.md).
 #
-#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly] [--side-by-side] [--perf]   (or PX4_DIR=... bash scripts/px4-module.sh)
+#   bash scripts/px4-module.sh PX4_DIR [--smoke] [--fly] [--teams] [--side-by-side] [--perf]   (or PX4_DIR=... bash scripts/px4-module.sh)
 #
 # What it changes in PX4_DIR (each once; rerunning is safe):
-#   - installs the airframe px4/airframes/4090_tvmd_control_a4 (+ .post) into
-#     ROMFS/px4fmu_common/init.d-posix/airframes and lists it in that folder's CMakeLists.txt;
+#   - installs the airframes px4/airframes/4090-4095_tvmd_control_* (+ .post, and the files
+#     they source, rc.tvmd_control_defaults and rc.tvmd_control_apps) into
+#     ROMFS/px4fmu_common/init.d-posix/airframes and lists them in that folder's CMakeLists.txt;
 #   - adds tvmd_control_status to the logger's default topics (src/modules/logger/
 #     logged_topics.cpp), so that every ulog has it.
 # Then it runs `make $PX4_TARGET EXTERNAL_MODULES_LOCATION=<repo>/px4` (PX4_TARGET defaults to
@@ -38,6 +39,11 @@
 # time (`tvmd-sim px4 --real-time`; each stack's again under the wind and the model error),
 # reading PX4's perf counters in each window (scripts/px4/perf.py): each stack's time per cycle
 # (PX4_TARGET=px4_sitl_nolockstep builds that one alone); the side-by-side table then shows it.
+# --teams (not in the test command: ten flights, about two minutes on a built tree) flies
+# flight.toml with the catalogue's other teams of at most four agents, each on its own airframe
+# (4091 a3-con, 4092 a3-inc, 4093 a4-con, 4094 a4-diamond-con, 4095 a4-diamond-inc; tvmd-sim's
+# team the same preset), nominal and with --fly's model error, and checks each as --fly does,
+# against tvmd-sim's own flight of the reference with the same team (docs/px4-teams.md).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 
@@ -46,13 +52,15 @@ smoke=0
 fly=0
 side=0
 perf=0
+teams=0
 for arg in "$@"; do
   case "$arg" in
     --smoke) smoke=1 ;;
     --fly) fly=1 ;;
     --side-by-side) side=1 ;;
     --perf) perf=1 ;;
-    -h|--help) sed -n '2,40p' "$0"; exit 0 ;;
+    --teams) teams=1 ;;
+    -h|--help) sed -n '2,48p' "$0"; exit 0 ;;
     *) px4_dir="$arg" ;;
   esac
 done
@@ -77,9 +85,11 @@ python3 -c 'import em, genmsg, kconfiglib, jinja2, yaml' 2>/dev/null || {
   exit 2
 }
 
-step "airframe 4090_tvmd_control_a4 into $px4_dir"
+step "airframes 4090-4095_tvmd_control_* into $px4_dir"
 airframes="$px4_dir/ROMFS/px4fmu_common/init.d-posix/airframes"
-for f in 4090_tvmd_control_a4 4090_tvmd_control_a4.post; do
+# PX4 (v1.15) takes ROMFS files only from its own tree: an external-modules folder cannot add
+# an airframe, so they are copied there, with the two files they share.
+for f in $(cd "$repo/px4/airframes" && ls); do
   cp "$repo/px4/airframes/$f" "$airframes/$f"
   if ! grep -qE "^[[:space:]]*$f\$" "$airframes/CMakeLists.txt"; then
     sed -i "s/^px4_add_romfs_files(\$/px4_add_romfs_files(\n\t$f/" "$airframes/CMakeLists.txt"
@@ -121,15 +131,15 @@ build_px4() {
 }
 build_px4 "$target"
 
-[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ] || exit 0
+[ "$smoke" -eq 1 ] || [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ] || [ "$teams" -eq 1 ] || exit 0
 case "$target" in
   px4_sitl*) ;;
-  *) echo "error: --smoke, --fly, --side-by-side and --perf need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
+  *) echo "error: --smoke, --fly, --teams, --side-by-side and --perf need a SITL target (PX4_TARGET=$target)" >&2; exit 2 ;;
 esac
 build="$px4_dir/build/$target"
 instance="${PX4_INSTANCE:-7}"
 
-if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ]; then
+if [ "$fly" -eq 1 ] || [ "$side" -eq 1 ] || [ "$perf" -eq 1 ] || [ "$teams" -eq 1 ]; then
   python3 -c 'import pyulog' 2>/dev/null || {
     echo "error: --fly reads the ulogs with pyulog: install it in the Python environment (pip install pyulog)" >&2
     exit 2
@@ -206,6 +216,42 @@ if [ "$fly" -eq 1 ]; then
   python3 "$repo/scripts/px4/tvmd_control.py" "$out/agent-failure.ulg" "$out/agent-failure.px4.json" \
     --failed-tilt 0.8 --failed-landing 0.15 --json "$out/agent-failure.measures.json"
   echo "tvmd_control flew hover, the tilt and the agent failure in PX4 SITL (ulogs in $out)"
+fi
+
+if [ "$teams" -eq 1 ]; then
+  # The catalogue's other teams of at most four agents, each on its airframe; tvmd-sim flies the
+  # same preset (scenario.toml with its team replaced) and its own flight of the reference with
+  # it (own-tilt.toml --team). The flight's parameters are params without the A4-Inc geometry
+  # (the airframe carries the team's).
+  teams_out="$out/teams"
+  mkdir -p "$teams_out"
+  grep -v '^param set TVMD_AG' "$flights/params" >"$teams_out/params"
+  for entry in 4091:a3-con 4092:a3-inc 4093:a4-con 4094:a4-diamond-con 4095:a4-diamond-inc; do
+    autostart="${entry%%:*}" preset="${entry#*:}"
+    step "tvmd-sim's own flight of the reference with $preset"
+    "$sim" run "$flights/own-tilt.toml" --team "$preset" --summary "$teams_out/own-tilt-$preset.json" \
+      --out "$teams_out/own-tilt-$preset.mcap" >/dev/null
+    for flight in scenario scenario-model-error; do
+      # The model error's gimbal offsets name four agents: a three-agent team drops the last
+      # (agent 3's, zero).
+      name="$preset"; [ "$flight" = scenario ] || name="$preset-model-error"
+      sed 's/^preset = "a4-inc"$/preset = "'"$preset"'"/' "$flights/$flight.toml" >"$teams_out/$name.toml"
+      case "$preset" in
+        a3-*) sed -i 's/^\(gimbal_offsets = .*\), \[0\.0, 0\.0\]\]$/\1]/' "$teams_out/$name.toml" ;;
+      esac
+      grep -q "^preset = \"$preset\"$" "$teams_out/$name.toml"
+      step "tvmd_control in PX4 on tvmd-sim: $name (airframe $autostart)"
+      start=$(date +%s)
+      "$sim" px4 "$teams_out/$name.toml" --flight "$flights/flight.toml" --px4-dir "$px4_dir" \
+        --px4-build "$target" --autostart "$autostart" --params "$teams_out/params" --instance "$instance" \
+        --out "$teams_out/$name.mcap"
+      echo "flown in $(($(date +%s) - start)) s wall"
+      python3 "$repo/scripts/px4/tvmd_control.py" "$teams_out/$name.ulg" "$teams_out/$name.px4.json" \
+        --own "$teams_out/own-tilt-$preset.json" --refused-at 30 --hover-rms 0.02 --tilt-hold 0.1 \
+        --json "$teams_out/$name.measures.json"
+    done
+  done
+  echo "tvmd_control flew hover and the tilt with every catalogue team of at most four agents (ulogs in $teams_out)"
 fi
 
 [ "$smoke" -eq 1 ] || exit 0

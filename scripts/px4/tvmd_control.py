@@ -110,12 +110,15 @@ def main():
     for stage in ("law", "attitude", "allocate", "output", "config"):
         m[f"{stage}_errors"] = int(status[f"{stage}_errors"][-1])
 
-    # No non-finite output: every driven channel of the 4 agents (motors 0-7, servos 0-7), and
-    # the status's wrench while flying.
+    # No non-finite output: every driven channel of the n agents (motors and servos 0 to 2n-1;
+    # n is TVMD_AG_COUNT, at most 4: the others are PX4's "disarmed" NaN), and the status's
+    # wrench while flying.
+    agents = int(ulog.initial_parameters.get("TVMD_AG_COUNT", 4))
+    m["agents"] = agents
     nonfinite = 0
     for name in ("actuator_motors", "actuator_servos"):
         d = topic(ulog, name)
-        for i in range(8):
+        for i in range(2 * agents):
             if name == "actuator_motors" and masked & (1 << (i // 2)):
                 continue  # a masked agent's motors are stopped (NaN) by design
             nonfinite += int(np.count_nonzero(~np.isfinite(d[f"control[{i}]"])))

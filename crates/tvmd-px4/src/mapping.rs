@@ -237,6 +237,29 @@ mod tests {
     }
 
     #[test]
+    fn authors_layout_drives_a_three_agent_team_from_the_first_six_of_each() {
+        // Airframes 4091 and 4092 (A3): motors 1-6 and servos 1-6; outputs 7, 8, 15, 16 unused.
+        let m = ControlMapping::new(&layout("authors"), 3, 12.0).unwrap();
+        for (i, role) in m.roles().iter().enumerate() {
+            let expected = match i {
+                0..=5 => Role::Rotor(i / 2),
+                8..=13 if i % 2 == 0 => Role::EtaX((i - 8) / 2),
+                8..=13 => Role::EtaY((i - 8) / 2),
+                _ => Role::Unused,
+            };
+            assert_eq!(*role, expected, "control {i}");
+        }
+        // What PX4 sends on the unused outputs (NaN, disarmed) drives nothing.
+        let mut u = [0.5f32; CONTROLS];
+        for i in [6, 7, 14, 15] {
+            u[i] = f32::NAN;
+        }
+        let c = m.commands(&u);
+        assert_eq!(c.len(), 3);
+        assert!(c.iter().all(|c| (c.thrust - 6.0).abs() < 1e-12), "{c:?}");
+    }
+
+    #[test]
     fn out_of_range_and_nan_controls_are_bounded() {
         let m = ControlMapping::new(&layout("quad"), 4, 10.0).unwrap();
         let mut u = [0f32; CONTROLS];
