@@ -57,8 +57,8 @@ def param_at(ulog, name, t):
     return value
 
 
-def quat_rows(data):
-    return np.stack([data[f"q[{i}]"] for i in range(4)], axis=1)
+def quat_rows(data, prefix="q"):
+    return np.stack([data[f"{prefix}[{i}]"] for i in range(4)], axis=1)
 
 
 def angle_between(q1, q2):

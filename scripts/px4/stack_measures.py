@@ -35,29 +35,10 @@ import sys
 import numpy as np
 from pyulog import ULog
 
-EARTH_RADIUS = 6371000.0
+from analyze import EARTH_RADIUS, quat_rows, roll_of, seconds, topic
+
 RATE_LOOP_HZ = 250.0  # tvmd_control's rate loop: every gyro sample in SITL
 HELD = 4.0  # s: the end of a window where the roll is held (the tilt windows' stick came 2-4 s before)
-
-
-def topic(ulog, name):
-    for d in ulog.data_list:
-        if d.name == name and d.multi_id == 0:
-            return d.data
-    return None
-
-
-def seconds(data):
-    return data["timestamp"] * 1e-6
-
-
-def quat_rows(data, prefix="q"):
-    return np.stack([data[f"{prefix}[{i}]"] for i in range(4)], axis=1)
-
-
-def roll_of(q):
-    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
 
 
 def tilt_of(q):

@@ -232,47 +232,56 @@ fn source(e: &Option<FaultEvent>) -> &'static str {
     }
 }
 
-fn fault_table(runs: &[FaultRun]) {
-    println!("| team | fault | phase | flights | named (right agent) | delay median / worst (s) | isolated: confirmed (right agent) | delay median / worst (s) | by reports / residual | masked | delay median / worst (s) | wrong agent first |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+/// The runs of each team, fault and phase, in the tables' order.
+fn groups(runs: &[FaultRun]) -> Vec<(&'static str, Fault, Phase, Vec<&FaultRun>)> {
+    let mut out = Vec::new();
     for team in TEAMS {
         for fault in Fault::ALL {
             for phase in [Phase::Hover, Phase::Tilt] {
-                let group: Vec<&FaultRun> = runs
+                let group = runs
                     .iter()
                     .filter(|r| r.team == team && r.fault == fault && r.phase == phase)
                     .collect();
-                let mut wrong = 0;
-                let mut column = |pick: &dyn Fn(&FaultRun) -> Option<FaultEvent>| {
-                    let mut delays = Vec::new();
-                    for r in &group {
-                        match r.delay(pick(r)) {
-                            Ok(Some(d)) => delays.push(d),
-                            Ok(None) => {}
-                            Err(()) => wrong += 1,
-                        }
-                    }
-                    (delays.len(), quantiles(delays, 3))
-                };
-                let (ns, ds) = column(&|r| r.summary.first_suspected);
-                let (nc, dc) = column(&|r| r.summary.first_confirmed);
-                let (nm, dm) = column(&|r| r.summary.masked);
-                let by = |name: &str| {
-                    group
-                        .iter()
-                        .filter(|r| source(&r.summary.first_confirmed) == name)
-                        .count()
-                };
-                println!(
-                    "| {team} | {} | {} | {} | {ns} | {ds} | {nc} | {dc} | {} / {} | {nm} | {dm} | {wrong} |",
-                    fault.name(),
-                    phase.name(),
-                    group.len(),
-                    by("reports"),
-                    by("residual"),
-                );
+                out.push((team, fault, phase, group));
             }
         }
+    }
+    out
+}
+
+fn fault_table(runs: &[FaultRun]) {
+    println!("| team | fault | phase | flights | named (right agent) | delay median / worst (s) | isolated: confirmed (right agent) | delay median / worst (s) | by reports / residual | masked | delay median / worst (s) | wrong agent first |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for (team, fault, phase, group) in groups(runs) {
+        let mut wrong = 0;
+        let mut column = |pick: &dyn Fn(&FaultRun) -> Option<FaultEvent>| {
+            let mut delays = Vec::new();
+            for r in &group {
+                match r.delay(pick(r)) {
+                    Ok(Some(d)) => delays.push(d),
+                    Ok(None) => {}
+                    Err(()) => wrong += 1,
+                }
+            }
+            (delays.len(), quantiles(delays, 3))
+        };
+        let (ns, ds) = column(&|r| r.summary.first_suspected);
+        let (nc, dc) = column(&|r| r.summary.first_confirmed);
+        let (nm, dm) = column(&|r| r.summary.masked);
+        let by = |name: &str| {
+            group
+                .iter()
+                .filter(|r| source(&r.summary.first_confirmed) == name)
+                .count()
+        };
+        println!(
+            "| {team} | {} | {} | {} | {ns} | {ds} | {nc} | {dc} | {} / {} | {nm} | {dm} | {wrong} |",
+            fault.name(),
+            phase.name(),
+            group.len(),
+            by("reports"),
+            by("residual"),
+        );
     }
 }
 
@@ -281,62 +290,53 @@ fn fault_table(runs: &[FaultRun]) {
 fn effect_table(runs: &[FaultRun]) {
     println!("| team | fault | phase | flights | an effect (3 sigma) | first effect, s after t_f: median / worst | isolated, s after the first effect (3 sigma): median / worst | (1 sigma): median / worst | (10 sigma): median / worst | largest angle effect within 50 ms (rad), median | reports within the commands' range, median share | the check's servo model's largest error (rad), median: healthy / stuck reports | named by a check against that model (0.1 rad, 2 reports), s after the first effect: median / worst |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for team in TEAMS {
-        for fault in Fault::ALL {
-            for phase in [Phase::Hover, Phase::Tilt] {
-                let group: Vec<&FaultRun> = runs
-                    .iter()
-                    .filter(|r| r.team == team && r.fault == fault && r.phase == phase)
-                    .collect();
-                let first: Vec<f64> = group
-                    .iter()
-                    .filter_map(|r| Some(r.effect.at[0]? - r.t_f))
-                    .collect();
-                let after = |k: usize| {
-                    quantiles(group.iter().filter_map(|r| r.since_effect(k)).collect(), 3)
-                };
-                let median = |pick: fn(&FirstEffect) -> Option<f64>, digits: usize| {
-                    let v: Vec<f64> = group.iter().filter_map(|r| pick(&r.effect)).collect();
-                    quantiles(v, digits)
-                        .split(" / ")
-                        .next()
-                        .unwrap_or("-")
-                        .to_string()
-                };
-                let (largest, inside, model) = if fault == Fault::StuckGimbal {
-                    (
-                        median(|e| e.largest, 3),
-                        median(|e| e.inside, 2),
-                        format!(
-                            "{} (worst {:.3}) / {} | {}",
-                            median(|e| e.model.map(|m| m[0]), 3),
-                            group
-                                .iter()
-                                .filter_map(|r| Some(r.effect.model?[0]))
-                                .fold(0.0, f64::max),
-                            median(|e| e.model.map(|m| m[1]), 3),
-                            quantiles(
-                                group.iter().filter_map(|r| r.effect.model_named).collect(),
-                                3
-                            ),
-                        ),
-                    )
-                } else {
-                    ("-".into(), "-".into(), "- | -".into())
-                };
-                println!(
-                    "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} | {model} |",
-                    fault.name(),
-                    phase.name(),
-                    group.len(),
-                    first.len(),
-                    quantiles(first, 3),
-                    after(0),
-                    after(1),
-                    after(2),
-                );
-            }
-        }
+    for (team, fault, phase, group) in groups(runs) {
+        let first: Vec<f64> = group
+            .iter()
+            .filter_map(|r| Some(r.effect.at[0]? - r.t_f))
+            .collect();
+        let after =
+            |k: usize| quantiles(group.iter().filter_map(|r| r.since_effect(k)).collect(), 3);
+        let median = |pick: fn(&FirstEffect) -> Option<f64>, digits: usize| {
+            let v: Vec<f64> = group.iter().filter_map(|r| pick(&r.effect)).collect();
+            quantiles(v, digits)
+                .split(" / ")
+                .next()
+                .unwrap_or("-")
+                .to_string()
+        };
+        let (largest, inside, model) = if fault == Fault::StuckGimbal {
+            (
+                median(|e| e.largest, 3),
+                median(|e| e.inside, 2),
+                format!(
+                    "{} (worst {:.3}) / {} | {}",
+                    median(|e| e.model.map(|m| m[0]), 3),
+                    group
+                        .iter()
+                        .filter_map(|r| Some(r.effect.model?[0]))
+                        .fold(0.0, f64::max),
+                    median(|e| e.model.map(|m| m[1]), 3),
+                    quantiles(
+                        group.iter().filter_map(|r| r.effect.model_named).collect(),
+                        3
+                    ),
+                ),
+            )
+        } else {
+            ("-".into(), "-".into(), "- | -".into())
+        };
+        println!(
+            "| {team} | {} | {} | {} | {} | {} | {} | {} | {} | {largest} | {inside} | {model} |",
+            fault.name(),
+            phase.name(),
+            group.len(),
+            first.len(),
+            quantiles(first, 3),
+            after(0),
+            after(1),
+            after(2),
+        );
     }
 }
 
