@@ -1,6 +1,8 @@
 //! Run-time choice of allocator (for configuration files and bindings), and the one table of
 //! allocator names.
 
+use core::mem::align_of;
+
 use super::choice::{AllocatorChoice, AllocatorOptions, Choice};
 use super::{
     Allocation, AllocationRequest, Allocator, CappedRedistribution, ExactBoundaryRedistribution,
@@ -126,9 +128,24 @@ impl<T: Real, const N: usize> Default for AnyAllocator<T, N> {
 
 impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
     unsafe fn storage_intact(this: *const Self) -> bool {
-        // The variants in declaration order (repr(u8)): 5, or 7 with `clarabel`.
-        const VARIANTS: u8 = if cfg!(feature = "clarabel") { 7 } else { 5 };
-        this.cast::<u8>().read() < VARIANTS
+        // The variants in declaration order (repr(u8)): 5, or 7 with `clarabel`; each a
+        // `repr(C)` struct of the tag and the allocator, which starts at its alignment.
+        unsafe fn inner<A: Allocator<T, N>, T: Real, const N: usize>(
+            this: *const AnyAllocator<T, N>,
+        ) -> bool {
+            A::storage_intact(this.cast::<u8>().add(align_of::<A>()).cast::<A>())
+        }
+        match this.cast::<u8>().read() {
+            // Unit structs and a round count (the walk bounds its rounds by `N` too).
+            0 | 2 | 4 => true,
+            1 => inner::<WeightedPseudoInverse<T, N>, T, N>(this),
+            3 => inner::<ExactBoundaryRedistribution<T, N>, T, N>(this),
+            // The `clarabel` allocators keep heap pointers no check can vouch for: a build with
+            // the feature is not one a C caller's handle holds.
+            #[cfg(feature = "clarabel")]
+            5 | 6 => true,
+            _ => false,
+        }
     }
 
     fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
