@@ -39,7 +39,7 @@ fn an_invalid_response_report_or_masking_tag_is_refused() {
     assert!(refuses(
         &m,
         2,
-        |p: P| unsafe { addr_of_mut!((*p).report).cast() },
+        |p: P| unsafe { addr_of_mut!((*p).reported).cast() },
         check
     ));
     assert!(refuses(
