@@ -54,6 +54,9 @@ struct Masked {
 
 /// The detector's state inside a controller.
 #[derive(Clone, Copy, Debug, PartialEq)]
+// `repr(C)`: fields in declaration order, which the C interface's flash build copies and
+// initializes in 144 B less code than Rust's reordering.
+#[repr(C)]
 pub(super) struct FaultMonitor<T: Real, const N: usize> {
     response: FaultResponse,
     detector: FaultDetector<T>,
@@ -136,11 +139,14 @@ impl<T: Real, const N: usize> FaultMonitor<T, N> {
             share_periods: 0,
             closed,
             undelivered: lit::<T>(FAULT_ACTUATOR_LAG) / period * closed,
+            // Never shown while `reported` is unset. A threshold of 1, not 0: a run of zero
+            // bytes here and around became one unaligned `__aeabi_memclr` call, which cost the C
+            // interface's flash build 208 B.
             report: FaultReport {
                 verdict: FaultVerdict::Nominal,
                 source: FaultSource::Residual,
                 statistic: T::zero(),
-                threshold: T::zero(),
+                threshold: T::one(),
                 best_misfit: T::zero(),
                 runner_up_misfit: T::zero(),
             },

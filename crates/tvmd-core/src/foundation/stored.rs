@@ -83,6 +83,25 @@ impl<T> Stored<T> {
         }
     }
 
+    /// Writes `value` at `this` as a `Stored`: the tag, and the value (if any) in place where
+    /// [`Self::storage_intact`] finds it, with no `Stored` built on the stack first.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` writable bytes.
+    #[inline(always)]
+    pub unsafe fn write_from(this: *mut Self, value: &Option<T>)
+    where
+        T: Copy,
+    {
+        match value {
+            None => this.write(Self::Absent),
+            Some(v) => {
+                this.cast::<u8>().write(1);
+                this.cast::<u8>().add(align_of::<T>()).cast::<T>().write(*v);
+            }
+        }
+    }
+
     /// [`Self::storage_intact`] of a value of plain numbers (every bit pattern a value).
     ///
     /// # Safety
