@@ -245,3 +245,35 @@ fn ratio_squared<T: Real>(x: T, c: T) -> T {
 pub(crate) fn infinity<T: Real>() -> T {
     T::one() / T::zero()
 }
+
+impl<T: Real> EllipticCone<T> {
+    /// Whether the cone at `this` holds a valid flag (its other fields are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        crate::foundation::stored::bool_intact(core::ptr::addr_of!((*this).unbounded_branch))
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use crate::{team::presets, FailureMask};
+
+    #[test]
+    fn an_invalid_flag_is_refused() {
+        let team = presets::a4_inc::<f32, 4>().unwrap();
+        let cone = team
+            .afs(&FailureMask::none())
+            .unwrap()
+            .cone(Relaxation::none());
+        let check = EllipticCone::<f32>::storage_intact;
+        let flag = |p: *mut EllipticCone<f32>| unsafe {
+            core::ptr::addr_of_mut!((*p).unbounded_branch).cast()
+        };
+        assert!(accepts(&cone, check) && refuses(&cone, 2, flag, check));
+    }
+}

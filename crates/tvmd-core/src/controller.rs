@@ -28,7 +28,7 @@ pub use settings::{
     OFFSET_FREE_MAX_TORQUE, POSITION_FREQUENCY,
 };
 
-use crate::afs::hover::{hover_capability, HoverCapability};
+use crate::afs::hover::{hover_capability, HoverCapability, StoredHover};
 use crate::afs::planner::{AttitudePlanner, PlannerOutput};
 use crate::afs::projection::ForceProjection;
 use crate::afs::{AttainableForceSpace, EllipticCone, Relaxation};
@@ -39,6 +39,7 @@ use crate::allocation::{Allocation, Allocator, NullSpaceReport};
 use crate::fault::ReportState;
 use crate::foundation::error::{ConfigError, InputError};
 use crate::foundation::real::Real;
+use crate::foundation::stored::Stored;
 use crate::law::attitude_rate::{AttitudeRateState, PlannedRates};
 use crate::law::offset_free::{Compensation, OffsetFreeState};
 use crate::law::{Gains, LawOutput, Plant, RigidState};
@@ -95,21 +96,25 @@ impl<T: Real, const N: usize> std::error::Error for CycleError<T, N> {}
 /// failure mask, the previous command and, when configured, the offset-free state and the
 /// planned-rate filter. One [`Controller::step`] per control period.
 #[derive(Clone, Debug)]
+// `repr(C)`: fields in declaration order, which the C interface's flash build writes and checks
+// in 80 B less code than Rust's reordering.
+#[repr(C)]
 pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     team: TeamConfig<T, N>,
-    settings: ControllerSettings<T>,
+    /// The settings, their optional parts in [`Stored`]s ([`settings::StoredSettings`]).
+    settings: settings::StoredSettings<T>,
     /// The law's gains: `settings.gains` resolved by `settings.gain_schedule` for the team.
     gains: Gains<T>,
     /// The offset-free state (inert when `settings.offset_free` is `None`).
     offset_free: OffsetFreeState<T>,
     /// The planned-rate filter (`None` when `settings.attitude_rate` is).
-    attitude_rate: Option<AttitudeRateState<T>>,
+    attitude_rate: Stored<AttitudeRateState<T>>,
     /// The fault detector (`None` when `settings.fault_detection` is).
-    fault: Option<detection::FaultMonitor<T, N>>,
+    fault: Stored<detection::FaultMonitor<T, N>>,
     /// The agents' reports ([`Self::set_report`]; taken only while `fault` runs).
     reports: ReportState<T, N>,
     /// What the offset-free state records once the law stage's wrench is allocated.
-    pending: Option<(RigidState<T>, cycle::PendingRecord<T>)>,
+    pending: Stored<(RigidState<T>, cycle::PendingRecord<T>)>,
     plant: Plant<T>,
     planner: AttitudePlanner<T>,
     allocator: A,
@@ -121,7 +126,7 @@ pub struct Controller<T: Real, const N: usize, A: Allocator<T, N>> {
     effectiveness: Effectiveness<T, N>,
     admissible: AdmissibleSet<T>,
     /// The classification of the working agents, computed when the mask is set.
-    hover: HoverCapability<T>,
+    hover: StoredHover<T>,
     previous: [AgentCommand<T>; N],
     /// The bound on every input component ([`Self::input_limit`]).
     input_limit: T,
@@ -156,7 +161,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     /// // Rank 6 is kept, but three agents at z = 0 cannot hold hover with a margin.
     /// let hover = controller.set_failures(FailureMask::with_failed(&[2])?)?;
     /// assert!(!hover.capable);
-    /// assert_eq!(controller.hover_capability(), &hover);
+    /// assert_eq!(controller.hover_capability(), hover);
     /// # Ok::<(), tvmd_core::ConfigError>(())
     /// ```
     pub fn set_failures(
@@ -170,16 +175,18 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.team
             .effectiveness_into(&failures, &mut self.effectiveness);
         self.allocator.configure(&self.effectiveness);
-        self.hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
+        let hover = hover_capability(&self.effectiveness, &self.admissible, self.plant.weight());
+        self.hover = hover.into();
         self.failures = failures;
         self.offset_free.set_force_bound(self.afs.max_force());
-        Ok(self.hover)
+        Ok(hover)
     }
 
     /// Whether the working agents can hold hover with a margin, as classified when the
-    /// failure mask was last set (or at [`Self::new`] for the full team).
-    pub fn hover_capability(&self) -> &HoverCapability<T> {
-        &self.hover
+    /// failure mask was last set (or at [`Self::new`] for the full team). A copy: the
+    /// controller keeps it in a form whose every tag [`Self::storage_intact`] can check.
+    pub fn hover_capability(&self) -> HoverCapability<T> {
+        self.hover.into()
     }
 
     /// Replaces the planner (e.g. another tolerance); its relaxation becomes the controller's.
@@ -199,12 +206,12 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         self.previous = [AgentCommand::idle(); N];
         self.allocator.reset();
         self.offset_free.reset();
-        self.pending = None;
-        if let Some(fault) = &mut self.fault {
+        self.pending = Stored::Absent;
+        if let Some(fault) = self.fault.as_mut() {
             fault.reset();
         }
         self.reports.clear();
-        if let Some(rates) = &mut self.attitude_rate {
+        if let Some(rates) = self.attitude_rate.as_mut() {
             rates.reset();
         }
     }
@@ -247,9 +254,10 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         &self.team
     }
 
-    /// The settings.
-    pub fn settings(&self) -> &ControllerSettings<T> {
-        &self.settings
+    /// The settings (a copy: the controller keeps them in a form whose every tag
+    /// [`Self::storage_intact`] can check).
+    pub fn settings(&self) -> ControllerSettings<T> {
+        self.settings.into()
     }
 
     /// The failure mask in use.

@@ -40,6 +40,7 @@ use nalgebra::{Matrix6x3, Vector3, Vector6};
 use crate::agent::failure::FailureMask;
 use crate::foundation::error::{positive, ConfigError, ConfigField};
 use crate::foundation::real::{lit, sqrt, Real};
+use crate::foundation::stored::Stored;
 
 pub mod detection;
 mod fit;
@@ -121,7 +122,7 @@ impl<T: Real> FaultDetector<T> {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FaultState {
     /// The candidate agent (`u16`: a mask's slot; keeps the controller's state small).
-    candidate: Option<u16>,
+    candidate: Stored<u16>,
     /// Its consecutive periods (`u16`, saturating: the state stays small).
     periods: u16,
 }
@@ -134,7 +135,7 @@ impl FaultState {
 
     /// The candidate held (through ambiguous periods too), if any.
     pub fn candidate(&self) -> Option<usize> {
-        self.candidate.map(usize::from)
+        self.candidate.get().map(usize::from)
     }
 
     /// Forgets the candidate.
@@ -152,7 +153,7 @@ impl FaultState {
         &mut self,
         detector: &FaultDetector<T>,
         residual: &Vector6<T>,
-        blocks: &[Option<Matrix6x3<T>>; N],
+        blocks: &[Stored<Matrix6x3<T>>; N],
         forces: &[Vector3<T>; N],
         failures: &FailureMask<N>,
     ) -> FaultReport<T> {
@@ -167,7 +168,7 @@ impl FaultState {
         &mut self,
         detector: &FaultDetector<T>,
         residual: &Vector6<T>,
-        blocks: &[Option<Matrix6x3<T>>; N],
+        blocks: &[Stored<Matrix6x3<T>>; N],
         force_of: impl Fn(usize) -> Vector3<T>,
         failures: &FailureMask<N>,
     ) -> FaultReport<T> {
@@ -192,7 +193,7 @@ impl FaultState {
         // The runner-up's squared misfit.
         let mut runner_up: T = none();
         for (i, block) in blocks.iter().enumerate() {
-            let (Some(m), false) = (block, failures.is_failed(i)) else {
+            let (Some(m), false) = (block.as_ref(), failures.is_failed(i)) else {
                 continue;
             };
             let Some(fit) = fit(&weighted, m, &force_of(i)) else {
@@ -226,9 +227,9 @@ impl FaultState {
         let Some((agent, b)) = explained else {
             // A period that does not tell the candidate from its runner-up, while the candidate
             // is still the best explanation, holds the count; anything else forgets it.
-            let still_best = best
-                .as_ref()
-                .is_some_and(|(i, b)| b.misfit2 <= k2 && self.candidate == u16::try_from(*i).ok());
+            let still_best = best.as_ref().is_some_and(|(i, b)| {
+                b.misfit2 <= k2 && self.candidate.get() == u16::try_from(*i).ok()
+            });
             if !still_best {
                 self.reset();
             }
@@ -237,12 +238,12 @@ impl FaultState {
         };
         let (agent, kind) = (*agent, b.kind);
         let slot = u16::try_from(agent).ok();
-        self.periods = if self.candidate.is_some() && self.candidate == slot {
+        self.periods = if self.candidate.is_some() && self.candidate.get() == slot {
             self.periods.saturating_add(1)
         } else {
             1
         };
-        self.candidate = slot;
+        self.candidate = slot.into();
         report.verdict = if u32::from(self.periods) >= detector.persistence {
             FaultVerdict::Confirmed { agent, kind }
         } else {
@@ -287,13 +288,23 @@ pub(crate) fn loss_kind<T: Real>(c: T) -> FaultKind<T> {
     }
 }
 
+impl FaultState {
+    /// Whether the state at `this` holds a valid candidate tag (its values are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        Stored::tag_intact(core::ptr::addr_of!((*this).candidate))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
     use super::*;
     use crate::team::presets;
 
-    fn setup() -> ([Option<Matrix6x3<f64>>; 4], [Vector3<f64>; 4]) {
+    fn setup() -> ([Stored<Matrix6x3<f64>>; 4], [Vector3<f64>; 4]) {
         let team = presets::a4_inc::<f64, 4>().unwrap();
         let m = team.effectiveness(&FailureMask::none());
         // Hover: each agent straight up with a quarter of the weight.
@@ -311,7 +322,7 @@ mod tests {
         let d = detector();
         for lost in 0..4 {
             let mut s = FaultState::new();
-            let r = -(blocks[lost].unwrap() * f[lost]);
+            let r = -(blocks[lost].get().unwrap() * f[lost]);
             for k in 1..=3u32 {
                 let rep = s.update(&d, &r, &blocks, &f, &FailureMask::none());
                 // The closed-form misfit of an exact fit is round-off: about sqrt(eps) ||r||.
@@ -338,7 +349,7 @@ mod tests {
         let (blocks, f) = setup();
         let d = detector();
         let mut s = FaultState::new();
-        let r = -(blocks[2].unwrap() * (f[2] * 0.5));
+        let r = -(blocks[2].get().unwrap() * (f[2] * 0.5));
         let rep = s.update(&d, &r, &blocks, &f, &FailureMask::none());
         match rep.verdict {
             FaultVerdict::Suspected {
@@ -352,7 +363,7 @@ mod tests {
         // hypothesis is the small-angle one: the force change across the command).
         let t = f[1].norm();
         let stuck = Vector3::new(t * 0.1f64.sin(), 0.0, t * 0.1f64.cos());
-        let r = blocks[1].unwrap() * (stuck - f[1]);
+        let r = blocks[1].get().unwrap() * (stuck - f[1]);
         let rep = FaultState::new().update(&d, &r, &blocks, &f, &FailureMask::none());
         // At hover every agent's force is vertical, so a slip across it (a horizontal force and
         // a yaw torque) is explained by the stuck hypothesis within the noise, but another
@@ -391,7 +402,7 @@ mod tests {
             );
         }
         // A masked agent is not a candidate, and garbage forgets the candidate.
-        let r = -(blocks[0].unwrap() * f[0]);
+        let r = -(blocks[0].get().unwrap() * f[0]);
         let masked = FailureMask::with_failed(&[0]).unwrap();
         let rep = s.update(&d, &r, &blocks, &f, &masked);
         assert!(!matches!(
@@ -410,7 +421,7 @@ mod tests {
         let (blocks, f) = setup();
         let d = detector();
         let none = FailureMask::none();
-        let full = -(blocks[0].unwrap() * f[0]);
+        let full = -(blocks[0].get().unwrap() * f[0]);
         // The same loss read with the torque's noise so large that only the force counts: the
         // agents' losses push alike, so no runner-up is rejected while agent 0 stays the best.
         let blind = FaultDetector::new(0.2, 1e6, 5.0, 3).unwrap();
@@ -448,5 +459,25 @@ mod tests {
                 field: ConfigField::FaultPersistence
             })
         );
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use core::ptr::addr_of_mut;
+
+    #[test]
+    fn an_invalid_candidate_tag_is_refused() {
+        let check = FaultState::storage_intact;
+        let s = FaultState {
+            candidate: Stored::Present(2),
+            periods: 1,
+        };
+        assert!(accepts(&s, check) && accepts(&FaultState::new(), check));
+        let candidate = |p: *mut FaultState| unsafe { addr_of_mut!((*p).candidate).cast() };
+        assert!(refuses(&s, 2, candidate, check));
     }
 }

@@ -344,14 +344,17 @@ fn check_ok<T: Real>(
         .blocks()
         .iter()
         .zip(sets)
-        .filter_map(|(b, s)| b.map(|b| to_f64(s.thrust().hi) * 3.0 * to_f64(b.amax())))
+        .filter_map(|(b, s)| {
+            b.as_ref()
+                .map(|b| to_f64(s.thrust().hi) * 3.0 * to_f64(b.amax()))
+        })
         .sum();
     let residual = |forces: &[Vector3<T>; N]| {
         let w: Vector6<f64> = e
             .blocks()
             .iter()
             .zip(forces)
-            .filter_map(|(b, f)| b.map(|b| (b * f).map(to_f64)))
+            .filter_map(|(b, f)| b.as_ref().map(|b| (b * f).map(to_f64)))
             .fold(Vector6::zeros(), |a, u| a + u);
         let d = [
             to_f64(u_fd.x) - w[3],

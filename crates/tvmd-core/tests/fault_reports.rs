@@ -102,7 +102,7 @@ fn fly(c: &mut C, after: After, seconds: f64) -> Flown {
         let mut u = out.allocation.wrench;
         // A dead rotor delivers nothing; a silent agent keeps flying its command.
         if failed && after != After::Silent {
-            u -= blocks[LOST].unwrap() * out.allocation.forces[LOST];
+            u -= blocks[LOST].get().unwrap() * out.allocation.forces[LOST];
         }
         for _ in 0..10 {
             body = flight::rk4(&body, &truth, &u, dt / 10.0);

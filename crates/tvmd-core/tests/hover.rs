@@ -38,7 +38,7 @@ fn a4_minus_one<T: Real>() {
             hover.limit,
             HoverLimit::MaxThrust | HoverLimit::MinThrust
         ));
-        assert_eq!(c.hover_capability(), &hover);
+        assert_eq!(c.hover_capability(), hover);
         // The same classification from the team alone.
         let g: T = nalgebra::convert(presets::GRAVITY);
         assert_eq!(c.team().hover_capability(&mask, g).unwrap(), hover);
@@ -49,7 +49,7 @@ fn a4_minus_one<T: Real>() {
 
 fn a6_minus_one<T: Real>() {
     let mut c = controller(a6_inc::<T>());
-    let full = *c.hover_capability();
+    let full = c.hover_capability();
     assert!(
         full.capable && full.margin > nalgebra::convert(0.99),
         "{full:?}"

@@ -371,7 +371,7 @@ fn lose_agent(lost: usize, cut: f64) -> (Option<(f64, usize)>, f64, FailureMask<
         }
         let mut u = out.allocation.wrench;
         if t >= cut {
-            u -= blocks[lost].unwrap() * out.allocation.forces[lost];
+            u -= blocks[lost].get().unwrap() * out.allocation.forces[lost];
         }
         for _ in 0..10 {
             body = flight::rk4(&body, &truth, &u, dt / 10.0);

@@ -321,7 +321,7 @@ pub unsafe extern "C" fn tvmd_hover_capability(
     }
     match inner(handle) {
         Ok(inner) => {
-            hover.fill(inner.controller.hover_capability());
+            hover.fill(&inner.controller.hover_capability());
             TVMD_OK
         }
         Err(status) => status,

@@ -251,7 +251,7 @@ impl PyController {
     #[getter]
     fn hover_capability(&self) -> PyHoverCapability {
         PyHoverCapability {
-            inner: *self.inner.hover_capability(),
+            inner: self.inner.hover_capability(),
         }
     }
 

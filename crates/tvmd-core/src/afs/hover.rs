@@ -26,6 +26,7 @@ use crate::agent::gimbal::GimbalCommand;
 use crate::foundation::linalg::EuclideanNorm;
 use crate::foundation::linalg::GramSolver;
 use crate::foundation::real::{eps, lit, sqrt, Real};
+use crate::foundation::stored::Stored;
 
 /// Reweighting rounds of the certifying allocation (Lawson's iteration for the minimax slack).
 pub const HOVER_ITERATIONS: usize = 24;
@@ -80,6 +81,42 @@ pub struct HoverCapability<T: Real> {
     pub limit: HoverLimit,
     /// `m_C g` (N), the vertical force of the hover wrench.
     pub weight: T,
+}
+
+/// A [`HoverCapability`] as a controller keeps it: the limiting agent in a [`Stored`], whose
+/// tag, unlike `Option`'s, [`crate::Controller::storage_intact`] can check raw (with the flag
+/// and the limit's tag).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StoredHover<T: Real> {
+    pub(crate) capable: bool,
+    pub(crate) margin: T,
+    pub(crate) limiting_agent: Stored<usize>,
+    pub(crate) limit: HoverLimit,
+    pub(crate) weight: T,
+}
+
+impl<T: Real> From<HoverCapability<T>> for StoredHover<T> {
+    fn from(h: HoverCapability<T>) -> Self {
+        Self {
+            capable: h.capable,
+            margin: h.margin,
+            limiting_agent: h.limiting_agent.into(),
+            limit: h.limit,
+            weight: h.weight,
+        }
+    }
+}
+
+impl<T: Real> From<StoredHover<T>> for HoverCapability<T> {
+    fn from(h: StoredHover<T>) -> Self {
+        Self {
+            capable: h.capable,
+            margin: h.margin,
+            limiting_agent: h.limiting_agent.get(),
+            limit: h.limit,
+            weight: h.weight,
+        }
+    }
 }
 
 /// A [`HoverCapability`] with the allocation that certifies it.
@@ -164,7 +201,7 @@ pub fn hover_allocation<T: Real, const N: usize>(
         let mut gram = Matrix6::zeros();
         let mut produced_by_centre = Vector6::zeros();
         for (block, w) in blocks.iter().zip(&weights) {
-            if let Some(b) = block {
+            if let Some(b) = block.as_ref() {
                 gram += b * d2_matrix * b.transpose() / *w;
                 produced_by_centre += b * centre;
             }
@@ -172,7 +209,7 @@ pub fn hover_allocation<T: Real, const N: usize>(
         let lambda = GramSolver::new(&gram).solve(&(target - produced_by_centre));
         let mut forces = [Vector3::zeros(); N];
         for ((f, block), w) in forces.iter_mut().zip(blocks).zip(&weights) {
-            if let Some(b) = block {
+            if let Some(b) = block.as_ref() {
                 *f = centre + (b.transpose() * lambda).component_mul(&d2) / *w;
             }
         }

@@ -7,6 +7,7 @@ use nalgebra::{Matrix6, Matrix6x3, Vector3, Vector6};
 use crate::foundation::error::ConfigError;
 use crate::foundation::linalg::{max_diagonal, weighted_gram, GramSolver, Ldlt};
 use crate::foundation::real::{eps, lit, to_f64, Real};
+use crate::foundation::stored::Stored;
 
 /// `R_z(m pi/2)`, at its old path (now in [`crate::foundation::rotation`]).
 pub use crate::foundation::rotation::quarter_turn;
@@ -26,7 +27,7 @@ pub fn agent_block<T: Real>(position: &Vector3<T>, quarter_turns: i32) -> Matrix
 /// agent `i`'s frame. Failed agents have no block.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Effectiveness<T: Real, const N: usize> {
-    blocks: [Option<Matrix6x3<T>>; N],
+    blocks: [Stored<Matrix6x3<T>>; N],
     /// How many blocks there are, counted when they were assigned: a plain count, so that the
     /// allocators' round bounds never derive from the blocks' tags (a stray write in a C
     /// caller's handle can make a tag anything, and an optimizer may count by adding tags).
@@ -49,7 +50,7 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
     /// ```
     pub fn new<'a>(agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>) -> Self {
         let mut m = Self {
-            blocks: [None; N],
+            blocks: [Stored::Absent; N],
             working: 0,
             gram: GramSolver::Zero,
         };
@@ -66,9 +67,9 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
         this: *mut Self,
         agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>,
     ) {
-        let blocks = core::ptr::addr_of_mut!((*this).blocks).cast::<Option<Matrix6x3<T>>>();
+        let blocks = core::ptr::addr_of_mut!((*this).blocks).cast::<Stored<Matrix6x3<T>>>();
         for i in 0..N {
-            blocks.add(i).write(None);
+            blocks.add(i).write(Stored::Absent);
         }
         core::ptr::addr_of_mut!((*this).working).write(0);
         core::ptr::addr_of_mut!((*this).gram).write(GramSolver::Zero);
@@ -80,11 +81,11 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
     /// stack and moved here costs a small-stack caller (a flight stack's work queue) twice that.
     pub fn assign<'a>(&mut self, agents: impl IntoIterator<Item = (usize, &'a Vector3<T>, i32)>) {
         for slot in self.blocks.iter_mut() {
-            *slot = None;
+            *slot = Stored::Absent;
         }
         for (i, position, quarter_turns) in agents {
             if let Some(slot) = self.blocks.get_mut(i) {
-                *slot = Some(agent_block(position, quarter_turns));
+                *slot = Stored::Present(agent_block(position, quarter_turns));
             }
         }
         self.working = self.blocks.iter().flatten().count();
@@ -98,11 +99,11 @@ impl<T: Real, const N: usize> Effectiveness<T, N> {
 
     /// Block of agent `i`, `None` if it failed or does not exist.
     pub fn block(&self, agent: usize) -> Option<&Matrix6x3<T>> {
-        self.blocks.get(agent).and_then(Option::as_ref)
+        self.blocks.get(agent).and_then(Stored::as_ref)
     }
 
-    /// Blocks per slot of the capacity (`None` for failed or absent agents).
-    pub fn blocks(&self) -> &[Option<Matrix6x3<T>>; N] {
+    /// Blocks per slot of the capacity ([`Stored::Absent`] for failed or absent agents).
+    pub fn blocks(&self) -> &[Stored<Matrix6x3<T>>; N] {
         &self.blocks
     }
 
@@ -180,5 +181,65 @@ pub(crate) fn check_gram_rank<T: Real>(gram: &Matrix6<T>) -> Result<(), ConfigEr
         Err(ConfigError::RankDeficient {
             conditioning: to_f64(conditioning).max(0.0),
         })
+    }
+}
+
+impl<T: Real, const N: usize> Effectiveness<T, N> {
+    /// Whether the model at `this` holds valid tags (each block's and the Gram factor's) and
+    /// as many blocks as its count of working agents. Reads only; about `N + 2` loads.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        let blocks = core::ptr::addr_of!((*this).blocks).cast::<Stored<Matrix6x3<T>>>();
+        let (mut bits, mut present) = (0_u8, 0_usize);
+        for i in 0..N {
+            let tag = blocks.add(i).cast::<u8>().read();
+            bits |= tag;
+            present += usize::from(tag & 1);
+        }
+        bits <= 1
+            && present == core::ptr::addr_of!((*this).working).read()
+            && GramSolver::storage_intact(core::ptr::addr_of!((*this).gram))
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use crate::{team::presets, FailureMask};
+    use core::ptr::addr_of_mut;
+
+    #[test]
+    fn an_invalid_block_or_gram_tag_or_a_block_the_count_misses_is_refused() {
+        let team = presets::a4_inc::<f32, 4>().unwrap();
+        let check = Effectiveness::<f32, 4>::storage_intact;
+        for failed in [&[][..], &[2]] {
+            let m = team.effectiveness(&FailureMask::with_failed(failed).unwrap());
+            assert!(accepts(&m, check));
+            type P = *mut Effectiveness<f32, 4>;
+            let block = |i: usize| {
+                move |p: P| unsafe {
+                    addr_of_mut!((*p).blocks)
+                        .cast::<Stored<Matrix6x3<f32>>>()
+                        .add(i)
+                        .cast()
+                }
+            };
+            assert!(refuses(&m, 2, block(3), check), "tag 2");
+            // A working agent's block taken away, or a failed one's given: the count disagrees.
+            assert!(refuses(&m, 0, block(1), check), "block absent");
+            assert!(refuses(
+                &m,
+                3,
+                |p: P| unsafe { addr_of_mut!((*p).gram).cast() },
+                check
+            ));
+        }
+        let mut m = team.effectiveness(&FailureMask::with_failed(&[2]).unwrap());
+        m.blocks[2] = m.blocks[0];
+        assert!(!accepts(&m, check), "a failed agent's block present");
     }
 }

@@ -163,7 +163,7 @@ pub(crate) fn pseudo_inverse_forces<T: Real, const N: usize>(
         .zip(out.iter_mut())
         .enumerate()
     {
-        if let (Some(b), true) = (block, *f) {
+        if let (Some(b), true) = (block.as_ref(), *f) {
             *slot = b.tr_mul(&lambda) / weight(i);
         }
     }

@@ -10,6 +10,7 @@ use crate::agent::effectiveness::Effectiveness;
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::linalg::GramSolver;
 use crate::foundation::real::Real;
+use crate::foundation::stored::Stored;
 
 /// `f = M^T (M M^T)^-1 u_d` through the 6x6 Gram matrix (`O(n)`), then each agent outside its
 /// admissible set is clamped onto it (so the result is admissible but the wrench may be off;
@@ -70,7 +71,7 @@ pub struct WeightedPseudoInverse<T: Real, const N: usize> {
     weights: [T; N],
     /// The factor of `M W^-1 M^T` from [`Allocator::configure`], with the working agents it
     /// was computed for (used only while they match the request's).
-    configured: Option<([bool; N], GramSolver<T>)>,
+    configured: Stored<([bool; N], GramSolver<T>)>,
 }
 
 impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
@@ -83,7 +84,7 @@ impl<T: Real, const N: usize> WeightedPseudoInverse<T, N> {
         }
         Ok(Self {
             weights,
-            configured: None,
+            configured: Stored::Absent,
         })
     }
 
@@ -98,7 +99,16 @@ impl<T: Real, const N: usize> Allocator<T, N> for WeightedPseudoInverse<T, N> {
     fn configure(&mut self, effectiveness: &Effectiveness<T, N>) {
         let working = working_mask(effectiveness);
         let gram = gram_of(effectiveness, &working, Some(&self.weights));
-        self.configured = Some((working, GramSolver::new(&gram)));
+        self.configured = Stored::Present((working, GramSolver::new(&gram)));
+    }
+
+    unsafe fn storage_intact(this: *const Self) -> bool {
+        // The mask's flags each 0 or 1 (their OR has no other bit) and the factor's tag.
+        Stored::storage_intact(core::ptr::addr_of!((*this).configured), |c| {
+            let flags = core::ptr::addr_of!((*c).0).cast::<[u8; N]>().read();
+            flags.iter().fold(0, |bits, f| bits | f) <= 1
+                && GramSolver::storage_intact(core::ptr::addr_of!((*c).1))
+        })
     }
 
     fn allocate(&mut self, request: &AllocationRequest<'_, T, N>) -> Allocation<T, N> {
@@ -185,5 +195,25 @@ mod tests {
             pseudo_inverse_forces(&e, &working, None, Some(f), &request.wrench, &mut cached);
             assert_eq!(forces, cached);
         }
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refused_bytes};
+    use crate::{team::presets, FailureMask};
+
+    #[test]
+    fn its_tag_flags_and_factor_tag_are_checked() {
+        let team = presets::a4_inc::<f32, 4>().unwrap();
+        let check = <WeightedPseudoInverse<f32, 4> as Allocator<f32, 4>>::storage_intact;
+        let mut a = WeightedPseudoInverse::new([1.0, 2.0, 1.0, 2.0]).unwrap();
+        assert!(accepts(&a, check));
+        a.configure(&team.effectiveness(&FailureMask::with_failed(&[1]).unwrap()));
+        assert!(a.configured.is_some() && accepts(&a, check));
+        // 3: past the option's and the flags' 0 or 1, and past the factor's three tags.
+        assert_eq!(refused_bytes(&a, 3, check), 1 + 4 + 1);
     }
 }

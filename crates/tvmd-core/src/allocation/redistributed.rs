@@ -166,7 +166,7 @@ pub(super) fn redistribute<T: Real, const N: usize>(
             rounds += 1;
             let mut fixed_wrench = request.wrench;
             for ((block, f), is_free) in e.blocks().iter().zip(&forces).zip(&free) {
-                if let (Some(b), false) = (block, *is_free) {
+                if let (Some(b), false) = (block.as_ref(), *is_free) {
                     fixed_wrench -= b * f;
                 }
             }

@@ -19,6 +19,7 @@ use crate::foundation::error::InputError;
 use crate::foundation::linalg::norm;
 use crate::foundation::real::Real;
 use crate::foundation::rotation::validate_rotation;
+use crate::foundation::stored::{bool_intact, Stored};
 use crate::law::anti_windup::Saturation;
 use crate::law::attitude_rate::PlannedRates;
 use crate::law::offset_free::CycleRecord;
@@ -104,7 +105,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
             return Err(self.reject(InputError::Overflow { field }));
         }
         // Kept for the allocation that delivers this wrench (`allocate`).
-        self.pending = pending.map(|p| (*state, p));
+        self.pending = pending.map(|p| (*state, p)).into();
         Ok(stage)
     }
 
@@ -206,7 +207,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
     ) -> Result<ControlOutput<T, N>, CycleError<T, N>> {
         let (law, u_fr, pending) = self.law_stage(state, reference)?;
         // A law stage run on its own before this step is superseded.
-        self.pending = None;
+        self.pending = Stored::Absent;
         let stage = self.allocation_stage(&law.law.u_d);
         let output = ControlOutput {
             planner: law.planner,
@@ -330,7 +331,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
         };
         let allocation = self.allocator.allocate(&request);
         // Without the feature `validate` refuses a stage, so `None` is the only case left.
-        let (allocation, null_space) = match &self.settings.null_space {
+        let (allocation, null_space) = match self.settings.null_space.as_ref() {
             #[cfg(feature = "null-space")]
             Some(stage) => stage.refine(&request, &allocation),
             _ => (allocation, NullSpaceReport::off()),
@@ -414,5 +415,39 @@ fn add_torque<T: Real>(law: &mut LawOutput<T>, torque: &Vector3<T>) {
             *r += *t;
             *d += *t;
         }
+    }
+}
+
+impl<T: Real> PendingRecord<T> {
+    /// Whether the record at `this` holds a valid flag (its other fields are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(super) unsafe fn storage_intact(this: *const Self) -> bool {
+        bool_intact(core::ptr::addr_of!((*this).unreachable))
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+
+    #[test]
+    fn an_invalid_flag_is_refused() {
+        let check = PendingRecord::<f32>::storage_intact;
+        let r = PendingRecord {
+            e_x: Vector3::zeros(),
+            e_r: Vector3::zeros(),
+            t_tf: 1.0_f32,
+            t_eta: 1.0,
+            unreachable: true,
+            u_d_norm: 1.0,
+        };
+        assert!(accepts(&r, check));
+        let flag = |p: *mut PendingRecord<f32>| unsafe {
+            core::ptr::addr_of_mut!((*p).unreachable).cast()
+        };
+        assert!(refuses(&r, 2, flag, check));
     }
 }

@@ -39,7 +39,7 @@ impl<T: Real, const N: usize, A: Allocator<T, N>> Controller<T, N, A> {
 
     /// New gimbal rate limits (`None`: none), from the next period on.
     pub fn set_rate_limits(&mut self, rate_limits: Option<RateLimits<T>>) {
-        self.settings.rate_limits = rate_limits;
+        self.settings.rate_limits = rate_limits.into();
     }
 
     /// The commands the vehicle flies now (a mode switch from another controller) become the

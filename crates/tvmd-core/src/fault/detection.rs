@@ -11,6 +11,7 @@
 use crate::fault::{FaultDetector, ReportCheck};
 use crate::foundation::error::ConfigError;
 use crate::foundation::real::{lit, Real};
+use crate::foundation::stored::tag_below;
 
 /// Relative model error `epsilon` of [`FaultDetection::recommended`].
 pub const FAULT_MODEL_ERROR: f64 = 0.015;
@@ -34,8 +35,10 @@ pub const FAULT_JUMP_SHARE: f64 = 0.1;
 /// Persistence (periods) of [`FaultDetection::recommended`].
 pub const FAULT_PERSISTENCE: u32 = 5;
 
-/// What the controller does when the detector confirms an agent's loss.
+/// What the controller does when the detector confirms an agent's loss. `repr(u8)`: the tag
+/// checked raw by [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[repr(u8)]
 pub enum FaultResponse {
     /// Report only ([`crate::Controller::fault_report`]): the caller keeps the decision.
     #[default]
@@ -138,5 +141,31 @@ impl<T: Real> FaultDetection<T> {
     pub fn detector(&self, weight: T, arm: T) -> Result<FaultDetector<T>, ConfigError> {
         let force = self.model_error * weight;
         FaultDetector::new(force, force * arm, self.threshold, self.persistence)
+    }
+}
+
+impl<T: Real> FaultDetection<T> {
+    /// Whether the settings at `this` hold a valid response tag (two variants; the rest are
+    /// numbers). Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        tag_below(core::ptr::addr_of!((*this).response), 2)
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    use super::*;
+    use crate::foundation::stored::{accepts, refused_bytes};
+
+    #[test]
+    fn its_response_tag_is_checked() {
+        let check = FaultDetection::<f32>::storage_intact;
+        for response in [FaultResponse::Report, FaultResponse::Mask] {
+            let d = FaultDetection::recommended(response);
+            assert!(accepts(&d, check) && refused_bytes(&d, 2, check) == 1);
+        }
     }
 }

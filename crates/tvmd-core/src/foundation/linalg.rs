@@ -254,8 +254,10 @@ pub(crate) fn solve_gram<T: Real>(a: &Matrix6<T>, r: &Vector6<T>) -> Vector6<T> 
 }
 
 /// The factorization [`solve_gram`] uses, kept so a Gram matrix that changes only with the
-/// team or its failures is factored once ([`crate::Allocator::configure`]).
+/// team or its failures is factored once ([`crate::Allocator::configure`]). `repr(u8)`: the
+/// tag first, checked raw by [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
 pub(crate) enum GramSolver<T: Real> {
     /// `A = L D L^T`, definite.
     Exact(Ldlt<T>),
@@ -266,6 +268,14 @@ pub(crate) enum GramSolver<T: Real> {
 }
 
 impl<T: Real> GramSolver<T> {
+    /// Whether the solver at `this` has one of the three tags (its factors are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        crate::foundation::stored::tag_below(this, 3)
+    }
+
     pub(crate) fn new(a: &Matrix6<T>) -> Self {
         let scale = max_diagonal(a);
         if scale <= T::zero() || !scale.is_finite() {

@@ -7,3 +7,4 @@ pub mod error;
 pub(crate) mod linalg;
 pub mod real;
 pub mod rotation;
+pub mod stored;

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 
 use crate::foundation::linalg::clamp_norm;
 use crate::foundation::real::{sqrt, Real};
+use crate::foundation::stored::bool_intact;
 
 /// Which parts of the requested wrench the team could not deliver in one period.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -67,6 +68,18 @@ pub(crate) fn guarded<T: Real>(
         candidate
     };
     clamp_norm(next, bound)
+}
+
+impl Saturation {
+    /// Whether the flags at `this` are each 0 or 1 (read raw, for
+    /// [`crate::Controller::storage_intact`]).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        bool_intact(core::ptr::addr_of!((*this).force))
+            && bool_intact(core::ptr::addr_of!((*this).torque))
+    }
 }
 
 #[cfg(test)]

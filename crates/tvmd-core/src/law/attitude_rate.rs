@@ -17,6 +17,7 @@ use crate::foundation::error::{positive, ConfigError, ConfigField};
 use crate::foundation::linalg::{clamp_norm, norm};
 use crate::foundation::real::{lit, Real};
 use crate::foundation::rotation::vee;
+use crate::foundation::stored::bool_intact;
 
 /// Settings of the planned-rate filter: bandwidth `w` (rad/s) and the largest rate `max_rate`
 /// (rad/s) a jump of `R_d` may stand for. Validated (each finite and positive).
@@ -156,6 +157,16 @@ pub(crate) fn log_so3<T: Real>(q: &Matrix3<T>) -> Vector3<T> {
     s * (theta / sin)
 }
 
+impl<T: Real> AttitudeRateState<T> {
+    /// Whether the filter at `this` holds a valid flag (its other fields are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        bool_intact(core::ptr::addr_of!((*this).has_previous))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -265,5 +276,28 @@ mod tests {
         }
         state.reset();
         assert_eq!(state.rates().omega_d, Vector3::zeros());
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use core::ptr::addr_of_mut;
+
+    #[test]
+    fn an_invalid_flag_is_refused() {
+        let filter = AttitudeRateFilter::new(20.0_f32, 5.0).unwrap();
+        let mut s = AttitudeRateState::new(filter, 0.01).unwrap();
+        s.update(&Matrix3::identity());
+        let check = AttitudeRateState::<f32>::storage_intact;
+        assert!(s.has_previous && accepts(&s, check));
+        assert!(refuses(
+            &s,
+            2,
+            |p| unsafe { addr_of_mut!((*p).has_previous).cast() },
+            check
+        ));
     }
 }

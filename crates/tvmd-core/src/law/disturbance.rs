@@ -17,11 +17,14 @@
 //! estimate's error decays as `(1 - gamma)^k`. The request subtracts the estimate:
 //! `u_fr += -R^T d^_f`, `u_tau += -d^_tau`.
 
+use core::ptr::addr_of;
+
 use nalgebra::{Matrix3, Vector3, Vector6};
 
 use crate::foundation::error::{positive, ConfigError, ConfigField};
 use crate::foundation::linalg::wrench_parts;
 use crate::foundation::real::Real;
+use crate::foundation::stored::Stored;
 use crate::law::anti_windup::{guarded, Saturation};
 use crate::law::{Plant, RigidState};
 
@@ -88,15 +91,15 @@ pub struct ObserverState<T: Real> {
     gamma: (T, T),
     force: Vector3<T>,
     torque: Vector3<T>,
-    last: Option<Sample<T>>,
+    last: Stored<Sample<T>>,
     /// `(m_C x_dot, J_C Omega)` of this period's state, from [`Self::measure`] for
     /// [`Self::record`] (the same state: computed once per period).
-    momenta: Option<(Vector3<T>, Vector3<T>)>,
+    momenta: Stored<(Vector3<T>, Vector3<T>)>,
     /// The saturation of the last period, for the update that measures it.
     saturation: Saturation,
     /// This period's raw measurement `(d_f,meas, d_tau,meas)`, before the filter and the
     /// anti-windup (`None` before a measurement).
-    measured: Option<(Vector3<T>, Vector3<T>)>,
+    measured: Stored<(Vector3<T>, Vector3<T>)>,
 }
 
 impl<T: Real> ObserverState<T> {
@@ -112,10 +115,10 @@ impl<T: Real> ObserverState<T> {
             period,
             force: Vector3::zeros(),
             torque: Vector3::zeros(),
-            last: None,
-            momenta: None,
+            last: Stored::Absent,
+            momenta: Stored::Absent,
             saturation: Saturation::NONE,
-            measured: None,
+            measured: Stored::Absent,
         }
     }
 
@@ -139,7 +142,7 @@ impl<T: Real> ObserverState<T> {
     /// change against the model over the last period, unfiltered and not held by the
     /// anti-windup. `None` when this period measured nothing (no sample yet, after a reset).
     pub fn measurement(&self) -> Option<(Vector3<T>, Vector3<T>)> {
-        self.measured
+        self.measured.get()
     }
 
     /// The estimates set to `(d^_f, d^_tau)` = `(force, torque)` (`{I}`, `{C}`; non-finite
@@ -160,10 +163,10 @@ impl<T: Real> ObserverState<T> {
     pub fn reset(&mut self) {
         self.force = Vector3::zeros();
         self.torque = Vector3::zeros();
-        self.last = None;
-        self.momenta = None;
+        self.last = Stored::Absent;
+        self.momenta = Stored::Absent;
         self.saturation = Saturation::NONE;
-        self.measured = None;
+        self.measured = Stored::Absent;
     }
 
     /// The estimates and the last sample of `old` (another observer's, e.g. before a
@@ -172,8 +175,8 @@ impl<T: Real> ObserverState<T> {
         self.force = old.force;
         self.torque = guarded(&old.torque, &old.torque, false, self.observer.max_torque);
         self.last = old.last;
-        self.momenta = None;
-        self.measured = None;
+        self.momenta = Stored::Absent;
+        self.measured = Stored::Absent;
         self.saturation = old.saturation;
     }
 
@@ -187,15 +190,15 @@ impl<T: Real> ObserverState<T> {
     /// Without a sample (first period, after a reset) nothing changes.
     pub fn measure(&mut self, plant: &Plant<T>, state: &RigidState<T>, force_bound: T) {
         let (momentum, angular_momentum) = momenta(plant, state);
-        self.momenta = Some((momentum, angular_momentum));
-        self.measured = None;
-        let Some(last) = self.last else {
+        self.momenta = Stored::Present((momentum, angular_momentum));
+        self.measured = Stored::Absent;
+        let Some(last) = self.last.get() else {
             return;
         };
         let dt = self.period;
         let d_f = (momentum - last.momentum) / dt - last.force;
         let d_tau = (angular_momentum - last.angular_momentum) / dt - last.torque;
-        self.measured = Some((d_f, d_tau));
+        self.measured = Stored::Present((d_f, d_tau));
         let (g_f, g_tau) = self.gamma;
         let force = self.force + (d_f - self.force) * g_f;
         let torque = self.torque + (d_tau - self.torque) * g_tau;
@@ -223,7 +226,7 @@ impl<T: Real> ObserverState<T> {
         let (u_tau, u_f) = wrench_parts(wrench);
         let weight = Vector3::new(T::zero(), T::zero(), plant.weight());
         let omega = state.angular_velocity;
-        self.last = Some(Sample {
+        self.last = Stored::Present(Sample {
             momentum,
             angular_momentum,
             force: state.attitude * u_f - weight,
@@ -240,6 +243,20 @@ fn momenta<T: Real>(plant: &Plant<T>, state: &RigidState<T>) -> (Vector3<T>, Vec
         state.attitude * state.velocity * plant.mass(),
         j * state.angular_velocity,
     )
+}
+
+impl<T: Real> ObserverState<T> {
+    /// Whether the state at `this` holds valid tags (its three [`Stored`]s and the saturation's
+    /// flags). Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        Stored::tag_intact(addr_of!((*this).last))
+            && Stored::tag_intact(addr_of!((*this).momenta))
+            && Stored::tag_intact(addr_of!((*this).measured))
+            && Saturation::storage_intact(addr_of!((*this).saturation))
+    }
 }
 
 #[cfg(test)]
@@ -320,5 +337,51 @@ mod tests {
         assert!(f.norm() <= 20.0 * (1.0 + 1e-12) && t.norm() <= 0.3 * (1.0 + 1e-12));
         s.reset();
         assert_eq!(s.estimate(), (Vector3::zeros(), Vector3::zeros()));
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use core::ptr::addr_of_mut;
+
+    #[test]
+    fn an_invalid_sample_measurement_or_saturation_tag_is_refused() {
+        let observer = DisturbanceObserver::new(10.0_f32, 10.0, 5.0).unwrap();
+        let mut s = ObserverState::new(observer, 0.01);
+        let plant = Plant::new(2.0, nalgebra::Matrix3::identity(), 9.81).unwrap();
+        let state = RigidState::at_rest(Vector3::zeros());
+        let check = ObserverState::<f32>::storage_intact;
+        assert!(accepts(&s, check));
+        for _ in 0..2 {
+            s.measure(&plant, &state, 100.0);
+            s.record(&plant, &state, &Vector6::zeros(), Saturation::NONE);
+        }
+        s.measure(&plant, &state, 100.0);
+        assert!(s.last.is_some() && s.momenta.is_some() && s.measured.is_some());
+        assert!(accepts(&s, check));
+        assert!(refuses(
+            &s,
+            2,
+            |p| unsafe { addr_of_mut!((*p).last).cast() },
+            check
+        ));
+        assert!(refuses(
+            &s,
+            2,
+            |p| unsafe { addr_of_mut!((*p).momenta).cast() },
+            check
+        ));
+        assert!(refuses(
+            &s,
+            0x41,
+            |p| unsafe { addr_of_mut!((*p).measured).cast() },
+            check
+        ));
+        let torque =
+            |p: *mut ObserverState<f32>| unsafe { addr_of_mut!((*p).saturation.torque).cast() };
+        assert!(refuses(&s, 2, torque, check));
     }
 }

@@ -7,11 +7,14 @@ use nalgebra::Matrix3;
 
 use crate::foundation::error::ConfigError;
 use crate::foundation::real::{lit, Real};
+use crate::foundation::stored::tag_below;
 use crate::law::natural_gains::NaturalGains;
 use crate::law::Gains;
 
-/// How the controller turns its settings into the gains of eq. (12).
+/// How the controller turns its settings into the gains of eq. (12). `repr(u8)`: the tag
+/// first, checked raw by [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
 pub enum GainSchedule<T: Real> {
     /// The settings' gains as they are: the paper's reading (eq. 12 with `K_x`, `K_R`, `K_xi`
     /// unscaled). The default of [`crate::ControllerSettings::paper`].
@@ -71,6 +74,16 @@ impl<T: Real> GainSchedule<T> {
     }
 }
 
+impl<T: Real> GainSchedule<T> {
+    /// Whether the schedule at `this` has one of the three tags (its gains are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        tag_below(this, 3)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
@@ -108,5 +121,21 @@ mod tests {
                 field: ConfigField::GainKv
             })
         );
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+
+    #[test]
+    fn an_invalid_schedule_tag_is_refused() {
+        let check = GainSchedule::<f32>::storage_intact;
+        for s in [GainSchedule::AsGiven, GainSchedule::TeamScaled] {
+            assert!(accepts(&s, check));
+            assert!(refuses(&s, 3, |p| p.cast(), check));
+        }
     }
 }

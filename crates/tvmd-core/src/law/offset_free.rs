@@ -5,15 +5,21 @@
 
 use nalgebra::{Vector3, Vector6};
 
+use core::mem::align_of;
+use core::ptr::addr_of;
+
 use crate::foundation::real::Real;
+use crate::foundation::stored::{bool_intact, tag_below};
 use crate::law::anti_windup::Saturation;
 use crate::law::disturbance::{DisturbanceObserver, ObserverState};
 use crate::law::integral::{IntegralAction, IntegralState};
 use crate::law::{Plant, RigidState};
 
 /// Which offset-free action the controller runs (`None` in
-/// [`crate::ControllerSettings::offset_free`]: the paper's law, no state).
+/// [`crate::ControllerSettings::offset_free`]: the paper's law, no state). `repr(u8)`: the
+/// tag first, checked raw by [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
 pub enum OffsetFree<T: Real> {
     /// The disturbance observer (the recommended one: `docs/method.md`).
     Observer(DisturbanceObserver<T>),
@@ -30,7 +36,9 @@ pub struct Compensation<T: Real> {
     pub torque: Vector3<T>,
 }
 
+/// `repr(u8)`: the tag first, checked raw ([`OffsetFreeState::storage_intact`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
 enum Kind<T: Real> {
     Off,
     Observer(ObserverState<T>),
@@ -202,6 +210,38 @@ pub struct CycleRecord<T: Real> {
     pub saturation: Saturation,
 }
 
+impl<T: Real> OffsetFree<T> {
+    /// Whether the action at `this` has one of the two tags (its values are numbers).
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        tag_below(this, 2)
+    }
+}
+
+impl<T: Real> OffsetFreeState<T> {
+    /// Whether the state at `this` holds valid tags: the kind's, the observer's inside
+    /// ([`ObserverState::storage_intact`]) and the landed flag. Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        let kind = addr_of!((*this).kind);
+        let intact = match kind.cast::<u8>().read() {
+            0 | 2 => true,
+            // `repr(u8)`: the variant is a `repr(C)` struct of the tag and the state.
+            1 => ObserverState::storage_intact(
+                kind.cast::<u8>()
+                    .add(align_of::<ObserverState<T>>())
+                    .cast::<ObserverState<T>>(),
+            ),
+            _ => false,
+        };
+        intact && bool_intact(addr_of!((*this).landed))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -250,5 +290,56 @@ mod tests {
         assert!(s.compensation().force.norm() <= 10.0 * (1.0 + 1e-12));
         s.reset();
         assert_eq!(s.compensation(), Compensation::default());
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used, clippy::unreachable)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refuses};
+    use core::ptr::addr_of_mut;
+
+    #[test]
+    fn an_invalid_kind_observer_or_landed_flag_is_refused() {
+        let observer = DisturbanceObserver::new(10.0_f32, 10.0, 5.0).unwrap();
+        let check = OffsetFreeState::<f32>::storage_intact;
+        let off = OffsetFreeState::<f32>::new(None, 0.01, 10.0);
+        let on = OffsetFreeState::new(Some(&OffsetFree::Observer(observer)), 0.01, 10.0);
+        let integral = IntegralAction::new([1.0; 3], [1.0; 3], 5.0).unwrap();
+        let integral = OffsetFreeState::new(Some(&OffsetFree::Integral(integral)), 0.01, 10.0);
+        for s in [&off, &on, &integral] {
+            assert!(accepts(s, check));
+            assert!(refuses(
+                s,
+                3,
+                |p| unsafe { addr_of_mut!((*p).kind).cast() },
+                check
+            ));
+            assert!(refuses(
+                s,
+                2,
+                |p| unsafe { addr_of_mut!((*p).landed).cast() },
+                check
+            ));
+        }
+        // The observer's own tags, reached through the kind's payload (`repr(u8)` layout).
+        let Kind::Observer(o) = &on.kind else {
+            unreachable!()
+        };
+        let at = o as *const ObserverState<f32> as usize - &on as *const _ as usize;
+        assert_eq!(at, core::mem::offset_of!(OffsetFreeState<f32>, kind) + 4);
+        let mut s = on;
+        s.set_landed(true);
+        assert!(accepts(&s, check));
+        let first = |p: *mut OffsetFreeState<f32>| unsafe { p.cast::<u8>().add(at) };
+        let tags = (0..core::mem::size_of::<ObserverState<f32>>())
+            .filter(|&k| refuses(&on, 2, |p| unsafe { first(p).add(k) }, check))
+            .count();
+        // `last`, `momenta`, `measured` and the two saturation flags.
+        assert_eq!(tags, 5);
+        let off = OffsetFree::Observer(observer);
+        let check = OffsetFree::<f32>::storage_intact;
+        assert!(accepts(&off, check) && refuses(&off, 2, |p| p.cast(), check));
     }
 }

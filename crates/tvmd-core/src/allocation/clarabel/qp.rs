@@ -50,7 +50,9 @@ impl<const N: usize> Problem<N> {
             .zip(key.iter_mut())
             .enumerate()
         {
-            let Some(block) = block else { continue };
+            let Some(block) = block.as_ref() else {
+                continue;
+            };
             let mut weighted = block.map(|x| to_f64(x));
             for (mut row, wr) in weighted.row_iter_mut().zip(weights) {
                 row *= *wr;

@@ -217,7 +217,7 @@ impl<T: Real, const N: usize> SequentialConvexAllocator<T, N> {
             .iter()
             .zip(request.sets)
             .zip(&previous)
-            .all(|((block, set), f)| match block {
+            .all(|((block, set), f)| match block.as_ref() {
                 Some(_) => !outside(set, f),
                 None => *f == Vector3::zeros(),
             });

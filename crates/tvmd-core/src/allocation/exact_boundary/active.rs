@@ -6,6 +6,7 @@ use nalgebra::{Matrix6x3, Vector3, Vector6};
 use super::constraint::{Constraint, CONSTRAINTS};
 use crate::foundation::linalg::norm;
 use crate::foundation::real::{lit, Real};
+use crate::foundation::stored::{bool_intact, Stored};
 
 /// Constraints an agent is held on (bit `k` for constraint `k`), with the orthonormal normals of
 /// their tangent planes at the agent's current force.
@@ -15,12 +16,12 @@ pub(in crate::allocation) struct ActiveSet<T: Real> {
     /// Constraints already let go once in this allocation: never again, so no cycling.
     released: u8,
     /// Orthonormal basis of the normals, up to two; three independent normals fix the force.
-    basis: [Option<Vector3<T>>; 2],
+    basis: [Stored<Vector3<T>>; 2],
     fixed: bool,
     curved: bool,
     /// The held bits and the force of the last [`Self::update`]: the normals are the same while
     /// both are (a fixed agent, or every agent after a release re-solves).
-    updated: Option<(u8, Vector3<T>)>,
+    updated: Stored<(u8, Vector3<T>)>,
 }
 
 impl<T: Real> Default for ActiveSet<T> {
@@ -28,10 +29,10 @@ impl<T: Real> Default for ActiveSet<T> {
         Self {
             bits: 0,
             released: 0,
-            basis: [None, None],
+            basis: [Stored::Absent, Stored::Absent],
             fixed: false,
             curved: false,
-            updated: None,
+            updated: Stored::Absent,
         }
     }
 }
@@ -78,11 +79,11 @@ impl<T: Real> ActiveSet<T> {
         constraints: &[Constraint<T>; CONSTRAINTS],
         force: &Vector3<T>,
     ) {
-        if self.updated == Some((self.bits, *force)) {
+        if self.updated == Stored::Present((self.bits, *force)) {
             return;
         }
-        self.updated = Some((self.bits, *force));
-        self.basis = [None, None];
+        self.updated = Stored::Present((self.bits, *force));
+        self.basis = [Stored::Absent, Stored::Absent];
         self.fixed = false;
         self.curved = false;
         let force_norm = norm(force);
@@ -107,7 +108,7 @@ impl<T: Real> ActiveSet<T> {
             }
             let v = v / rest;
             match self.basis.iter_mut().find(|b| b.is_none()) {
-                Some(slot) => *slot = Some(v),
+                Some(slot) => *slot = Stored::Present(v),
                 None => self.fixed = true,
             }
         }
@@ -168,7 +169,7 @@ impl<T: Real> ActiveSet<T> {
 
     /// Whether [`Self::downdate`] changes a Gram matrix (a held normal, or a fixed agent).
     pub(in crate::allocation) fn downdates(&self) -> bool {
-        self.fixed || self.basis.iter().any(Option::is_some)
+        self.fixed || self.basis.iter().any(Stored::is_some)
     }
 
     /// Whether a held constraint is a cone or a sphere.
@@ -187,6 +188,22 @@ fn lower_downdate<T: Real>(gram: &mut nalgebra::Matrix6<T>, v: &Vector6<T>) {
                 *x -= *vi * *vj;
             }
         }
+    }
+}
+
+impl<T: Real> ActiveSet<T> {
+    /// Whether the set at `this` holds valid tags: the basis's two, the last update's and the
+    /// two flags. Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(in crate::allocation) unsafe fn storage_intact(this: *const Self) -> bool {
+        let basis = core::ptr::addr_of!((*this).basis).cast::<Stored<Vector3<T>>>();
+        Stored::tag_intact(basis)
+            && Stored::tag_intact(basis.add(1))
+            && Stored::tag_intact(core::ptr::addr_of!((*this).updated))
+            && bool_intact(core::ptr::addr_of!((*this).fixed))
+            && bool_intact(core::ptr::addr_of!((*this).curved))
     }
 }
 

@@ -8,8 +8,10 @@
 /// cap and target").
 pub const DEFAULT_MAX_ROUNDS: u32 = 2;
 
-/// How many rounds the exact-boundary redistribution may walk per allocation.
+/// How many rounds the exact-boundary redistribution may walk per allocation. `repr(u8)`: the
+/// tag first, checked raw by [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
 pub enum RoundCap {
     /// At most this many rounds (`Rounds(0)`: the walk's start alone, the redistributed
     /// pseudo-inverse or the previous forces, whichever does better). A capped walk returns the
@@ -29,6 +31,14 @@ impl Default for RoundCap {
 }
 
 impl RoundCap {
+    /// Whether the cap at `this` has one of the two tags.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        crate::foundation::stored::tag_below(this, 2)
+    }
+
     /// The cap as a number of rounds (`u32::MAX` when uncapped: no walk reaches it), as
     /// [`super::WalkCost::bound`] takes it.
     pub const fn rounds(self) -> u32 {

@@ -48,7 +48,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .zip(&self.forces)
             .zip(self.working.iter().zip(self.bounds.iter()))
         {
-            if let (Some(block), true) = (block, *w) {
+            if let (Some(block), true) = (block.as_ref(), *w) {
                 a.update(b, f);
                 a.downdate(block, &mut gram);
                 movable |= !a.fixed();
@@ -73,7 +73,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .zip(self.effectiveness.blocks())
             .zip(&self.working)
         {
-            if let (Some(block), true) = (block, *w) {
+            if let (Some(block), true) = (block.as_ref(), *w) {
                 *d = block.tr_mul(&lambda);
             }
         }
@@ -226,7 +226,7 @@ impl<T: Real, const N: usize> Walk<'_, T, N> {
             .zip(&self.forces)
             .zip(&self.working)
         {
-            if let (Some(block), true) = (block, *w) {
+            if let (Some(block), true) = (block.as_ref(), *w) {
                 *d = block.tr_mul(&lambda) - f;
             }
         }

@@ -8,12 +8,13 @@ use super::constraint::{constraints, Constraint, CONSTRAINTS};
 use super::walk::offset;
 use crate::agent::admissible::AdmissibleSet;
 use crate::foundation::real::Real;
+use crate::foundation::stored::Stored;
 
 /// Scratch of one allocation, and the constraints of the sets it last saw.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Workspace<T: Real, const N: usize> {
     /// The set each agent's constraints were built from (`None`: not built).
-    built_from: [Option<AdmissibleSet<T>>; N],
+    built_from: [Stored<AdmissibleSet<T>>; N],
     pub(super) bounds: [[Constraint<T>; CONSTRAINTS]; N],
     /// Each agent's largest constraint offset `|k|` ([`offset`]), for the line search's rays.
     pub(super) offsets: [T; N],
@@ -23,7 +24,7 @@ pub(super) struct Workspace<T: Real, const N: usize> {
 impl<T: Real, const N: usize> Default for Workspace<T, N> {
     fn default() -> Self {
         Self {
-            built_from: [None; N],
+            built_from: [Stored::Absent; N],
             bounds: [[Constraint::placeholder(); CONSTRAINTS]; N],
             offsets: [T::zero(); N],
             active: [ActiveSet::default(); N],
@@ -68,8 +69,25 @@ impl<T: Real, const N: usize> Workspace<T, N> {
             ) {
                 *b = bounds;
                 *o = offset(&bounds);
-                *f = Some(*set);
+                *f = Stored::Present(*set);
             }
         }
+    }
+}
+
+impl<T: Real, const N: usize> Workspace<T, N> {
+    /// Whether the workspace at `this` holds valid tags: each agent's built set's and its
+    /// held set's ([`ActiveSet::storage_intact`]). Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(super) unsafe fn storage_intact(this: *const Self) -> bool {
+        let built = core::ptr::addr_of!((*this).built_from).cast::<Stored<AdmissibleSet<T>>>();
+        let active = core::ptr::addr_of!((*this).active).cast::<ActiveSet<T>>();
+        let mut intact = true;
+        for i in 0..N {
+            intact &= Stored::tag_intact(built.add(i)) && ActiveSet::storage_intact(active.add(i));
+        }
+        intact
     }
 }

@@ -18,6 +18,7 @@ use nalgebra::Vector3;
 use crate::agent::effectiveness::Effectiveness;
 use crate::foundation::error::{ConfigError, ConfigField};
 use crate::foundation::real::Real;
+use crate::foundation::stored::tag_below;
 
 /// Largest iteration cap [`NullSpaceStage::new`] accepts.
 pub const MAX_NULL_SPACE_ITERATIONS: u32 = 64;
@@ -224,5 +225,39 @@ mod tests {
         let (back, report) = stage.refine(&request, &bad);
         assert!(!report.ran && back.forces[1].x.is_nan());
         assert_eq!(back.forces[0], bad.forces[0]);
+    }
+}
+
+impl<T: Real> NullSpaceStage<T> {
+    /// Whether the stage at `this` has a valid objective tag (two variants) and an iteration
+    /// count in `1..=`[`MAX_NULL_SPACE_ITERATIONS`]. Reads only.
+    ///
+    /// # Safety
+    /// `this` is aligned and points to `size_of::<Self>()` readable bytes.
+    pub(crate) unsafe fn storage_intact(this: *const Self) -> bool {
+        let iterations = core::ptr::addr_of!((*this).iterations).read();
+        tag_below(core::ptr::addr_of!((*this).objective), 2)
+            && (1..=MAX_NULL_SPACE_ITERATIONS).contains(&iterations)
+    }
+}
+
+#[cfg(test)]
+mod storage_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::foundation::stored::{accepts, refused_bytes};
+
+    #[test]
+    fn its_objective_tag_and_iterations_are_checked() {
+        let check = NullSpaceStage::<f32>::storage_intact;
+        let tilt = NullSpaceObjective::InwardTilt { angle: 0.1 };
+        for objective in [NullSpaceObjective::Margin, tilt] {
+            let stage = NullSpaceStage::new(objective, 8).unwrap();
+            assert!(accepts(&stage, check));
+            // The tag and the iteration count's three high bytes (2 iterations are valid, 65
+            // are not: its low byte too).
+            assert_eq!(refused_bytes(&stage, 2, check), 1 + 3);
+            assert_eq!(refused_bytes(&stage, 0x41, check), 1 + 4);
+        }
     }
 }

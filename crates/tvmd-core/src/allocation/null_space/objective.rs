@@ -3,8 +3,10 @@
 
 use crate::foundation::real::Real;
 
-/// The objective of a [`super::NullSpaceStage`].
+/// The objective of a [`super::NullSpaceStage`]. `repr(u8)`: the tag first, checked raw by
+/// [`crate::Controller::storage_intact`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
 pub enum NullSpaceObjective<T: Real> {
     /// Keep every working agent away from its limits: maximize the soft minimum
     /// `-(1/kappa) ln sum_j exp(-kappa h_j)` (`kappa = 32`) of the normalized margins `h_j`, one

@@ -37,9 +37,9 @@ pub(super) fn project_null<T: Real, const N: usize>(
         .zip(inward.iter_mut())
         .zip(frozen)
     {
-        if let (Some(b), true) = (block, *cold) {
+        if let (Some(b), true) = (block.as_ref(), *cold) {
             gram -= b * b.transpose();
-        } else if let Some(b) = block {
+        } else if let Some(b) = block.as_ref() {
             a.downdate(b, &mut gram);
             if !a.fixed() {
                 *q = a.normals().fold(Vector3::zeros(), |acc, u| {
@@ -59,7 +59,7 @@ pub(super) fn project_null<T: Real, const N: usize>(
         .zip(&inward)
         .zip(frozen)
     {
-        if let (Some(b), false) = (block, *cold) {
+        if let (Some(b), false) = (block.as_ref(), *cold) {
             *slot = a.project(&(gi - b.tr_mul(&lambda))) + q;
         }
     }
