@@ -89,15 +89,17 @@ cargo build --release --locked --manifest-path embedded/ffi-check/Cargo.toml \
 echo "every entry point linked, opt-level 3 (the speed the on-target costs are measured at):"
 python3 scripts/elf_size.py "$check_dir/thumbv7em-none-eabihf/release/tvmd-ffi-check"
 
-step "the same link built for flash (opt-level z, LLVM inline threshold 40): panic-free too, text at most 80 KB"
+step "the same link built for flash (opt-level z, LLVM inline threshold 40): panic-free too, text at most 81,000 B"
 # Flight stacks build for size (PX4: -Os). At opt-level z alone nalgebra's small accessors stay
 # out of line with their bounds checks (a panic path); an inline threshold of 40 inlines them
 # back, and the link proves none is left. The flags go in CARGO_ENCODED_RUSTFLAGS so that they
 # reach only this build. Its own target directory, so that neither build invalidates the other's
-# cache. Issue 45 asks for at most 80 KB (docs/c-interface.md, Footprint).
+# cache. Issue 45 asked for at most 80 KB; the raw check of every tag the handle stores (issue 57,
+# item 7) took it to 80,866 B, and the bound became 81,000 B: defined behaviour on a corrupted
+# handle is worth 1.1% of flash (docs/c-interface.md, Footprint).
 CARGO_PROFILE_RELEASE_OPT_LEVEL=z CARGO_ENCODED_RUSTFLAGS="-Cllvm-args=-inline-threshold=40" \
   cargo build --release --locked \
   --manifest-path embedded/ffi-check/Cargo.toml --target thumbv7em-none-eabihf \
   --target-dir embedded/ffi-check/target-flash
 python3 scripts/elf_size.py embedded/ffi-check/target-flash/thumbv7em-none-eabihf/release/tvmd-ffi-check \
-  --max-text 80000
+  --max-text 81000
