@@ -24,7 +24,7 @@ use tvmd_sim::{run_scenario, FaultSummary, RunResult};
 use tvmd_studies::montecarlo::Conditions;
 
 mod fault_common;
-use fault_common::{map, quantiles, Phase, TEAMS};
+use fault_common::{delay_after, delay_column, map, Phase, TEAMS};
 
 const SEED: u64 = 47;
 
@@ -70,14 +70,9 @@ struct FaultRun {
 }
 
 impl FaultRun {
-    /// Delay of an event to the fault when it names the right agent; `Err(())` for a wrong
-    /// agent or an event before the fault; `Ok(None)` when none.
-    fn delay(&self, event: Option<tvmd_sim::FaultEvent>) -> Result<Option<f64>, ()> {
-        match event {
-            None => Ok(None),
-            Some(e) if e.agent == self.agent && e.time >= self.t_f => Ok(Some(e.time - self.t_f)),
-            Some(_) => Err(()),
-        }
+    /// The delay of an event naming the right agent after the fault; `Err` for another agent.
+    fn delay(&self, e: Option<tvmd_sim::FaultEvent>) -> Result<Option<f64>, ()> {
+        delay_after(e, self.agent, self.t_f)
     }
 }
 
@@ -145,15 +140,9 @@ fn fault_table(runs: &[FaultRun]) {
                     .collect();
                 let mut wrong = 0;
                 let mut column = |pick: &dyn Fn(&FaultRun) -> Option<tvmd_sim::FaultEvent>| {
-                    let mut delays = Vec::new();
-                    for r in &group {
-                        match r.delay(pick(r)) {
-                            Ok(Some(d)) => delays.push(d),
-                            Ok(None) => {}
-                            Err(()) => wrong += 1,
-                        }
-                    }
-                    (delays.len(), quantiles(delays, 2))
+                    let (n, q, w) = delay_column(&group, |r| r.delay(pick(r)), 2);
+                    wrong += w;
+                    (n, q)
                 };
                 let (ns, ds) = column(&|r| r.fault.first_suspected);
                 let (nc, dc) = column(&|r| r.fault.first_confirmed);

@@ -34,7 +34,7 @@ use tvmd_studies::montecarlo::Conditions;
 
 mod fault_common;
 mod fault_effect;
-use fault_common::{map, quantiles, Phase, TEAMS};
+use fault_common::{delay_after, delay_column, map, quantiles, Phase, TEAMS};
 use fault_effect::{EffectWatch, FirstEffect};
 
 const SEED: u64 = 60;
@@ -159,11 +159,7 @@ struct FaultRun {
 impl FaultRun {
     /// The delay of an event naming the right agent after the fault; `Err` for another agent.
     fn delay(&self, e: Option<FaultEvent>) -> Result<Option<f64>, ()> {
-        match e {
-            None => Ok(None),
-            Some(e) if e.agent == self.agent && e.time >= self.t_f => Ok(Some(e.time - self.t_f)),
-            Some(_) => Err(()),
-        }
+        delay_after(e, self.agent, self.t_f)
     }
 
     /// The delay of the first confirmation (the right agent) after the failure's first effect
@@ -255,15 +251,9 @@ fn fault_table(runs: &[FaultRun]) {
     for (team, fault, phase, group) in groups(runs) {
         let mut wrong = 0;
         let mut column = |pick: &dyn Fn(&FaultRun) -> Option<FaultEvent>| {
-            let mut delays = Vec::new();
-            for r in &group {
-                match r.delay(pick(r)) {
-                    Ok(Some(d)) => delays.push(d),
-                    Ok(None) => {}
-                    Err(()) => wrong += 1,
-                }
-            }
-            (delays.len(), quantiles(delays, 3))
+            let (n, q, w) = delay_column(&group, |r| r.delay(pick(r)), 3);
+            wrong += w;
+            (n, q)
         };
         let (ns, ds) = column(&|r| r.summary.first_suspected);
         let (nc, dc) = column(&|r| r.summary.first_confirmed);

@@ -1,6 +1,6 @@
 //! What the fault studies share (`fault_detection.rs`, `fault_reports.rs`): the flight phases,
-//! the flight of a team with a Monte Carlo draw and the default conditions, a parallel map and
-//! the median / worst of a column.
+//! the flight of a team with a Monte Carlo draw and the default conditions, a parallel map,
+//! the delays of the detector's events and the median / worst of a column.
 
 use tvmd_scenario::{FaultDetectionConfig, LawConfig, Scenario};
 use tvmd_studies::montecarlo::{Conditions, Distributions, Draw};
@@ -81,4 +81,36 @@ pub fn quantiles(mut v: Vec<f64>, digits: usize) -> String {
     }
     v.sort_by(f64::total_cmp);
     format!("{:.digits$} / {:.digits$}", v[v.len() / 2], v[v.len() - 1])
+}
+
+/// The delay of `event` after the fault of `agent` at `t_f`: `Ok(None)` when nothing was
+/// named, `Err(())` for another agent or an event before the fault.
+pub fn delay_after(
+    event: Option<tvmd_sim::FaultEvent>,
+    agent: usize,
+    t_f: f64,
+) -> Result<Option<f64>, ()> {
+    match event {
+        None => Ok(None),
+        Some(e) if e.agent == agent && e.time >= t_f => Ok(Some(e.time - t_f)),
+        Some(_) => Err(()),
+    }
+}
+
+/// One column of delays over `group`: how many runs had one, their `median / worst` with
+/// `digits` decimals, and how many named another agent.
+pub fn delay_column<R>(
+    group: &[&R],
+    delay: impl Fn(&R) -> Result<Option<f64>, ()>,
+    digits: usize,
+) -> (usize, String, usize) {
+    let (mut delays, mut wrong) = (Vec::new(), 0);
+    for r in group {
+        match delay(r) {
+            Ok(Some(d)) => delays.push(d),
+            Ok(None) => {}
+            Err(()) => wrong += 1,
+        }
+    }
+    (delays.len(), quantiles(delays, digits), wrong)
 }
