@@ -145,8 +145,9 @@ impl<T: Real, const N: usize> Allocator<T, N> for AnyAllocator<T, N> {
             0 | 2 | 4 => true,
             1 => inner::<WeightedPseudoInverse<T, N>, T, N>(this),
             3 => inner::<ExactBoundaryRedistribution<T, N>, T, N>(this),
-            // The `clarabel` allocators keep heap pointers no check can vouch for: a build with
-            // the feature is not one a C caller's handle holds.
+            // The `clarabel` allocators keep heap pointers no raw check can vouch for. The C
+            // interface never builds one and is built without the feature; a build that
+            // unifies it in (`--all-features`) accepts these two tags unchecked.
             #[cfg(feature = "clarabel")]
             5 | 6 => true,
             _ => false,

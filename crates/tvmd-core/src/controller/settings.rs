@@ -188,23 +188,6 @@ pub(super) struct StoredSettings<T: Real> {
     pub(super) fault_detection: Stored<FaultDetection<T>>,
 }
 
-impl<T: Real> From<ControllerSettings<T>> for StoredSettings<T> {
-    fn from(s: ControllerSettings<T>) -> Self {
-        Self {
-            gains: s.gains,
-            relaxation: s.relaxation,
-            gravity: s.gravity,
-            period: s.period,
-            rate_limits: s.rate_limits.into(),
-            null_space: s.null_space.into(),
-            gain_schedule: s.gain_schedule,
-            offset_free: s.offset_free.into(),
-            attitude_rate: s.attitude_rate.into(),
-            fault_detection: s.fault_detection.into(),
-        }
-    }
-}
-
 impl<T: Real> From<StoredSettings<T>> for ControllerSettings<T> {
     fn from(s: StoredSettings<T>) -> Self {
         Self {
@@ -223,9 +206,9 @@ impl<T: Real> From<StoredSettings<T>> for ControllerSettings<T> {
 }
 
 impl<T: Real> StoredSettings<T> {
-    /// Writes `s` at `this` field by field, each optional part's tag and value in place: the
-    /// same settings as `Self::from(*s)`, without a converted copy on the stack (about 370 B
-    /// less of the C interface's flash build).
+    /// Writes `s` at `this` field by field, each optional part's tag and value in place (what
+    /// `ControllerSettings::from` reads back as `s`), without a converted copy on the stack
+    /// (about 370 B less of the C interface's flash build).
     ///
     /// # Safety
     /// `this` is aligned and points to `size_of::<Self>()` writable bytes.

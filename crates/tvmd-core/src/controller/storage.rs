@@ -353,8 +353,9 @@ mod tests {
                     }
                 })
                 .count();
-            // 7: past every tag and flag (the allocator's too, with or without `clarabel`). The variant's tag, then the variant's own tags (as in
-            // its module's test): 2 + 4 x 6 or 1 + 4 + 1.
+            // 7: past every tag and flag (the allocator's too, with or without `clarabel`).
+            // Refused: the variant's tag, then the variant's own tags (as in its module's
+            // test): 2 + 4 x 6 or 1 + 4 + 1.
             let own = if name == "weighted-pseudo-inverse" {
                 6
             } else {
