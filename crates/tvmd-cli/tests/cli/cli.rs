@@ -298,18 +298,17 @@ fn null_space_option_reports_its_margins_and_rejects_bad_objectives() {
     }
 }
 
+/// A6-Inc loses agent 0 at 0.5 s in a hover the controller is not told of.
+const A6_UNTOLD_LOSS: &str =
+    "name = \"loss\"\nduration = 1.2\ninitial_position = [0.0, 0.0, 1.5]\n\
+     [team]\npreset = \"a6-inc\"\n[reference]\nkind = \"hover\"\nposition = [0.0, 0.0, 1.5]\n\
+     [[failures]]\nagent = 0\ntime = 0.5\nkind = \"no-thrust\"\ncontroller_informed = false\n";
+
 #[test]
 fn detect_option_reports_the_fault_and_needs_the_observer() {
     let dir = tmp_dir("detect");
-    // A6-Inc loses agent 0 at 0.5 s in a hover the controller is not told of.
     let path = dir.join("loss.toml");
-    std::fs::write(
-        &path,
-        "name = \"loss\"\nduration = 1.2\ninitial_position = [0.0, 0.0, 1.5]\n\
-         [team]\npreset = \"a6-inc\"\n[reference]\nkind = \"hover\"\nposition = [0.0, 0.0, 1.5]\n\
-         [[failures]]\nagent = 0\ntime = 0.5\nkind = \"no-thrust\"\ncontroller_informed = false\n",
-    )
-    .unwrap();
+    std::fs::write(&path, A6_UNTOLD_LOSS).unwrap();
     let summary = dir.join("summary.json");
     ok(bin()
         .args([
@@ -354,15 +353,8 @@ fn detect_option_reports_the_fault_and_needs_the_observer() {
 #[test]
 fn reports_option_turns_on_the_agents_reports() {
     let dir = tmp_dir("reports");
-    // A6-Inc loses agent 0 at 0.5 s in a hover the controller is not told of.
     let path = dir.join("loss.toml");
-    std::fs::write(
-        &path,
-        "name = \"loss\"\nduration = 1.2\ninitial_position = [0.0, 0.0, 1.5]\n\
-         [team]\npreset = \"a6-inc\"\n[reference]\nkind = \"hover\"\nposition = [0.0, 0.0, 1.5]\n\
-         [[failures]]\nagent = 0\ntime = 0.5\nkind = \"no-thrust\"\ncontroller_informed = false\n",
-    )
-    .unwrap();
+    std::fs::write(&path, A6_UNTOLD_LOSS).unwrap();
     let summary = dir.join("summary.json");
     let masked = |reports: &[&str]| {
         ok(bin()
